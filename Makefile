@@ -1,0 +1,29 @@
+# make demo : set up .venv and localize on a shipped part (plot in out/)
+# make test : set up .venv and run the tests, the doctests and the benchmark smoke run
+PYTHON ?= python3.11
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+
+.PHONY: demo test bench clean
+
+$(STAMP): pyproject.toml
+	@test -x $(PY) || { command -v $(PYTHON) >/dev/null 2>&1 || { echo "$(PYTHON) not found; run: make PYTHON=/path/to/python3.11"; exit 1; }; $(PYTHON) -m venv $(VENV); }
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[dev]'
+	@touch $(STAMP)
+
+demo: $(STAMP)
+	@mkdir -p out
+	$(VENV)/bin/rolltouch localize parts/cam.json --length 25 --turn 40 --then 20 30 --plot out/demo.png
+	@echo "plot written to out/demo.png"
+
+test: $(STAMP)
+	$(PY) -m pytest -q tests localizer
+	$(PY) -m pytest -q bench --benchmark-disable -p no:cacheprovider
+
+bench: $(STAMP)
+	$(PY) -m pytest bench --benchmark-only --benchmark-json=out/bench.json
+
+clean:
+	rm -rf $(VENV) out .pytest_cache .benchmarks

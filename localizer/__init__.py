@@ -1,0 +1,8 @@
+"""Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
+
+from ._errors import LocalizerError, PartError, QueryError
+from ._part import UNITS_TO_MM, Part, load_part, part_from_points
+from ._solver import DIRECTIONS, METHODS, Segment, feasible_segments
+
+__all__ = ["LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
+           "Segment", "feasible_segments", "METHODS", "DIRECTIONS"]

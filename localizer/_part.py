@@ -1,0 +1,488 @@
+"""The part model: a closed C2 cubic spline through the part's points.
+
+Knot ``i`` sits at parameter ``i``; the domain is ``[0, N)`` and the curve is
+periodic, so every function here accepts *unrolled* parameters (any real
+``t``; ``t + N`` is the same point one lap further on). Along the unrolled
+curve, arc length and tangent angle grow by the perimeter and by ``2*pi``
+per lap, which makes arc length ℓ(s, t) and total curvature Φ(s, t) plain
+differences, for segments that wrap past the first point too.
+
+Lengths are in millimetres, angles in radians, arc positions are measured
+counter-clockwise from the first point.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from ._errors import PartError
+from ._poly import bernstein_bounds, horner, poly_der, poly_mul
+
+__all__ = ["Part", "load_part", "part_from_points", "UNITS_TO_MM"]
+
+#: Length units a part file may declare, and their size in millimetres.
+UNITS_TO_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "um": 1e-3}
+
+_TWO_PI = 2.0 * np.pi
+# Gauss-Legendre nodes on [0, 1]: 16 for whole table cells, 8 for partial ones.
+_GL16_X, _GL16_W = np.polynomial.legendre.leggauss(16)
+_GL16_X, _GL16_W = 0.5 * (_GL16_X + 1.0), 0.5 * _GL16_W
+_GL8_X, _GL8_W = np.polynomial.legendre.leggauss(8)
+_GL8_X, _GL8_W = 0.5 * (_GL8_X + 1.0), 0.5 * _GL8_W
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    """Map angles to [-pi, pi)."""
+    return (angle + np.pi) % _TWO_PI - np.pi
+
+
+@dataclass(frozen=True, eq=False)
+class Part:
+    """A part's boundary: the closed, counter-clockwise C2 cubic spline through its points.
+
+    Build one with :func:`load_part` or :func:`part_from_points`, which
+    validate their input; the constructor trusts it.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 2), mm
+        Knots in counter-clockwise order, first point first.
+    name : str
+        A name for messages and plots.
+    cells_per_piece : int
+        Table resolution: each spline piece is split into this many cells
+        for the arc-length table and the solver's grid.
+
+    Attributes
+    ----------
+    n_knots : int
+        N, the number of knots; parameters run over ``[0, N)``.
+    perimeter : float, mm
+        Arc length of the whole boundary.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    >>> part = part_from_points(np.c_[30 * np.cos(a), 20 * np.sin(a)], name="ellipse")
+    >>> round(part.perimeter, 3)  # Ramanujan: 158.654 for the true ellipse
+    158.654
+    >>> float(part.total_curvature(0.0, 64.0))  # one lap turns by 2 pi
+    6.283185307179586
+    """
+
+    points: np.ndarray
+    name: str = "part"
+    cells_per_piece: int = 4
+    n_knots: int = field(init=False)
+    perimeter: float = field(init=False)
+
+    def __post_init__(self):
+        pts = np.array(self.points, dtype=float)
+        pts.setflags(write=False)
+        object.__setattr__(self, "points", pts)
+        n = len(pts)
+        object.__setattr__(self, "n_knots", n)
+        closed = np.vstack([pts, pts[:1]])
+        spline = CubicSpline(np.arange(n + 1, dtype=float), closed, bc_type="periodic")
+        # Ascending coefficients per piece: (N, 4) for x and for y.
+        cx = spline.c[::-1, :, 0].T.copy()
+        cy = spline.c[::-1, :, 1].T.copy()
+        dx, dy = poly_der(cx), poly_der(cy)
+        ddx, ddy = poly_der(dx), poly_der(dy)
+        num = poly_mul(dx, ddy) - poly_mul(dy, ddx)  # x'y'' - y'x''
+        den = poly_mul(dx, dx) + poly_mul(dy, dy)  # |alpha'|^2
+        dkappa = poly_mul(poly_der(num), den) - 1.5 * poly_mul(num, poly_der(den))
+        object.__setattr__(self, "_cx", cx)
+        object.__setattr__(self, "_cy", cy)
+        object.__setattr__(self, "_dx", dx)
+        object.__setattr__(self, "_dy", dy)
+        object.__setattr__(self, "_ddx", ddx)
+        object.__setattr__(self, "_ddy", ddy)
+        object.__setattr__(self, "_num", num)
+        object.__setattr__(self, "_den", den)
+        object.__setattr__(self, "_dkappa", dkappa)
+        self._build_table(int(self.cells_per_piece))
+
+    # ------------------------------------------------------------------ tables
+    def _build_table(self, m: int) -> None:
+        """Cumulative arc length, tangent angle and curvature bounds on a cell grid."""
+        n = self.n_knots
+        while True:
+            j = np.arange(n * m)
+            piece = j // m
+            u0 = (j % m) / m
+            u1 = u0 + 1.0 / m
+            dlo, _ = bernstein_bounds(self._den[piece], u0, u1)
+            if np.any(dlo <= 0.0):
+                # The Bernstein bound is loose or the speed really vanishes.
+                bad = int(np.argmin(dlo))
+                fine = self._speed_piece(piece[bad], np.linspace(u0[bad], u1[bad], 257))
+                if fine.min() < 1e-9 * max(1.0, np.ptp(self.points)):
+                    raise PartError(
+                        f"part {self.name!r}: the spline stops (zero speed, a cusp) near "
+                        f"parameter {piece[bad] + fine.argmin() / 256 / m + u0[bad] - piece[bad]:.3f}; "
+                        "space the points more evenly")
+                if m >= 256:
+                    raise PartError(f"part {self.name!r}: speed bound failed near parameter {j[bad] / m:.3f}")
+                m *= 2
+                continue
+            nlo, nhi = bernstein_bounds(self._num[piece], u0, u1)
+            kappa_abs = np.maximum(np.abs(nlo), np.abs(nhi)) / dlo ** 1.5
+            # cell arc lengths
+            uu = u0[:, None] + (u1 - u0)[:, None] * _GL16_X
+            sp = self._speed_piece(piece[:, None], uu)
+            dsig = (sp * _GL16_W).sum(axis=1) * (u1 - u0)
+            if np.all(kappa_abs * dsig < 1.0) or m >= 256:
+                break
+            m *= 2
+        object.__setattr__(self, "cells_per_piece", m)
+        sig = np.concatenate([[0.0], np.cumsum(dsig)])
+        perimeter = float(sig[-1])
+        object.__setattr__(self, "perimeter", perimeter)
+        t_nodes = np.arange(n * m + 1) / m
+        dxn = horner(self._dx[np.minimum(t_nodes.astype(int) % n, n - 1)], t_nodes - np.floor(t_nodes))
+        dyn = horner(self._dy[np.minimum(t_nodes.astype(int) % n, n - 1)], t_nodes - np.floor(t_nodes))
+        raw = np.arctan2(dyn, dxn)
+        theta = raw[0] + np.concatenate([[0.0], np.cumsum(_wrap(np.diff(raw)))])
+        turning = theta[-1] - theta[0]
+        # Bound of |d kappa / d sigma| per cell, on 4 sub-cells each for tightness.
+        sub = 4
+        js = np.repeat(j, sub)
+        ps = js // m
+        a0 = (js % m) / m + (np.tile(np.arange(sub), n * m) / (sub * m))
+        a1 = a0 + 1.0 / (sub * m)
+        plo, phi = bernstein_bounds(self._dkappa[ps], a0, a1)
+        dlo_s, _ = bernstein_bounds(self._den[ps], a0, a1)
+        dlo_s = np.maximum(dlo_s, 0.25 * np.repeat(dlo, sub))
+        k1 = (np.maximum(np.abs(plo), np.abs(phi)) / dlo_s ** 3).reshape(-1, sub).max(axis=1)
+        object.__setattr__(self, "_m", m)
+        object.__setattr__(self, "_t_nodes", t_nodes)
+        object.__setattr__(self, "_sig_nodes", sig)
+        object.__setattr__(self, "_theta_nodes", theta)
+        object.__setattr__(self, "_turning", float(turning))
+        object.__setattr__(self, "_k1", k1 * (1 + 1e-9) + 1e-15)
+        object.__setattr__(self, "_kappa_abs", kappa_abs)
+        v_nodes = np.hypot(dxn, dyn)
+        object.__setattr__(self, "_dtds_nodes", 1.0 / v_nodes)
+
+    def _speed_piece(self, piece, u):
+        return np.hypot(horner(self._dx[piece], u), horner(self._dy[piece], u))
+
+    # --------------------------------------------------------------- locating
+    def _split(self, t):
+        """Unrolled parameter -> (lap, piece, u in [0, 1), cell index)."""
+        t = np.asarray(t, dtype=float)
+        n = self.n_knots
+        lap = np.floor(t / n)
+        tt = t - lap * n
+        piece = np.minimum(tt.astype(np.int64), n - 1)
+        u = tt - piece
+        cell = np.minimum((tt * self._m).astype(np.int64), n * self._m - 1)
+        return lap, piece, u, cell
+
+    # -------------------------------------------------------- functions of t
+    def point(self, t) -> np.ndarray:
+        """Boundary point at parameter ``t``; shape ``t.shape + (2,)``, mm."""
+        _, piece, u, _ = self._split(t)
+        return np.stack([horner(self._cx[piece], u), horner(self._cy[piece], u)], axis=-1)
+
+    def derivative(self, t) -> np.ndarray:
+        """Curve derivative dα/dt at ``t``; shape ``t.shape + (2,)``, mm per unit parameter."""
+        _, piece, u, _ = self._split(t)
+        return np.stack([horner(self._dx[piece], u), horner(self._dy[piece], u)], axis=-1)
+
+    def speed(self, t) -> np.ndarray:
+        """Curve speed ``|dα/dt|`` at ``t``, mm per unit parameter."""
+        _, piece, u, _ = self._split(t)
+        return self._speed_piece(piece, u)
+
+    def tangent(self, t) -> np.ndarray:
+        """Unit tangent (counter-clockwise direction) at ``t``; shape ``t.shape + (2,)``."""
+        d = self.derivative(t)
+        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+    def normal(self, t) -> np.ndarray:
+        """Unit outward normal at ``t`` (the tangent turned clockwise)."""
+        tg = self.tangent(t)
+        return np.stack([tg[..., 1], -tg[..., 0]], axis=-1)
+
+    def tangent_angle(self, t) -> np.ndarray:
+        """Unwrapped tangent angle θ(t), rad: continuous, θ(t + N) = θ(t) + 2π."""
+        lap, piece, u, cell = self._split(t)
+        raw = np.arctan2(horner(self._dy[piece], u), horner(self._dx[piece], u))
+        base = self._theta_nodes[cell]
+        return base + _wrap(raw - base) + _TWO_PI * lap
+
+    def curvature(self, t) -> np.ndarray:
+        """Signed curvature κ(t), 1/mm: positive where the boundary is convex."""
+        _, piece, u, _ = self._split(t)
+        return horner(self._num[piece], u) / horner(self._den[piece], u) ** 1.5
+
+    def arc_at_param(self, t) -> np.ndarray:
+        """Unrolled arc position Λ(t) = ℓ(0, t), mm (grows by the perimeter per lap)."""
+        lap, piece, u, cell = self._split(t)
+        return self._sig_nodes[cell] + self._partial_arc(piece, cell, u) + self.perimeter * lap
+
+    def _partial_arc(self, piece, cell, u):
+        """Arc length from the start of ``cell`` to ``u`` within ``piece``."""
+        u0 = (cell - piece * self._m) / self._m
+        w = u - u0
+        uu = u0[..., None] + w[..., None] * _GL8_X
+        return (self._speed_piece(piece[..., None], uu) * _GL8_W).sum(axis=-1) * w
+
+    def arc_length(self, s, t) -> np.ndarray:
+        """Arc length ℓ(s, t) of the counter-clockwise stretch from ``s`` to ``t``, mm.
+
+        Parameters are unrolled; when ``t < s`` the stretch wraps past the
+        first point (``t`` is taken one lap further on).
+        """
+        s = np.asarray(s, dtype=float)
+        t = np.asarray(t, dtype=float)
+        laps = np.where(t < s, np.ceil((s - t) / self.n_knots), 0.0)
+        return self.arc_at_param(t + laps * self.n_knots) - self.arc_at_param(s)
+
+    def total_curvature(self, s, t) -> np.ndarray:
+        """Total curvature Φ(s, t) = ∫ κ dℓ of the stretch from ``s`` to ``t``, rad.
+
+        Exact: the difference of unwrapped tangent angles. ``t < s`` wraps as
+        in :meth:`arc_length`.
+        """
+        s = np.asarray(s, dtype=float)
+        t = np.asarray(t, dtype=float)
+        laps = np.where(t < s, np.ceil((s - t) / self.n_knots), 0.0)
+        return self.tangent_angle(t + laps * self.n_knots) - self.tangent_angle(s)
+
+    def _state(self, t):
+        """Exact (unrolled arc position, unwrapped tangent angle, curvature, speed) at ``t``."""
+        lap, piece, u, cell = self._split(t)
+        dx = horner(self._dx[piece], u)
+        dy = horner(self._dy[piece], u)
+        ddx = horner(self._ddx[piece], u)
+        ddy = horner(self._ddy[piece], u)
+        v2 = dx * dx + dy * dy
+        v = np.sqrt(v2)
+        base = self._theta_nodes[cell]
+        theta = base + _wrap(np.arctan2(dy, dx) - base) + _TWO_PI * lap
+        sigma = self._sig_nodes[cell] + self._partial_arc(piece, cell, u) + self.perimeter * lap
+        return sigma, theta, (dx * ddy - dy * ddx) / (v2 * v), v
+
+    # ---------------------------------------------------- functions of arc
+    def param_at_arc(self, sigma, *, newton_steps: int = 2) -> np.ndarray:
+        """Unrolled parameter at unrolled arc position ``sigma`` (mm): the inverse of ℓ(0, ·).
+
+        A cubic Hermite guess inside the table cell, then safeguarded Newton
+        steps on the Gauss-Legendre arc length (two steps give ~1e-13 mm).
+        """
+        sigma = np.asarray(sigma, dtype=float)
+        P = self.perimeter
+        lap = np.floor(sigma / P)
+        ss = sigma - lap * P
+        nodes = self._sig_nodes
+        ncell = len(nodes) - 1
+        cell = np.clip(np.searchsorted(nodes, ss, side="right") - 1, 0, ncell - 1)
+        s0, s1 = nodes[cell], nodes[cell + 1]
+        h = s1 - s0
+        x = (ss - s0) / h
+        m = self._m
+        t0 = cell / m
+        dt = 1.0 / m
+        d0 = self._dtds_nodes[cell] * h
+        d1 = self._dtds_nodes[cell + 1] * h
+        # cubic Hermite in x on [0, 1] for t(sigma)
+        x2, x3 = x * x, x * x * x
+        t = (t0 + dt * (3 * x2 - 2 * x3) + d0 * (x3 - 2 * x2 + x) + d1 * (x3 - x2))
+        piece = cell // m
+        lo, hi = t0, t0 + dt
+        target = ss - s0
+        for _ in range(newton_steps):
+            u = t - piece
+            f = self._partial_arc(piece, cell, u) - target
+            t = np.clip(t - f / self._speed_piece(piece, u), lo, hi)
+        return t + lap * self.n_knots
+
+    def point_at_arc(self, sigma) -> np.ndarray:
+        """Boundary point at arc position ``sigma`` (mm); shape ``sigma.shape + (2,)``."""
+        return self.point(self.param_at_arc(sigma))
+
+    def tangent_angle_at_arc(self, sigma) -> np.ndarray:
+        """Unwrapped tangent angle at arc position ``sigma``, rad (grows 2π per lap)."""
+        return self.tangent_angle(self.param_at_arc(sigma))
+
+    def curvature_at_arc(self, sigma) -> np.ndarray:
+        """Signed curvature at arc position ``sigma``, 1/mm."""
+        return self.curvature(self.param_at_arc(sigma))
+
+    def wrap_arc(self, sigma) -> np.ndarray:
+        """Arc positions reduced to ``[0, perimeter)``."""
+        w = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
+        return np.where(w >= self.perimeter, 0.0, w)
+
+    def sample(self, per_piece: int = 16) -> np.ndarray:
+        """Dense closed polyline of the boundary, shape (N*per_piece + 1, 2), mm."""
+        t = np.arange(self.n_knots * per_piece + 1) / per_piece
+        return self.point(t)
+
+
+# ------------------------------------------------------------------ loading
+def _check_points(points, source: str) -> np.ndarray:
+    try:
+        pts = np.array(points, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise PartError(f"{source}: points must be a list of [x, y] numbers ({exc})") from None
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise PartError(f"{source}: points must have shape (N, 2), got {pts.shape}")
+    if len(pts) < 4:
+        raise PartError(f"{source}: a part needs at least 4 points, got {len(pts)}")
+    bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
+    if bad.size:
+        raise PartError(f"{source}: point {bad[0]} is {pts[bad[0]].tolist()}: NaN or inf is not a coordinate")
+    step = np.linalg.norm(np.roll(pts, -1, axis=0) - pts, axis=1)
+    scale = np.ptp(pts, axis=0).max()
+    if scale <= 0:
+        raise PartError(f"{source}: all points coincide")
+    dup = np.flatnonzero(step <= 1e-9 * scale)
+    if dup.size:
+        i = int(dup[0])
+        raise PartError(
+            f"{source}: points {i} and {(i + 1) % len(pts)} coincide at {pts[i].tolist()}; "
+            "remove the repeated point (do not close the list by repeating the first point)")
+    return pts
+
+
+def _segments_cross(poly: np.ndarray):
+    """First pair of non-adjacent crossing edges of a closed polyline, or None."""
+    a = poly[:-1]
+    b = poly[1:]
+    n = len(a)
+    lo = np.minimum(a, b)
+    hi = np.maximum(a, b)
+    order = np.argsort(lo[:, 0])
+    for idx in range(n):
+        i = order[idx]
+        # candidates: edges whose x-range overlaps, later in the sort order
+        cand = order[idx + 1:]
+        cand = cand[lo[cand, 0] <= hi[i, 0]]
+        if cand.size == 0:
+            continue
+        cand = cand[(lo[cand, 1] <= hi[i, 1]) & (hi[cand, 1] >= lo[i, 1])]
+        cand = cand[(np.abs(cand - i) > 1) & (np.abs(cand - i) < n - 1)]
+        if cand.size == 0:
+            continue
+        p, r = a[i], b[i] - a[i]
+        q, sv = a[cand], b[cand] - a[cand]
+        rxs = r[0] * sv[:, 1] - r[1] * sv[:, 0]
+        qp = q - p
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tt = (qp[:, 0] * sv[:, 1] - qp[:, 1] * sv[:, 0]) / rxs
+            uu = (qp[:, 0] * r[1] - qp[:, 1] * r[0]) / rxs
+        hit = (rxs != 0) & (tt >= 0) & (tt <= 1) & (uu >= 0) & (uu <= 1)
+        if hit.any():
+            return int(i), int(cand[np.argmax(hit)])
+    return None
+
+
+def part_from_points(points, *, name: str = "part", units: str = "mm", source: str | None = None) -> Part:
+    """Validate a point list and build its :class:`Part`.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2)
+        Boundary points in ``units``, in either winding; the first point stays first.
+    name : str
+        Name of the part.
+    units : {"mm", "cm", "m", "in", "um"}
+        Units of ``points``; the part is stored in mm.
+    source : str, optional
+        What to call the input in error messages (a file name).
+
+    Returns
+    -------
+    Part
+
+    Raises
+    ------
+    PartError
+        Fewer than 4 points, a NaN or inf, coincident consecutive points, unknown
+        units, a spline that stops (cusp) or crosses itself.
+
+    Examples
+    --------
+    >>> part_from_points([[0, 0], [1, 0], [1, 1]])
+    Traceback (most recent call last):
+    ...
+    localizer._errors.PartError: points: a part needs at least 4 points, got 3
+    """
+    source = source or "points"
+    if units not in UNITS_TO_MM:
+        raise PartError(f"{source}: unknown units {units!r}; use one of {sorted(UNITS_TO_MM)}")
+    pts = _check_points(points, source) * UNITS_TO_MM[units]
+    part = Part(pts, name=name)
+    turning = part._turning
+    if abs(abs(turning) - 2 * np.pi) > 1e-6:
+        raise PartError(
+            f"{source}: the spline through the points crosses itself (its tangent turns "
+            f"{turning / (2 * np.pi):.2f} times, a simple closed curve turns once); check the point order")
+    if turning < 0:  # clockwise: reverse, keeping the first point first
+        pts = np.vstack([pts[:1], pts[:0:-1]])
+        part = Part(pts, name=name)
+    crossing = _segments_cross(part.sample(16))
+    if crossing is not None:
+        i, j = sorted(crossing)
+        raise PartError(
+            f"{source}: the spline through the points crosses itself between parameters "
+            f"{i / 16:.2f} and {j / 16:.2f} (near points {i // 16} and {j // 16}); check the point order")
+    return part
+
+
+def load_part(path) -> Part:
+    """Read and validate a part file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A JSON file ``{"name": str, "units": "mm", "points": [[x, y], ...]}``
+        or a CSV file of ``x,y`` rows in mm (a header row and ``#`` comments
+        are allowed).
+
+    Returns
+    -------
+    Part
+
+    Raises
+    ------
+    PartError
+        The file is missing or unreadable, or the part is invalid (see
+        :func:`part_from_points`).
+    """
+    path = Path(path)
+    src = str(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise PartError(f"{src}: cannot read part file ({exc.strerror or exc})") from None
+    if path.suffix.lower() == ".csv":
+        rows = []
+        for k, row in enumerate(csv.reader(line for line in text.splitlines() if not line.lstrip().startswith("#"))):
+            if not row or all(not c.strip() for c in row):
+                continue
+            try:
+                rows.append([float(row[0]), float(row[1])])
+            except (ValueError, IndexError):
+                if rows or k > 0:
+                    raise PartError(f"{src}: row {k + 1} {row!r} is not two numbers x,y") from None
+        return part_from_points(rows, name=path.stem, source=src)
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise PartError(f"{src}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    if not isinstance(data, dict) or "points" not in data:
+        raise PartError(f'{src}: a part file is a JSON object with "name", "units" and "points"')
+    units = data.get("units", "mm")
+    return part_from_points(data["points"], name=str(data.get("name", path.stem)), units=units, source=src)

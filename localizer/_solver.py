@@ -1,0 +1,441 @@
+"""The exact feasible-segment solver (paper §II, DESIGN "The localization problem").
+
+Find every arc position σ where a segment of arc length L starting there has
+total curvature Ω:
+
+    g(σ) = θ(σ + L) - θ(σ) - Ω = 0,     g'(σ) = κ(σ + L) - κ(σ),
+
+with θ the unwrapped tangent angle as a function of arc position (exact, no
+integration) and κ the signed curvature.
+
+Completeness comes from a certificate on every cell of a grid in σ. The
+part's table bounds |dκ/dσ| on each of its cells, so ``K = K(base cell) +
+K(end cell)`` bounds |g''| on a cell, and with g and g' known exactly at the
+cell's ends:
+
+* ``g'(a) + g'(b) > K w`` (or ``< -K w``) certifies g strictly monotone on the
+  cell: exactly one root if g changes sign there, none otherwise;
+* otherwise the quadratic envelopes ``g(a) + g'(a) s - K s²/2`` and
+  ``g(b) - g'(b) s - K s²/2`` certify that a cell whose ends have the same sign
+  holds no root when their zero crossings overlap;
+* a cell that passes neither is bisected. Near a double root (g touching
+  zero) the bisection stops at a width of ``double_width`` mm and reports the
+  point as a root of kind ``"double"``; a stretch where |g| stays below
+  ``flat_tol`` everywhere (a circular arc of radius L/Ω) is reported as one
+  ``"continuum"`` segment with its extent, so no root is ever skipped.
+
+Bracketed roots are refined together by a safeguarded Newton iteration to
+``tol`` mm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._errors import QueryError
+from ._part import Part, _TWO_PI
+from ._table import ArcTable, arc_table
+
+__all__ = ["Segment", "feasible_segments", "METHODS", "DIRECTIONS"]
+
+#: Solver methods accepted by :func:`feasible_segments`.
+METHODS = ("exact",)
+#: Rolling directions: the contact moves counter-clockwise or clockwise on the part.
+DIRECTIONS = ("ccw", "cw")
+KINDS = ("simple", "double", "continuum")
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A boundary stretch with the requested arc length and total curvature.
+
+    Attributes
+    ----------
+    start_arc : float, mm
+        Where the contact started, counter-clockwise from the first point, in [0, perimeter).
+    end_arc : float, mm
+        Where the contact ended, in [0, perimeter). For ``direction="ccw"`` the
+        contact moved counter-clockwise from ``start_arc`` to ``end_arc``; for
+        ``"cw"`` clockwise.
+    start_param, end_param : float
+        Spline parameters of the two ends, in [0, N).
+    length : float, mm
+        Arc length L of the stretch (the query's).
+    turn : float, rad
+        Signed jaw rotation Ω (counter-clockwise positive), the query's.
+    direction : {"ccw", "cw"}
+        Direction the contact moved on the part.
+    kind : {"simple", "double", "continuum"}
+        ``"simple"``: a transversal root, refined to the solver's tolerance.
+        ``"double"``: g touches zero here (two roots closer than the solver's
+        resolution, or a tangency); the segment is feasible to within
+        ``residual``. ``"continuum"``: every start from ``start_arc`` over ``span`` mm
+        in the rolling direction is feasible (a circular stretch).
+    span : float, mm
+        Extent of a continuum, 0 otherwise.
+    residual : float, rad
+        |Φ(segment) - Ω| at the reported start.
+    """
+
+    start_arc: float
+    end_arc: float
+    start_param: float
+    end_param: float
+    length: float
+    turn: float
+    direction: str = "ccw"
+    kind: str = "simple"
+    span: float = 0.0
+    residual: float = 0.0
+
+    def as_dict(self) -> dict:
+        """Plain-JSON form."""
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+# ---------------------------------------------------------------- evaluators
+def _g_table(table: ArcTable, sigma, length, turn):
+    """Tabulated g and g' at arc positions ``sigma``."""
+    th_s, k_s = table.theta_kappa(sigma)
+    th_e, k_e = table.theta_kappa(sigma + length)
+    return th_e - th_s - turn, k_e - k_s
+
+
+def _g_exact(part: Part, sigma, length, turn):
+    """Exact g, g' and the parameters of both ends at arc positions ``sigma``."""
+    ts = part.param_at_arc(sigma)
+    te = part.param_at_arc(sigma + length)
+    _, th_s, k_s, _ = part._state(ts)
+    _, th_e, k_e, _ = part._state(te)
+    return th_e - th_s - turn, k_e - k_s, ts, te
+
+
+def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
+    """Newton on the exact system ℓ(s, e) = L, Φ(s, e) = Ω in the spline parameters.
+
+    Starts from the tabulated parameters of a root of the tabulated g; each
+    step is exact up to rounding, so two steps take a 1e-9 mm start to
+    machine precision. Returns (start arc, start param, end param, converged,
+    |Φ - Ω| at the start).
+    """
+    n = part.n_knots
+    ps, lap_s = table.param_at(sigma)
+    pe, lap_e = table.param_at(sigma + length)
+    s = ps + lap_s * n
+    e = pe + lap_e * n
+    both = np.concatenate([s, e])
+    k = s.size
+    for it in range(max_iter + 1):
+        lam, th, ka, v = part._state(both)
+        f1 = lam[k:] - lam[:k] - length
+        f2 = th[k:] - th[:k] - turn
+        gp = ka[k:] - ka[:k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dss = (ka[k:] * f1 - f2) / gp
+        dss = np.where(np.isfinite(dss), dss, np.inf)
+        step = np.abs(dss) + np.abs(f1)
+        if np.all(step <= tol) or it == max_iter:
+            break
+        both = both + np.concatenate([dss / v[:k], (dss - f1) / v[k:]])
+    # the last correction is below tol: the start is known to tol (Newton's error
+    # after a step is quadratic in that correction)
+    return lam[:k], both[:k], both[k:], step <= tol, np.abs(f2)
+
+
+def _cell_of(table: ArcTable, sigma: np.ndarray) -> np.ndarray:
+    return table.locate(sigma)[1]
+
+
+# ------------------------------------------------------------------ checks
+def _check_query(part: Part, length, turn, direction: str, method: str):
+    if not isinstance(part, Part):
+        raise QueryError(f"part must be a localizer.Part (use load_part), got {type(part).__name__}")
+    if method not in METHODS:
+        raise QueryError(f"unknown method {method!r}; use one of {list(METHODS)}")
+    if direction not in DIRECTIONS:
+        raise QueryError(f"unknown direction {direction!r}; use one of {list(DIRECTIONS)}")
+    try:
+        length = float(length)
+        turn = float(turn)
+    except (TypeError, ValueError):
+        raise QueryError(f"length and turn must be numbers, got {length!r} and {turn!r}") from None
+    if not np.isfinite(length) or not np.isfinite(turn):
+        raise QueryError(f"length and turn must be finite, got length={length!r} mm, turn={turn!r} rad")
+    if not 0.0 < length < part.perimeter:
+        raise QueryError(
+            f"length={length!r} mm is out of range: the contact travel must be in "
+            f"(0, perimeter={part.perimeter:.6g}) mm on part {part.name!r}")
+    return length, turn
+
+
+# ------------------------------------------------------------------- solver
+def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: float,
+               double_width: float, max_cells: int):
+    """Roots of g on [0, P) for counter-clockwise travel.
+
+    Returns (simple_roots, double_roots, continua): arrays of start arc
+    positions, and a list of (start, span) pairs.
+    """
+    table = arc_table(part)
+    P = part.perimeter
+    nodes = table.sig[:-1]
+    margin = 4.0 * table.theta_error + 1e-14   # |g - g_table| <= 2 theta_error
+    dmargin = 1e-9                             # slack on g' (tabulated κ is ~1e-11 off)
+    # Breakpoints: the table nodes (their θ, κ are the table's constants) and the
+    # starts whose end falls on a node; one table evaluation covers both.
+    J = nodes.size
+    th_n, k_n = table._th_cols[0], table._k_cols[0]
+    shifted = nodes - length
+    wrapped = shifted < 0.0
+    shifted = np.where(wrapped, shifted + P, shifted)
+    th_x, k_x = table.theta_kappa(np.concatenate([nodes + length, shifted]))
+    bp = np.concatenate([nodes, shifted])
+    g = np.concatenate([th_x[:J] - th_n, th_n + _TWO_PI * wrapped - th_x[J:]]) - turn
+    dg = np.concatenate([k_x[:J] - k_n, k_n - k_x[J:]])
+    order = np.argsort(bp, kind="stable")
+    bp, g, dg = bp[order], g[order], dg[order]
+    keep = np.concatenate([[True], np.diff(bp) > 1e-12 * P]) & (bp < P)
+    bp, g, dg = bp[keep], g[keep], dg[keep]
+    a = bp
+    b = np.append(bp[1:], P)
+    ga, da = g, dg
+    gb, db = np.append(g[1:], g[0]), np.append(dg[1:], dg[0])
+    mid = 0.5 * (a + b)
+    slope = table.kappa_slope
+    K = slope[_cell_of(table, mid)] + slope[_cell_of(table, mid + length)]
+
+    brackets = []  # (lo, hi, glo, ghi, near_double)
+    exact_zero = [a[ga == 0.0]]
+    doubles = []
+    flats = []
+    processed = 0
+    while a.size:
+        processed += a.size
+        if processed > max_cells:
+            raise QueryError(
+                f"the query length={length!r} mm, turn={turn!r} rad is degenerate on part "
+                f"{part.name!r}: g stays near zero on too many cells ({processed}); the part is "
+                "nearly a circular arc there. Raise flat_tol or max_cells")
+        w = b - a
+        s = da + db
+        mono = (s > K * w + dmargin) | (s < -(K * w + dmargin))
+        change = (ga * gb < 0.0)
+        take = mono & change
+        if take.any():
+            brackets.append((a[take], b[take], ga[take], gb[take], np.zeros(int(take.sum()), bool)))
+        rest = ~mono
+        # same-sign cells: no root if the quadratic envelopes' zero crossings overlap
+        sg = np.where(ga != 0.0, np.sign(ga), np.sign(gb))
+        Ga, Gb, Da, Db = sg * ga - margin, sg * gb - margin, sg * da, sg * db
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ra = (Da + np.sqrt(np.maximum(Da * Da + 2 * K * Ga, 0.0))) / K
+            rb = (-Db + np.sqrt(np.maximum(Db * Db + 2 * K * Gb, 0.0))) / K
+        excluded = (~change) & (Ga > 0) & (Gb > 0) & (ra + rb > w)
+        M = 0.5 * (np.abs(s) + K * w)
+        flat = (np.maximum(np.abs(ga), np.abs(gb)) + 0.5 * M * w + margin <= flat_tol)
+        rest &= ~excluded
+        fl = rest & flat
+        if fl.any():
+            flats.append(np.c_[a[fl], b[fl]])
+        rest &= ~flat
+        bottom = rest & (w <= double_width)
+        if bottom.any():
+            bc = bottom & change
+            if bc.any():
+                brackets.append((a[bc], b[bc], ga[bc], gb[bc], np.ones(int(bc.sum()), bool)))
+            bn = bottom & ~change
+            if bn.any():
+                pick = np.abs(ga[bn]) <= np.abs(gb[bn])
+                doubles.append(np.where(pick, a[bn], b[bn]))
+        split = rest & ~bottom
+        if not split.any():
+            break
+        a, b, ga, gb, da, db, K = (x[split] for x in (a, b, ga, gb, da, db, K))
+        m = 0.5 * (a + b)
+        gm, dm = _g_table(table, m, length, turn)
+        a = np.concatenate([a, m])
+        b = np.concatenate([m, b])
+        ga, gb = np.concatenate([ga, gm]), np.concatenate([gm, gb])
+        da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
+        K = np.concatenate([K, K])
+
+    simple = [np.concatenate(exact_zero)]
+    double_br = []
+    if brackets:
+        lo = np.concatenate([x[0] for x in brackets])
+        hi = np.concatenate([x[1] for x in brackets])
+        glo = np.concatenate([x[2] for x in brackets])
+        ghi = np.concatenate([x[3] for x in brackets])
+        dbl = np.concatenate([x[4] for x in brackets])
+        roots = _refine(lambda x: _g_table(table, x, length, turn), lo, hi, glo, ghi, 1e-9)
+        simple.append(roots[~dbl])
+        double_br.append(roots[dbl])
+    simple = np.concatenate(simple)
+    doubles = np.concatenate(doubles + double_br) if (doubles or double_br) else np.empty(0)
+    continua = _merge_flats(np.concatenate(flats) if flats else np.empty((0, 2)), P)
+    return simple, doubles, continua
+
+
+def _refine(fun, lo, hi, glo, ghi, tol):
+    """Safeguarded Newton on bracketed roots, all at once, to ``tol`` mm.
+
+    A Newton step that leaves the bracket is replaced by the secant of the
+    bracket (regula falsi), and that by bisection if it stalls.
+    """
+    lo, hi, glo, ghi = lo.copy(), hi.copy(), glo.copy(), ghi.copy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = lo - glo * (hi - lo) / (ghi - glo)
+    x = np.where(np.isfinite(x) & (x > lo) & (x < hi), x, 0.5 * (lo + hi))
+    active = np.ones(x.shape, bool)
+    for _ in range(100):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        xi = x[idx]
+        g, dg = fun(xi)
+        left = np.sign(g) == np.sign(glo[idx])
+        lo[idx] = np.where(left, xi, lo[idx])
+        glo[idx] = np.where(left, g, glo[idx])
+        hi[idx] = np.where(left, hi[idx], xi)
+        ghi[idx] = np.where(left, ghi[idx], g)
+        li, hii, gl, gh = lo[idx], hi[idx], glo[idx], ghi[idx]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = g / dg
+            xn = xi - step
+            xs = li - gl * (hii - li) / (gh - gl)
+        inside = (xn > li) & (xn < hii)
+        xs = np.where((xs > li) & (xs < hii) & (np.abs(xs - xi) < 0.5 * (hii - li)), xs, 0.5 * (li + hii))
+        xn = np.where(inside, xn, xs)
+        # an end of the bracket already within tol of the root (by its Newton step)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            el, eh = np.abs(gl / dg), np.abs(gh / dg)
+        near = np.minimum(el, eh) <= tol
+        xn = np.where(near, np.where(el <= eh, li, hii), xn)
+        done = (g == 0.0) | (hii - li <= tol) | (inside & (np.abs(step) <= tol)) | near
+        x[idx] = np.where(g == 0.0, xi, xn)
+        active[idx[done]] = False
+    return x
+
+
+def _merge_flats(cells: np.ndarray, P: float):
+    if len(cells) == 0:
+        return []
+    cells = cells[np.argsort(cells[:, 0])]
+    out = [list(cells[0])]
+    for a, b in cells[1:]:
+        if a <= out[-1][1] + 1e-9:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    if len(out) > 1 and out[0][0] <= 1e-9 and out[-1][1] >= P - 1e-9:  # joins across σ = 0
+        first = out.pop(0)
+        out[-1][1] = P + first[1]
+    return [(a, b - a) for a, b in out]
+
+
+def _dedupe(x: np.ndarray, P: float, sep: float) -> np.ndarray:
+    if x.size == 0:
+        return x
+    x = np.sort(np.mod(x, P))
+    keep = np.concatenate([[True], np.diff(x) > sep])
+    x = x[keep]
+    if x.size > 1 and (x[0] + P - x[-1]) <= sep:
+        x = x[:-1]
+    return x
+
+
+def feasible_segments(part: Part, length: float, turn: float, *, method: str = "exact",
+                      direction: str = "ccw", tol: float = 1e-10, flat_tol: float = 1e-10,
+                      double_width: float = 1e-7, max_cells: int = 2_000_000) -> list[Segment]:
+    """Every boundary segment with arc length ``length`` and total curvature ``turn``.
+
+    Parameters
+    ----------
+    part : Part
+        The part, from :func:`load_part`.
+    length : float, mm
+        Contact travel L on the jaw (= arc length on the part, eq. 3), ``0 < L < perimeter``.
+    turn : float, rad
+        Signed jaw rotation Ω, counter-clockwise positive (eq. 4). Rolling
+        counter-clockwise over a convex stretch gives Ω > 0; a negative Ω with
+        counter-clockwise travel is legal across a concave stretch.
+    method : {"exact"}
+        Solver. ``"exact"`` is complete by construction (see module notes).
+    direction : {"ccw", "cw"}
+        Direction the contact moved on the part. For ``"cw"`` the contact
+        moved clockwise from ``start_arc`` to ``end_arc``; rolling clockwise
+        over a convex stretch turns the jaw clockwise (Ω < 0).
+    tol : float, mm
+        Accuracy of each root's arc position.
+    flat_tol : float, rad
+        |g| below which a whole cell counts as feasible (a circular stretch).
+    double_width : float, mm
+        Width below which a cell that cannot be certified is reported as a double root.
+    max_cells : int
+        Work limit against degenerate queries.
+
+    Returns
+    -------
+    list of Segment
+        Sorted by ``start_arc``; empty when no segment has that turn.
+
+    Raises
+    ------
+    QueryError
+        ``length`` not in (0, perimeter), non-finite arguments, an unknown
+        method or direction, or a degenerate query beyond ``max_cells``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from localizer import part_from_points
+    >>> a = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    >>> ellipse = part_from_points(np.c_[40 * np.cos(a), 25 * np.sin(a)])
+    >>> segs = feasible_segments(ellipse, 20.0, 0.5)
+    >>> len(segs)  # by symmetry the roots come in pairs
+    4
+    >>> [round(s.start_arc, 3) for s in segs]
+    [4.319, 49.541, 70.984, 116.206]
+    """
+    length, turn = _check_query(part, length, turn, direction, method)
+    P = part.perimeter
+    omega = turn if direction == "ccw" else -turn
+    simple, doubles, continua = _solve_ccw(part, length, omega, tol=tol, flat_tol=flat_tol,
+                                           double_width=double_width, max_cells=max_cells)
+    table = arc_table(part)
+    n = part.n_knots
+    rows = []  # (start arc, kind, span, residual, start param, end param), ccw sense
+    simple = _dedupe(simple, P, 1e-3 * tol)
+    if simple.size:
+        lam, ps, pe, ok, res = _polish(part, table, simple, length, omega, tol)
+        for i in range(simple.size):
+            # a root the exact Newton cannot settle is ill-conditioned (g' ~ 0): near-double
+            rows.append((lam[i] if ok[i] else simple[i], "simple" if ok[i] else "double", 0.0,
+                         res[i], ps[i], pe[i]))
+    doubles = _dedupe(doubles, P, 10 * double_width)
+    if rows and doubles.size:  # a double root already bracketed as a simple one
+        known = np.array([r[0] for r in rows])
+        d = np.abs((doubles[:, None] - known[None, :] + P / 2) % P - P / 2)
+        doubles = doubles[d.min(axis=1) > 10 * double_width]
+    others = [(x, "double", 0.0) for x in doubles] + [(a0, "continuum", sp) for a0, sp in continua]
+    if others:
+        sig = np.mod(np.array([o[0] for o in others]), P)
+        g, _, ts, te = _g_exact(part, sig, length, omega)
+        rows += [(s0, kind, sp, abs(gi), t0, t1) for (_, kind, sp), s0, gi, t0, t1 in zip(others, sig, g, ts, te)]
+    out = []
+    for s0, kind, sp_, res, t0, t1 in rows:
+        if direction == "ccw":
+            sa, ea, sp, ep = s0, s0 + length, t0, t1
+        else:  # the ccw stretch [s0, s0 + L] was travelled from its far end
+            sa, ea, sp, ep = s0 + length, s0, t1, t0
+            if kind == "continuum":
+                sa, ea = s0 + length + sp_, s0 + sp_
+        out.append(Segment(
+            start_arc=float(part.wrap_arc(sa)), end_arc=float(part.wrap_arc(ea)),
+            start_param=float(np.mod(sp, n)), end_param=float(np.mod(ep, n)),
+            length=length, turn=turn, direction=direction, kind=kind, span=float(sp_),
+            residual=float(res)))
+    out.sort(key=lambda s: s.start_arc)
+    return out
