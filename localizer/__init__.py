@@ -2,7 +2,9 @@
 
 from ._errors import LocalizerError, PartError, QueryError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
+from ._disambiguate import RULES, Candidate, Localization, localize
 from ._solver import DIRECTIONS, METHODS, Segment, feasible_segments
 
 __all__ = ["LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
-           "Segment", "feasible_segments", "METHODS", "DIRECTIONS"]
+           "Segment", "feasible_segments", "METHODS", "DIRECTIONS",
+           "Candidate", "Localization", "localize", "RULES"]
