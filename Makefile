@@ -15,8 +15,7 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	@mkdir -p out
-	$(VENV)/bin/rolltouch localize parts/cam.json --length 25 --turn 40 --then 20 30 --plot out/demo.png
-	@echo "plot written to out/demo.png"
+	$(VENV)/bin/rolltouch localize parts/trefoil.json --length 25.2 --turn 31.8 --then 19.9 34.4 --plot out/demo.png
 
 test: $(STAMP)
 	$(PY) -m pytest -q tests localizer
