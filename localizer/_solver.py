@@ -397,7 +397,9 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
     >>> len(segs)  # by symmetry the roots come in pairs
     4
     >>> [round(s.start_arc, 3) for s in segs]
-    [4.319, 49.541, 70.984, 116.206]
+    [15.425, 68.04, 118.891, 171.506]
+    >>> abs(segs[2].start_arc - segs[0].start_arc - ellipse.perimeter / 2) < 1e-9
+    True
     """
     length, turn = _check_query(part, length, turn, direction, method)
     P = part.perimeter
