@@ -1,0 +1,34 @@
+"""Reference costs the benchmarks compare against."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["trapezoid_perimeter", "trefoil_part", "PARTS_DIR"]
+
+from pathlib import Path
+
+PARTS_DIR = Path(__file__).resolve().parents[1] / "parts"
+
+
+def trapezoid_perimeter(part, h: float = 1e-5, chunk: int = 1_000_000) -> float:
+    """Perimeter by the trapezoid rule at step ``h`` in the parameter domain, mm.
+
+    The paper's unit of cost (§II-B: "acquiring the perimeter of α by
+    integration requires τ/h numerical steps"), vectorized in chunks so the
+    baseline is as fast as numpy allows.
+    """
+    n = int(round(part.n_knots / h))
+    total = 0.0
+    for i in range(0, n, chunk):
+        t = np.arange(i, min(i + chunk, n) + 1) * h
+        v = part.speed(t)
+        total += h * (v.sum() - 0.5 * (v[0] + v[-1]))
+    return float(total)
+
+
+def trefoil_part():
+    """The 90-knot non-convex benchmark part."""
+    from localizer import load_part
+
+    return load_part(PARTS_DIR / "trefoil.json")
