@@ -108,6 +108,7 @@ class Part:
         object.__setattr__(self, "_num", num)
         object.__setattr__(self, "_den", den)
         object.__setattr__(self, "_dkappa", dkappa)
+        object.__setattr__(self, "_dcols", np.ascontiguousarray(np.hstack([dx, dy]).T))
         self._build_table(int(self.cells_per_piece))
 
     # ------------------------------------------------------------------ tables
@@ -262,10 +263,11 @@ class Part:
     def _state(self, t):
         """Exact (unrolled arc position, unwrapped tangent angle, curvature, speed) at ``t``."""
         lap, piece, u, cell = self._split(t)
-        dx = horner(self._dx[piece], u)
-        dy = horner(self._dy[piece], u)
-        ddx = horner(self._ddx[piece], u)
-        ddy = horner(self._ddy[piece], u)
+        c = self._dcols[:, piece]  # x', y' coefficients (6, n): gathered once
+        dx = (c[2] * u + c[1]) * u + c[0]
+        dy = (c[5] * u + c[4]) * u + c[3]
+        ddx = 2.0 * c[2] * u + c[1]
+        ddy = 2.0 * c[5] * u + c[4]
         v2 = dx * dx + dy * dy
         v = np.sqrt(v2)
         base = self._theta_nodes[cell]

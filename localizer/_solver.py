@@ -190,21 +190,25 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
     shifted = nodes - length
     wrapped = shifted < 0.0
     shifted = np.where(wrapped, shifted + P, shifted)
-    th_x, k_x = table.theta_kappa(np.concatenate([nodes + length, shifted]))
+    th_x, k_x, c_x = table.theta_kappa_cell(np.concatenate([nodes + length, shifted]))
     bp = np.concatenate([nodes, shifted])
     g = np.concatenate([th_x[:J] - th_n, th_n + _TWO_PI * wrapped - th_x[J:]]) - turn
     dg = np.concatenate([k_x[:J] - k_n, k_n - k_x[J:]])
+    # table cells of each breakpoint's start and end, known exactly by construction
+    idx = np.arange(J)
+    cell_s = np.concatenate([idx, c_x[J:]])
+    cell_e = np.concatenate([c_x[:J], idx])
     order = np.argsort(bp, kind="stable")
-    bp, g, dg = bp[order], g[order], dg[order]
-    keep = np.concatenate([[True], np.diff(bp) > 1e-12 * P]) & (bp < P)
-    bp, g, dg = bp[keep], g[keep], dg[keep]
+    bp, g, dg, cell_s, cell_e = bp[order], g[order], dg[order], cell_s[order], cell_e[order]
+    keep = np.concatenate([np.diff(bp) > 1e-12 * P, [True]]) & (bp < P)
+    bp, g, dg, cell_s, cell_e = bp[keep], g[keep], dg[keep], cell_s[keep], cell_e[keep]
     a = bp
     b = np.append(bp[1:], P)
     ga, da = g, dg
     gb, db = np.append(g[1:], g[0]), np.append(dg[1:], dg[0])
-    mid = 0.5 * (a + b)
+    # a cell [a, b] lies in the start's table cell and its end [a+L, b+L] in the end's
     slope = table.kappa_slope
-    K = slope[_cell_of(table, mid)] + slope[_cell_of(table, mid + length)]
+    K = slope[cell_s] + slope[cell_e]
 
     brackets = []  # (lo, hi, glo, ghi, near_double)
     exact_zero = [a[ga == 0.0]]
@@ -261,21 +265,39 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
         da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
         K = np.concatenate([K, K])
 
-    simple = [np.concatenate(exact_zero)]
-    double_br = []
+    zeros = np.concatenate(exact_zero)
     if brackets:
-        lo = np.concatenate([x[0] for x in brackets])
-        hi = np.concatenate([x[1] for x in brackets])
-        glo = np.concatenate([x[2] for x in brackets])
-        ghi = np.concatenate([x[3] for x in brackets])
-        dbl = np.concatenate([x[4] for x in brackets])
-        roots = _refine(lambda x: _g_table(table, x, length, turn), lo, hi, glo, ghi, 1e-9)
-        simple.append(roots[~dbl])
-        double_br.append(roots[dbl])
-    simple = np.concatenate(simple)
-    doubles = np.concatenate(doubles + double_br) if (doubles or double_br) else np.empty(0)
+        brackets = tuple(np.concatenate([x[i] for x in brackets]) for i in range(5))
+    else:
+        brackets = None
+    doubles = np.concatenate(doubles) if doubles else np.empty(0)
     continua = _merge_flats(np.concatenate(flats) if flats else np.empty((0, 2)), P)
-    return simple, doubles, continua
+    return zeros, brackets, doubles, continua
+
+
+def _roots_from_brackets(part, table, brackets, length, turn, tol):
+    """Exact roots in certified single-root brackets.
+
+    Exact Newton (:func:`_polish`) from the secant point of each bracket; a
+    root that does not converge inside its bracket is first refined on the
+    table with a safeguarded Newton, then polished again.
+    """
+    lo, hi, glo, ghi, dbl = brackets
+    P = part.perimeter
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x0 = lo - glo * (hi - lo) / (ghi - glo)
+    x0 = np.where(np.isfinite(x0) & (x0 >= lo) & (x0 <= hi), x0, 0.5 * (lo + hi))
+    lam, ps, pe, ok, res = _polish(part, table, x0, length, turn, tol, max_iter=4)
+    d = np.mod(lam - lo, P)
+    inside = (d <= hi - lo + 1e-9) | (d >= P - 1e-9)
+    bad = ~(ok & inside)
+    if bad.any():
+        xb = _refine(lambda x: _g_table(table, x, length, turn), lo[bad], hi[bad], glo[bad], ghi[bad], 1e-9)
+        out = _polish(part, table, xb, length, turn, tol)
+        for arr, new in zip((lam, ps, pe, ok, res), out):
+            arr[bad] = new
+        lam[bad & ~ok] = xb[~out[3]]
+    return lam, ps, pe, ok & ~dbl, res
 
 
 def _refine(fun, lo, hi, glo, ghi, tol):
@@ -404,18 +426,29 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
     length, turn = _check_query(part, length, turn, direction, method)
     P = part.perimeter
     omega = turn if direction == "ccw" else -turn
-    simple, doubles, continua = _solve_ccw(part, length, omega, tol=tol, flat_tol=flat_tol,
-                                           double_width=double_width, max_cells=max_cells)
+    zeros, brackets, doubles, continua = _solve_ccw(part, length, omega, tol=tol, flat_tol=flat_tol,
+                                                    double_width=double_width, max_cells=max_cells)
     table = arc_table(part)
     n = part.n_knots
     rows = []  # (start arc, kind, span, residual, start param, end param), ccw sense
-    simple = _dedupe(simple, P, 1e-3 * tol)
-    if simple.size:
-        lam, ps, pe, ok, res = _polish(part, table, simple, length, omega, tol)
-        for i in range(simple.size):
+    found = []
+    if zeros.size:
+        found.append(_polish(part, table, zeros, length, omega, tol))
+    if brackets is not None:
+        found.append(_roots_from_brackets(part, table, brackets, length, omega, tol))
+    for lam, ps, pe, ok, res in found:
+        for i in range(lam.size):
             # a root the exact Newton cannot settle is ill-conditioned (g' ~ 0): near-double
-            rows.append((lam[i] if ok[i] else simple[i], "simple" if ok[i] else "double", 0.0,
-                         res[i], ps[i], pe[i]))
+            rows.append((lam[i], "simple" if ok[i] else "double", 0.0, res[i], ps[i], pe[i]))
+    if rows:  # a root on a cell boundary is found from both sides
+        rows.sort(key=lambda r: np.mod(r[0], P))
+        keep = [rows[0]]
+        for r in rows[1:]:
+            if abs((r[0] - keep[-1][0] + P / 2) % P - P / 2) > 2 * tol:
+                keep.append(r)
+        if len(keep) > 1 and abs((keep[0][0] - keep[-1][0] + P / 2) % P - P / 2) <= 2 * tol:
+            keep.pop()
+        rows = keep
     doubles = _dedupe(doubles, P, 10 * double_width)
     if rows and doubles.size:  # a double root already bracketed as a simple one
         known = np.array([r[0] for r in rows])
@@ -426,18 +459,21 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
         sig = np.mod(np.array([o[0] for o in others]), P)
         g, _, ts, te = _g_exact(part, sig, length, omega)
         rows += [(s0, kind, sp, abs(gi), t0, t1) for (_, kind, sp), s0, gi, t0, t1 in zip(others, sig, g, ts, te)]
-    out = []
-    for s0, kind, sp_, res, t0, t1 in rows:
-        if direction == "ccw":
-            sa, ea, sp, ep = s0, s0 + length, t0, t1
-        else:  # the ccw stretch [s0, s0 + L] was travelled from its far end
-            sa, ea, sp, ep = s0 + length, s0, t1, t0
-            if kind == "continuum":
-                sa, ea = s0 + length + sp_, s0 + sp_
-        out.append(Segment(
-            start_arc=float(part.wrap_arc(sa)), end_arc=float(part.wrap_arc(ea)),
-            start_param=float(np.mod(sp, n)), end_param=float(np.mod(ep, n)),
-            length=length, turn=turn, direction=direction, kind=kind, span=float(sp_),
-            residual=float(res)))
+    if not rows:
+        return []
+    s0, sp_, res, t0, t1 = (np.array([r[i] for r in rows], dtype=float) for i in (0, 2, 3, 4, 5))
+    kinds = [r[1] for r in rows]
+    cont = np.array([k == "continuum" for k in kinds])
+    if direction == "ccw":
+        sa, ea, sp, ep = s0, s0 + length, t0, t1
+    else:  # the ccw stretch [s0, s0 + L] was travelled from its far end
+        sa = np.where(cont, s0 + length + sp_, s0 + length)
+        ea = np.where(cont, s0 + sp_, s0)
+        sp, ep = t1, t0
+    sa, ea = part.wrap_arc(sa).tolist(), part.wrap_arc(ea).tolist()
+    sp, ep = np.mod(sp, n).tolist(), np.mod(ep, n).tolist()
+    out = [Segment(start_arc=sa[i], end_arc=ea[i], start_param=sp[i], end_param=ep[i], length=length,
+                   turn=turn, direction=direction, kind=kinds[i], span=float(sp_[i]), residual=float(res[i]))
+           for i in range(len(rows))]
     out.sort(key=lambda s: s.start_arc)
     return out

@@ -82,6 +82,10 @@ class ArcTable:
 
     def theta_kappa(self, sigma):
         """Tabulated unwrapped tangent angle (rad) and curvature (1/mm) at ``sigma``."""
+        return self.theta_kappa_cell(sigma)[:2]
+
+    def theta_kappa_cell(self, sigma):
+        """As :meth:`theta_kappa`, plus the table cell of each point."""
         lap, cell, x = self.locate(sigma)
         c = self._th_cols
         th = c[5][cell]
@@ -91,7 +95,7 @@ class ArcTable:
         ka = c[4][cell]
         for k in (3, 2, 1, 0):
             ka = ka * x + c[k][cell]
-        return th + _TWO_PI * lap, ka
+        return th + _TWO_PI * lap, ka, cell
 
     def param_at(self, sigma):
         """Tabulated unrolled spline parameter at ``sigma`` (add ``lap * N`` outside)."""
