@@ -144,9 +144,6 @@ def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
     return lam[:k], both[:k], both[k:], step <= tol, np.abs(f2)
 
 
-def _cell_of(table: ArcTable, sigma: np.ndarray) -> np.ndarray:
-    return table.locate(sigma)[1]
-
 
 # ------------------------------------------------------------------ checks
 def _check_query(part: Part, length, turn, direction: str, method: str):
@@ -454,6 +451,8 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
         known = np.array([r[0] for r in rows])
         d = np.abs((doubles[:, None] - known[None, :] + P / 2) % P - P / 2)
         doubles = doubles[d.min(axis=1) > 10 * double_width]
+    for c0, span in continua:  # a touching point inside a continuum is part of it
+        doubles = doubles[np.mod(doubles - c0 + 10 * double_width, P) > span + 20 * double_width]
     others = [(x, "double", 0.0) for x in doubles] + [(a0, "continuum", sp) for a0, sp in continua]
     if others:
         sig = np.mod(np.array([o[0] for o in others]), P)

@@ -140,3 +140,28 @@ def test_bad_queries(kwargs, match):
 def test_part_argument_must_be_a_part():
     with pytest.raises(QueryError, match="must be a localizer.Part"):
         feasible_segments([[0, 0]], 1.0, 0.1)
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-9, -1e-9, 1e-6])
+def test_near_double_roots_are_found_not_skipped(offset):
+    """Ω at (or within 1e-6 rad of) a local extremum of Φ(σ, σ+L): g touches zero."""
+    from scipy.optimize import brentq
+
+    part = trefoil()
+    L = 20.0
+    dg = lambda s: float(part.curvature_at_arc(s + L) - part.curvature_at_arc(s))
+    grid = np.linspace(0, part.perimeter, 2000, endpoint=False)
+    vals = np.array([dg(s) for s in grid])
+    i = int(np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0])
+    s_star = brentq(dg, grid[i], grid[i + 1], xtol=1e-13)
+    phi = lambda s: float(part.tangent_angle_at_arc(s + L) - part.tangent_angle_at_arc(s))
+    # step towards the inside of the extremum so that two roots exist for offset > 0
+    curvature_sign = np.sign(phi(s_star + 0.01) + phi(s_star - 0.01) - 2 * phi(s_star))
+    w = phi(s_star) + curvature_sign * offset
+    segs = feasible_segments(part, L, w)
+    near = [s for s in segs if abs(s.start_arc - s_star) < 0.05]
+    if offset >= 0:
+        assert near, "the tangency was skipped"
+        assert all(s.residual < 1e-6 for s in near)
+    if offset > 1e-8:  # two distinct roots, both found
+        assert len(near) == 2 and all(s.kind == "simple" for s in near)
