@@ -79,4 +79,4 @@ def test_table_build(benchmark):
         return arc_table(p)
 
     table = benchmark.pedantic(build, rounds=5, iterations=1)
-    assert table.theta_error < 1e-10
+    assert table.theta_error < 1e-9

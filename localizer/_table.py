@@ -123,7 +123,7 @@ def _node_state(part: Part, piece, u):
     return np.arctan2(dy, dx), kappa, dkds, dtds, d2tds2
 
 
-def arc_table(part: Part, *, max_theta_error: float = 1e-11) -> ArcTable:
+def arc_table(part: Part, *, max_theta_error: float = 1e-9) -> ArcTable:
     """Build (and cache on the part) the arc-position tables of ``part``.
 
     Cells are the part's table cells, split further until the measured
