@@ -113,7 +113,7 @@ class Part:
 
     # ------------------------------------------------------------------ tables
     def _build_table(self, m: int) -> None:
-        """Cumulative arc length, tangent angle and curvature bounds on a cell grid."""
+        """Cumulative arc length and unwrapped tangent angle on a cell grid (each cell turns < 1 rad)."""
         n = self.n_knots
         while True:
             j = np.arange(n * m)
@@ -153,22 +153,11 @@ class Part:
         raw = np.arctan2(dyn, dxn)
         theta = raw[0] + np.concatenate([[0.0], np.cumsum(_wrap(np.diff(raw)))])
         turning = theta[-1] - theta[0]
-        # Bound of |d kappa / d sigma| per cell, on 4 sub-cells each for tightness.
-        sub = 4
-        js = np.repeat(j, sub)
-        ps = js // m
-        a0 = (js % m) / m + (np.tile(np.arange(sub), n * m) / (sub * m))
-        a1 = a0 + 1.0 / (sub * m)
-        plo, phi = bernstein_bounds(self._dkappa[ps], a0, a1)
-        dlo_s, _ = bernstein_bounds(self._den[ps], a0, a1)
-        dlo_s = np.maximum(dlo_s, 0.25 * np.repeat(dlo, sub))
-        k1 = (np.maximum(np.abs(plo), np.abs(phi)) / dlo_s ** 3).reshape(-1, sub).max(axis=1)
         object.__setattr__(self, "_m", m)
         object.__setattr__(self, "_t_nodes", t_nodes)
         object.__setattr__(self, "_sig_nodes", sig)
         object.__setattr__(self, "_theta_nodes", theta)
         object.__setattr__(self, "_turning", float(turning))
-        object.__setattr__(self, "_k1", k1 * (1 + 1e-9) + 1e-15)
         object.__setattr__(self, "_kappa_abs", kappa_abs)
         v_nodes = np.hypot(dxn, dyn)
         object.__setattr__(self, "_dtds_nodes", 1.0 / v_nodes)
