@@ -1,0 +1,1 @@
+"""pytest-benchmark suites, their baselines and (later) Monte Carlo studies."""

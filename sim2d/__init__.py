@@ -1,0 +1,1 @@
+"""The pymunk planar world and its simulated instruments (issue 4; depends on localizer)."""
