@@ -31,7 +31,7 @@ from scipy.optimize import least_squares
 
 from ._errors import QueryError
 from ._part import Part
-from ._solver import DIRECTIONS, Segment, feasible_segments
+from ._solver import DIRECTIONS, feasible_segments
 
 __all__ = ["Candidate", "Localization", "localize", "RULES"]
 
@@ -140,8 +140,7 @@ def _chain_turns(part: Part, start, lengths, sign):
     """Positions and turns of consecutive segments from unrolled arc ``start``."""
     pos = start + sign * np.concatenate([[0.0], np.cumsum(lengths)])
     t = part.param_at_arc(pos)
-    theta = part.tangent_angle(t)
-    kappa = part.curvature(t)
+    _, theta, kappa, _ = part._state(t)
     return pos, np.diff(theta), kappa, t
 
 
@@ -217,11 +216,10 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
         neg_log_evidence = float(r.cost + 0.5 * logdet)
         fits.append((neg_log_evidence, r.x))
     fits.sort(key=lambda f: f[0])
-    P = part.perimeter
     kept = []
     for f in fits:
         s = part.wrap_arc(f[1][0])
-        if all(abs((s - part.wrap_arc(k[1][0]) + P / 2) % P - P / 2) > min_separation for k in kept):
+        if all(abs(part.arc_offset(s, k[1][0])) > min_separation for k in kept):
             kept.append(f)
     nle = np.array([k[0] for k in kept])
     w = np.exp(-(nle - nle.min()))

@@ -42,6 +42,12 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
     return (angle + np.pi) % _TWO_PI - np.pi
 
 
+def _curvature(dx, dy, ddx, ddy):
+    """Signed curvature from first and second derivatives, 1/mm."""
+    v2 = dx * dx + dy * dy
+    return (dx * ddy - dy * ddx) / (v2 * np.sqrt(v2))
+
+
 @dataclass(frozen=True, eq=False)
 class Part:
     """A part's boundary: the closed, counter-clockwise C2 cubic spline through its points.
@@ -101,13 +107,10 @@ class Part:
         dkappa = poly_mul(poly_der(num), den) - 1.5 * poly_mul(num, poly_der(den))
         object.__setattr__(self, "_cx", cx)
         object.__setattr__(self, "_cy", cy)
-        object.__setattr__(self, "_dx", dx)
-        object.__setattr__(self, "_dy", dy)
-        object.__setattr__(self, "_ddx", ddx)
-        object.__setattr__(self, "_ddy", ddy)
         object.__setattr__(self, "_num", num)
         object.__setattr__(self, "_den", den)
         object.__setattr__(self, "_dkappa", dkappa)
+        # x', y' coefficients as rows (6, N): gathering 1-D rows is the fast path
         object.__setattr__(self, "_dcols", np.ascontiguousarray(np.hstack([dx, dy]).T))
         self._build_table(int(self.cells_per_piece))
 
@@ -148,8 +151,8 @@ class Part:
         perimeter = float(sig[-1])
         object.__setattr__(self, "perimeter", perimeter)
         t_nodes = np.arange(n * m + 1) / m
-        dxn = horner(self._dx[np.minimum(t_nodes.astype(int) % n, n - 1)], t_nodes - np.floor(t_nodes))
-        dyn = horner(self._dy[np.minimum(t_nodes.astype(int) % n, n - 1)], t_nodes - np.floor(t_nodes))
+        node_piece = np.minimum(t_nodes.astype(int), n - 1)
+        dxn, dyn, _, _ = self._derivs(node_piece, t_nodes - node_piece)
         raw = np.arctan2(dyn, dxn)
         theta = raw[0] + np.concatenate([[0.0], np.cumsum(_wrap(np.diff(raw)))])
         turning = theta[-1] - theta[0]
@@ -162,8 +165,16 @@ class Part:
         v_nodes = np.hypot(dxn, dyn)
         object.__setattr__(self, "_dtds_nodes", 1.0 / v_nodes)
 
+    def _derivs(self, piece, u):
+        """x', y', x'', y'' of spline pieces ``piece`` at local parameters ``u`` (broadcast)."""
+        c = self._dcols[:, piece]
+        dx = (c[2] * u + c[1]) * u + c[0]
+        dy = (c[5] * u + c[4]) * u + c[3]
+        return dx, dy, 2.0 * c[2] * u + c[1], 2.0 * c[5] * u + c[4]
+
     def _speed_piece(self, piece, u):
-        return np.hypot(horner(self._dx[piece], u), horner(self._dy[piece], u))
+        c = self._dcols[:, piece]
+        return np.hypot((c[2] * u + c[1]) * u + c[0], (c[5] * u + c[4]) * u + c[3])
 
     # --------------------------------------------------------------- locating
     def _split(self, t):
@@ -186,7 +197,8 @@ class Part:
     def derivative(self, t) -> np.ndarray:
         """Curve derivative dα/dt at ``t``; shape ``t.shape + (2,)``, mm per unit parameter."""
         _, piece, u, _ = self._split(t)
-        return np.stack([horner(self._dx[piece], u), horner(self._dy[piece], u)], axis=-1)
+        dx, dy, _, _ = self._derivs(piece, u)
+        return np.stack([dx, dy], axis=-1)
 
     def speed(self, t) -> np.ndarray:
         """Curve speed ``|dα/dt|`` at ``t``, mm per unit parameter."""
@@ -206,14 +218,18 @@ class Part:
     def tangent_angle(self, t) -> np.ndarray:
         """Unwrapped tangent angle θ(t), rad: continuous, θ(t + N) = θ(t) + 2π."""
         lap, piece, u, cell = self._split(t)
-        raw = np.arctan2(horner(self._dy[piece], u), horner(self._dx[piece], u))
+        dx, dy, _, _ = self._derivs(piece, u)
+        return self._unwrap(np.arctan2(dy, dx), cell, lap)
+
+    def _unwrap(self, raw, cell, lap):
+        """Unwrapped angle from atan2 ``raw``: the cell's start angle turns < 1 rad across the cell."""
         base = self._theta_nodes[cell]
         return base + _wrap(raw - base) + _TWO_PI * lap
 
     def curvature(self, t) -> np.ndarray:
         """Signed curvature κ(t), 1/mm: positive where the boundary is convex."""
         _, piece, u, _ = self._split(t)
-        return horner(self._num[piece], u) / horner(self._den[piece], u) ** 1.5
+        return _curvature(*self._derivs(piece, u))
 
     def arc_at_param(self, t) -> np.ndarray:
         """Unrolled arc position Λ(t) = ℓ(0, t), mm (grows by the perimeter per lap)."""
@@ -252,17 +268,10 @@ class Part:
     def _state(self, t):
         """Exact (unrolled arc position, unwrapped tangent angle, curvature, speed) at ``t``."""
         lap, piece, u, cell = self._split(t)
-        c = self._dcols[:, piece]  # x', y' coefficients (6, n): gathered once
-        dx = (c[2] * u + c[1]) * u + c[0]
-        dy = (c[5] * u + c[4]) * u + c[3]
-        ddx = 2.0 * c[2] * u + c[1]
-        ddy = 2.0 * c[5] * u + c[4]
-        v2 = dx * dx + dy * dy
-        v = np.sqrt(v2)
-        base = self._theta_nodes[cell]
-        theta = base + _wrap(np.arctan2(dy, dx) - base) + _TWO_PI * lap
+        dx, dy, ddx, ddy = self._derivs(piece, u)
+        theta = self._unwrap(np.arctan2(dy, dx), cell, lap)
         sigma = self._sig_nodes[cell] + self._partial_arc(piece, cell, u) + self.perimeter * lap
-        return sigma, theta, (dx * ddy - dy * ddx) / (v2 * v), v
+        return sigma, theta, _curvature(dx, dy, ddx, ddy), np.hypot(dx, dy)
 
     # ---------------------------------------------------- functions of arc
     def param_at_arc(self, sigma, *, newton_steps: int = 2) -> np.ndarray:
@@ -314,6 +323,15 @@ class Part:
         """Arc positions reduced to ``[0, perimeter)``."""
         w = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
         return np.where(w >= self.perimeter, 0.0, w)
+
+    def arc_offset(self, a, b) -> np.ndarray:
+        """Signed shortest offset from arc position ``b`` to ``a`` around the boundary, mm.
+
+        In ``[-perimeter/2, perimeter/2)``; its absolute value is the distance
+        along the boundary.
+        """
+        half = 0.5 * self.perimeter
+        return np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
 
     def sample(self, per_piece: int = 16) -> np.ndarray:
         """Dense closed polyline of the boundary, shape (N*per_piece + 1, 2), mm."""

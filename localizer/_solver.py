@@ -285,15 +285,13 @@ def _roots_from_brackets(part, table, brackets, length, turn, tol):
         x0 = lo - glo * (hi - lo) / (ghi - glo)
     x0 = np.where(np.isfinite(x0) & (x0 >= lo) & (x0 <= hi), x0, 0.5 * (lo + hi))
     lam, ps, pe, ok, res = _polish(part, table, x0, length, turn, tol, max_iter=4)
-    d = np.mod(lam - lo, P)
-    inside = (d <= hi - lo + 1e-9) | (d >= P - 1e-9)
-    bad = ~(ok & inside)
-    if bad.any():
+    inside = np.mod(lam - lo + 1e-9, P) <= hi - lo + 2e-9
+    bad = np.flatnonzero(~(ok & inside))
+    if bad.size:
         xb = _refine(lambda x: _g_table(table, x, length, turn), lo[bad], hi[bad], glo[bad], ghi[bad], 1e-9)
-        out = _polish(part, table, xb, length, turn, tol)
-        for arr, new in zip((lam, ps, pe, ok, res), out):
-            arr[bad] = new
-        lam[bad & ~ok] = xb[~out[3]]
+        lam[bad], ps[bad], pe[bad], ok[bad], res[bad] = _polish(part, table, xb, length, turn, tol)
+        # still unsettled: keep the table's root, reported as near-double below
+        lam[bad] = np.where(ok[bad], lam[bad], xb)
     return lam, ps, pe, ok & ~dbl, res
 
 
@@ -354,15 +352,21 @@ def _merge_flats(cells: np.ndarray, P: float):
     return [(a, b - a) for a, b in out]
 
 
-def _dedupe(x: np.ndarray, P: float, sep: float) -> np.ndarray:
+def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
+    """Indices of the arc positions ``x`` that stay once those within ``sep`` mm are merged.
+
+    Sorted by position in [0, P); the first of a run of close positions stays,
+    across σ = 0 too.
+    """
     if x.size == 0:
-        return x
-    x = np.sort(np.mod(x, P))
-    keep = np.concatenate([[True], np.diff(x) > sep])
-    x = x[keep]
-    if x.size > 1 and (x[0] + P - x[-1]) <= sep:
-        x = x[:-1]
-    return x
+        return np.zeros(0, dtype=int)
+    xm = np.mod(x, P)
+    order = np.argsort(xm, kind="stable")
+    xs = xm[order]
+    keep = np.concatenate([[True], np.diff(xs) > sep])
+    if keep.sum() > 1 and xs[0] + P - xs[np.flatnonzero(keep)[-1]] <= sep:
+        keep[np.flatnonzero(keep)[-1]] = False
+    return order[keep]
 
 
 def feasible_segments(part: Part, length: float, turn: float, *, method: str = "exact",
@@ -437,20 +441,13 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
         for i in range(lam.size):
             # a root the exact Newton cannot settle is ill-conditioned (g' ~ 0): near-double
             rows.append((lam[i], "simple" if ok[i] else "double", 0.0, res[i], ps[i], pe[i]))
-    if rows:  # a root on a cell boundary is found from both sides
-        rows.sort(key=lambda r: np.mod(r[0], P))
-        keep = [rows[0]]
-        for r in rows[1:]:
-            if abs((r[0] - keep[-1][0] + P / 2) % P - P / 2) > 2 * tol:
-                keep.append(r)
-        if len(keep) > 1 and abs((keep[0][0] - keep[-1][0] + P / 2) % P - P / 2) <= 2 * tol:
-            keep.pop()
-        rows = keep
-    doubles = _dedupe(doubles, P, 10 * double_width)
+    # a root on a cell boundary is found from both sides
+    rows = [rows[i] for i in _distinct(np.array([r[0] for r in rows]), P, 2 * tol)]
+    doubles = doubles[_distinct(doubles, P, 10 * double_width)]
     if rows and doubles.size:  # a double root already bracketed as a simple one
         known = np.array([r[0] for r in rows])
-        d = np.abs((doubles[:, None] - known[None, :] + P / 2) % P - P / 2)
-        doubles = doubles[d.min(axis=1) > 10 * double_width]
+        near = np.abs(part.arc_offset(doubles[:, None], known[None, :])).min(axis=1)
+        doubles = doubles[near > 10 * double_width]
     for c0, span in continua:  # a touching point inside a continuum is part of it
         doubles = doubles[np.mod(doubles - c0 + 10 * double_width, P) > span + 20 * double_width]
     others = [(x, "double", 0.0) for x in doubles] + [(a0, "continuum", sp) for a0, sp in continua]

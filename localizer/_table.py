@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._part import Part, _TWO_PI, _wrap
+from ._part import Part, _TWO_PI, _curvature, _wrap
 from ._poly import bernstein_bounds, horner
 
 __all__ = ["ArcTable", "arc_table"]
@@ -109,13 +109,10 @@ class ArcTable:
 
 def _node_state(part: Part, piece, u):
     """θ, κ, dκ/dσ, t, dt/dσ, d²t/dσ² from one spline piece at u (one-sided at knots)."""
-    dx = horner(part._dx[piece], u)
-    dy = horner(part._dy[piece], u)
-    ddx = horner(part._ddx[piece], u)
-    ddy = horner(part._ddy[piece], u)
+    dx, dy, ddx, ddy = part._derivs(piece, u)
     v2 = dx * dx + dy * dy
     v = np.sqrt(v2)
-    kappa = (dx * ddy - dy * ddx) / (v2 * v)
+    kappa = _curvature(dx, dy, ddx, ddy)
     dkds = horner(part._dkappa[piece], u) / (v2 * v2 * v2)
     dtds = 1.0 / v
     vt = (dx * ddx + dy * ddy) / v

@@ -165,3 +165,13 @@ def test_part_is_immutable():
     with pytest.raises(ValueError):
         part.points[0, 0] = 1.0
     assert isinstance(part, Part)
+
+
+def test_arc_offset_is_the_signed_shortest_way_round():
+    part = trefoil()
+    P = part.perimeter
+    assert part.arc_offset(5.0, P - 5.0) == pytest.approx(10.0)
+    assert part.arc_offset(P - 5.0, 5.0) == pytest.approx(-10.0)
+    assert part.arc_offset(3.0 + 2 * P, 1.0) == pytest.approx(2.0)
+    off = part.arc_offset(np.linspace(0, 3 * P, 101), 17.0)
+    assert np.all(off >= -P / 2) and np.all(off < P / 2)
