@@ -120,13 +120,9 @@ def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
     machine precision. Returns (start arc, start param, end param, converged,
     |Φ - Ω| at the start).
     """
-    n = part.n_knots
-    ps, lap_s = table.param_at(sigma)
-    pe, lap_e = table.param_at(sigma + length)
-    s = ps + lap_s * n
-    e = pe + lap_e * n
-    both = np.concatenate([s, e])
-    k = s.size
+    k = sigma.size
+    p, lap = table.param_at(np.concatenate([sigma, sigma + length]))
+    both = p + lap * part.n_knots
     for it in range(max_iter + 1):
         lam, th, ka, v = part._state(both)
         f1 = lam[k:] - lam[:k] - length
@@ -207,7 +203,7 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
     slope = table.kappa_slope
     K = slope[cell_s] + slope[cell_e]
 
-    brackets = []  # (lo, hi, glo, ghi, near_double)
+    brackets = []  # (lo, hi, glo, ghi, g'lo, g'hi, near_double)
     exact_zero = [a[ga == 0.0]]
     doubles = []
     flats = []
@@ -225,7 +221,8 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
         change = (ga * gb < 0.0)
         take = mono & change
         if take.any():
-            brackets.append((a[take], b[take], ga[take], gb[take], np.zeros(int(take.sum()), bool)))
+            brackets.append((a[take], b[take], ga[take], gb[take], da[take], db[take],
+                             np.zeros(int(take.sum()), bool)))
         rest = ~mono
         # same-sign cells: no root if the quadratic envelopes' zero crossings overlap
         sg = np.where(ga != 0.0, np.sign(ga), np.sign(gb))
@@ -245,7 +242,7 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
         if bottom.any():
             bc = bottom & change
             if bc.any():
-                brackets.append((a[bc], b[bc], ga[bc], gb[bc], np.ones(int(bc.sum()), bool)))
+                brackets.append((a[bc], b[bc], ga[bc], gb[bc], da[bc], db[bc], np.ones(int(bc.sum()), bool)))
             bn = bottom & ~change
             if bn.any():
                 pick = np.abs(ga[bn]) <= np.abs(gb[bn])
@@ -264,7 +261,7 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
 
     zeros = np.concatenate(exact_zero)
     if brackets:
-        brackets = tuple(np.concatenate([x[i] for x in brackets]) for i in range(5))
+        brackets = tuple(np.concatenate([x[i] for x in brackets]) for i in range(7))
     else:
         brackets = None
     doubles = np.concatenate(doubles) if doubles else np.empty(0)
@@ -272,18 +269,33 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
     return zeros, brackets, doubles, continua
 
 
+def _hermite_root(g0, g1, d0, d1, iterations=2):
+    """Root in [0, 1] of the cubic Hermite through (0, g0, d0) and (1, g1, d1); g0·g1 < 0.
+
+    Newton on the cubic from the secant point, kept inside [0, 1].
+    """
+    c2 = 3.0 * (g1 - g0) - 2.0 * d0 - d1
+    c3 = 2.0 * (g0 - g1) + d0 + d1
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = g0 / (g0 - g1)
+        for _ in range(iterations):
+            f = ((c3 * x + c2) * x + d0) * x + g0
+            x = x - f / ((3.0 * c3 * x + 2.0 * c2) * x + d0)
+    return np.where(np.isfinite(x), np.clip(x, 0.0, 1.0), 0.5)
+
+
 def _roots_from_brackets(part, table, brackets, length, turn, tol):
     """Exact roots in certified single-root brackets.
 
-    Exact Newton (:func:`_polish`) from the secant point of each bracket; a
-    root that does not converge inside its bracket is first refined on the
-    table with a safeguarded Newton, then polished again.
+    The start point is the root of the cubic Hermite interpolant of g on the
+    bracket (from g and g' at its ends; ~1e-7 mm off on the trefoil), so the
+    exact Newton of :func:`_polish` needs one step and one check. A root that
+    does not converge inside its bracket is first refined on the table with a
+    safeguarded Newton, then polished again.
     """
-    lo, hi, glo, ghi, dbl = brackets
+    lo, hi, glo, ghi, dlo, dhi, dbl = brackets
     P = part.perimeter
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x0 = lo - glo * (hi - lo) / (ghi - glo)
-    x0 = np.where(np.isfinite(x0) & (x0 >= lo) & (x0 <= hi), x0, 0.5 * (lo + hi))
+    x0 = lo + (hi - lo) * _hermite_root(glo, ghi, dlo * (hi - lo), dhi * (hi - lo))
     lam, ps, pe, ok, res = _polish(part, table, x0, length, turn, tol, max_iter=4)
     inside = np.mod(lam - lo + 1e-9, P) <= hi - lo + 2e-9
     bad = np.flatnonzero(~(ok & inside))
@@ -358,12 +370,15 @@ def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
     Sorted by position in [0, P); the first of a run of close positions stays,
     across σ = 0 too.
     """
-    if x.size == 0:
-        return np.zeros(0, dtype=int)
+    if x.size < 2:
+        return np.arange(x.size)
     xm = np.mod(x, P)
     order = np.argsort(xm, kind="stable")
     xs = xm[order]
-    keep = np.concatenate([[True], np.diff(xs) > sep])
+    gaps = np.diff(xs)
+    if gaps.min() > sep and xs[0] + P - xs[-1] > sep:  # the usual case: nothing to merge
+        return order
+    keep = np.concatenate([[True], gaps > sep])
     if keep.sum() > 1 and xs[0] + P - xs[np.flatnonzero(keep)[-1]] <= sep:
         keep[np.flatnonzero(keep)[-1]] = False
     return order[keep]
@@ -430,46 +445,45 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
     zeros, brackets, doubles, continua = _solve_ccw(part, length, omega, tol=tol, flat_tol=flat_tol,
                                                     double_width=double_width, max_cells=max_cells)
     table = arc_table(part)
-    n = part.n_knots
-    rows = []  # (start arc, kind, span, residual, start param, end param), ccw sense
+    # columns, ccw sense: start arc, kind code, span, residual, start param, end param
     found = []
     if zeros.size:
         found.append(_polish(part, table, zeros, length, omega, tol))
     if brackets is not None:
         found.append(_roots_from_brackets(part, table, brackets, length, omega, tol))
-    for lam, ps, pe, ok, res in found:
-        for i in range(lam.size):
-            # a root the exact Newton cannot settle is ill-conditioned (g' ~ 0): near-double
-            rows.append((lam[i], "simple" if ok[i] else "double", 0.0, res[i], ps[i], pe[i]))
-    # a root on a cell boundary is found from both sides
-    rows = [rows[i] for i in _distinct(np.array([r[0] for r in rows]), P, 2 * tol)]
+    if found:
+        lam, ps, pe, ok, res = (np.concatenate(c) for c in zip(*found))
+        keep = _distinct(lam, P, 2 * tol)  # a root on a cell boundary is found from both sides
+        lam, ps, pe, res = lam[keep], ps[keep], pe[keep], res[keep]
+        # a root the exact Newton cannot settle is ill-conditioned (g' ~ 0): near-double
+        code = np.where(ok[keep], 0, 1)
+    else:
+        lam = ps = pe = res = np.empty(0)
+        code = np.empty(0, dtype=int)
+    span = np.zeros(lam.size)
     doubles = doubles[_distinct(doubles, P, 10 * double_width)]
-    if rows and doubles.size:  # a double root already bracketed as a simple one
-        known = np.array([r[0] for r in rows])
-        near = np.abs(part.arc_offset(doubles[:, None], known[None, :])).min(axis=1)
+    if lam.size and doubles.size:  # a double root already bracketed as a simple one
+        near = np.abs(part.arc_offset(doubles[:, None], lam[None, :])).min(axis=1)
         doubles = doubles[near > 10 * double_width]
-    for c0, span in continua:  # a touching point inside a continuum is part of it
-        doubles = doubles[np.mod(doubles - c0 + 10 * double_width, P) > span + 20 * double_width]
-    others = [(x, "double", 0.0) for x in doubles] + [(a0, "continuum", sp) for a0, sp in continua]
-    if others:
-        sig = np.mod(np.array([o[0] for o in others]), P)
+    for c0, sp0 in continua:  # a touching point inside a continuum is part of it
+        doubles = doubles[np.mod(doubles - c0 + 10 * double_width, P) > sp0 + 20 * double_width]
+    if doubles.size or continua:
+        sig = np.mod(np.concatenate([doubles, [c[0] for c in continua]]), P)
         g, _, ts, te = _g_exact(part, sig, length, omega)
-        rows += [(s0, kind, sp, abs(gi), t0, t1) for (_, kind, sp), s0, gi, t0, t1 in zip(others, sig, g, ts, te)]
-    if not rows:
+        lam, ps, pe, res = (np.concatenate(x) for x in ((lam, sig), (ps, ts), (pe, te), (res, np.abs(g))))
+        code = np.concatenate([code, np.ones(doubles.size, int), np.full(len(continua), 2)])
+        span = np.concatenate([span, np.zeros(doubles.size), [c[1] for c in continua]])
+    if lam.size == 0:
         return []
-    s0, sp_, res, t0, t1 = (np.array([r[i] for r in rows], dtype=float) for i in (0, 2, 3, 4, 5))
-    kinds = [r[1] for r in rows]
-    cont = np.array([k == "continuum" for k in kinds])
     if direction == "ccw":
-        sa, ea, sp, ep = s0, s0 + length, t0, t1
-    else:  # the ccw stretch [s0, s0 + L] was travelled from its far end
-        sa = np.where(cont, s0 + length + sp_, s0 + length)
-        ea = np.where(cont, s0 + sp_, s0)
-        sp, ep = t1, t0
-    sa, ea = part.wrap_arc(sa).tolist(), part.wrap_arc(ea).tolist()
-    sp, ep = np.mod(sp, n).tolist(), np.mod(ep, n).tolist()
-    out = [Segment(start_arc=sa[i], end_arc=ea[i], start_param=sp[i], end_param=ep[i], length=length,
-                   turn=turn, direction=direction, kind=kinds[i], span=float(sp_[i]), residual=float(res[i]))
-           for i in range(len(rows))]
-    out.sort(key=lambda s: s.start_arc)
-    return out
+        sa, ea, sp, ep = lam, lam + length, ps, pe
+    else:  # the ccw stretch [s0, s0 + L] was travelled from its far end; a continuum from its far end too
+        sa, ea, sp, ep = lam + length + span, lam + span, pe, ps
+    order = np.argsort(part.wrap_arc(sa), kind="stable")
+    n = part.n_knots
+    cols = (part.wrap_arc(sa), part.wrap_arc(ea), np.mod(sp, n), np.mod(ep, n), span, res)
+    sa, ea, sp, ep, span, res = (c[order].tolist() for c in cols)
+    kinds = [KINDS[k] for k in code[order]]
+    return [Segment(start_arc=sa[i], end_arc=ea[i], start_param=sp[i], end_param=ep[i], length=length,
+                    turn=turn, direction=direction, kind=kinds[i], span=span[i], residual=res[i])
+            for i in range(len(sa))]
