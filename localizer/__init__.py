@@ -2,9 +2,11 @@
 
 from ._errors import LocalizerError, PartError, QueryError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
+from ._march import MarchGrid, MarchResult, march, march_grid
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._solver import DIRECTIONS, METHODS, Segment, feasible_segments
 
 __all__ = ["LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
            "Segment", "feasible_segments", "METHODS", "DIRECTIONS",
-           "Candidate", "Localization", "localize", "RULES"]
+           "Candidate", "Localization", "localize", "RULES",
+           "march", "march_grid", "MarchResult", "MarchGrid"]

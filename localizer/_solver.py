@@ -30,7 +30,7 @@ Bracketed roots are refined together by a safeguarded Newton iteration to
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -41,7 +41,7 @@ from ._table import ArcTable, arc_table
 __all__ = ["Segment", "feasible_segments", "METHODS", "DIRECTIONS"]
 
 #: Solver methods accepted by :func:`feasible_segments`.
-METHODS = ("exact",)
+METHODS = ("exact", "march")
 #: Rolling directions: the contact moves counter-clockwise or clockwise on the part.
 DIRECTIONS = ("ccw", "cw")
 KINDS = ("simple", "double", "continuum")
@@ -76,7 +76,12 @@ class Segment:
     span : float, mm
         Extent of a continuum, 0 otherwise.
     residual : float, rad
-        |Φ(segment) - Ω| at the reported start.
+        |Φ(segment) - Ω| at the reported start (exact Φ).
+    iterates : tuple of float, mm
+        ``method="march"`` only: start arc positions s0, s1, s2, ... of the
+        iterations that converged to this segment.
+    iterations : int
+        ``method="march"`` only: the iteration count.
     """
 
     start_arc: float
@@ -89,10 +94,14 @@ class Segment:
     kind: str = "simple"
     span: float = 0.0
     residual: float = 0.0
+    iterates: tuple = ()
+    iterations: int = 0
 
     def as_dict(self) -> dict:
         """Plain-JSON form."""
-        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d["iterates"] = list(self.iterates)
+        return d
 
 
 # ---------------------------------------------------------------- evaluators
@@ -386,7 +395,9 @@ def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
 
 def feasible_segments(part: Part, length: float, turn: float, *, method: str = "exact",
                       direction: str = "ccw", tol: float = 1e-10, flat_tol: float = 1e-10,
-                      double_width: float = 1e-7, max_cells: int = 2_000_000) -> list[Segment]:
+                      double_width: float = 1e-7, max_cells: int = 2_000_000, step: float = 1e-5,
+                      length_tol: float = 0.004, turn_tol: float = 0.0004,
+                      min_separation: float = 0.5) -> list[Segment]:
     """Every boundary segment with arc length ``length`` and total curvature ``turn``.
 
     Parameters
@@ -399,8 +410,10 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
         Signed jaw rotation Ω, counter-clockwise positive (eq. 4). Rolling
         counter-clockwise over a convex stretch gives Ω > 0; a negative Ω with
         counter-clockwise travel is legal across a concave stretch.
-    method : {"exact"}
+    method : {"exact", "march"}
         Solver. ``"exact"`` is complete by construction (see module notes).
+        ``"march"`` is the paper's marching algorithm (:func:`localizer.march`),
+        kept as the reference; its segments carry ``iterates``.
     direction : {"ccw", "cw"}
         Direction the contact moved on the part. For ``"cw"`` the contact
         moved clockwise from ``start_arc`` to ``end_arc``; rolling clockwise
@@ -413,6 +426,10 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
         Width below which a cell that cannot be certified is reported as a double root.
     max_cells : int
         Work limit against degenerate queries.
+    step, length_tol, turn_tol, min_separation
+        ``method="march"`` only: the integration step h in the parameter
+        domain, the convergence tolerances (mm, rad) and the minimum
+        separation of starts (mm); defaults are the paper's.
 
     Returns
     -------
@@ -442,6 +459,17 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
     length, turn = _check_query(part, length, turn, direction, method)
     P = part.perimeter
     omega = turn if direction == "ccw" else -turn
+    if method == "march":
+        from ._march import march
+
+        res = march(part, length, omega, step=step, length_tol=length_tol, turn_tol=turn_tol,
+                    min_separation=min_separation)
+        if direction == "ccw":
+            return [replace(g, turn=turn) for g in res.segments]
+        # the ccw stretch was travelled from its far end
+        return sorted((replace(g, start_arc=g.end_arc, end_arc=g.start_arc, start_param=g.end_param,
+                               end_param=g.start_param, turn=turn, direction="cw")
+                       for g in res.segments), key=lambda g: g.start_arc)
     zeros, brackets, doubles, continua = _solve_ccw(part, length, omega, tol=tol, flat_tol=flat_tol,
                                                     double_width=double_width, max_cells=max_cells)
     table = arc_table(part)

@@ -138,7 +138,7 @@ def test_circular_stretch_is_reported_as_continuum():
     (dict(length=float("nan"), turn=0.1), "must be finite"),
     (dict(length=10.0, turn=float("inf")), "must be finite"),
     (dict(length="ten", turn=0.1), "must be numbers"),
-    (dict(length=10.0, turn=0.1, method="newton"), r"unknown method 'newton'; use one of \['exact'\]"),
+    (dict(length=10.0, turn=0.1, method="newton"), r"unknown method 'newton'; use one of \['exact', 'march'\]"),
     (dict(length=10.0, turn=0.1, direction="up"), r"unknown direction 'up'; use one of \['ccw', 'cw'\]"),
 ])
 def test_bad_queries(kwargs, match):

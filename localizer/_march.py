@@ -1,0 +1,391 @@
+"""Jia's marching algorithm (paper §II-A, §II-B and the Appendix), the reference method.
+
+Everything is evaluated the paper's way: ℓ and Φ by fixed-step numerical
+integration (trapezoid rule) with step ``h`` in the parameter domain. The
+integrals are accumulated once on the h-grid (``MarchGrid``); between grid
+points they are interpolated linearly. Every move of an endpoint s or t over
+k grid cells counts as k numerical steps, which is what Theorem 2 bounds by
+6τ/h.
+
+The boundary is split into *modes* (Appendix): stretches of start positions
+s on which the signs of κ(s) and κ(t) stay fixed, t being the end with
+ℓ(s, t) = L. Their ends are the inflections z_j and the starts whose end is
+an inflection (ℓ(s, z_j) = L); a zero of κ where κ keeps its sign (a
+higher-order zero, footnote 5: κ' decides the side) is not a mode change.
+
+* convex-convex and concave-concave modes: the iteration (7), alternately
+  elongating and contracting [s, t] (for concave-concave on -Φ, which has
+  the convex signs), with the ε step-over of Theorem 2 after each segment;
+* convex-concave and concave-convex modes: Φ along ℓ = L is monotone in s,
+  so a mode holds one feasible segment iff Φ at its ends brackets Ω, found
+  by bisection.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._errors import QueryError
+from ._part import Part, _curvature
+
+__all__ = ["MarchGrid", "MarchResult", "march_grid", "march"]
+
+
+@dataclass(frozen=True, eq=False)
+class MarchGrid:
+    """ℓ(0, ih) and Φ(0, ih) by the trapezoid rule on the h-grid of one period.
+
+    Attributes
+    ----------
+    h : float
+        Step in the parameter domain.
+    cells : int
+        Grid cells per period, τ/h.
+    length : ndarray, shape (cells+1,), mm
+        Cumulative arc length at the grid points.
+    turn : ndarray, shape (cells+1,), rad
+        Cumulative total curvature at the grid points.
+    kappa : ndarray, shape (cells+1,), 1/mm
+        Curvature at the grid points.
+    """
+
+    h: float
+    cells: int
+    length: np.ndarray
+    turn: np.ndarray
+    kappa: np.ndarray
+
+    # ---- unrolled evaluation (parameter x may exceed the period) ----------
+    def _value(self, cum, x):
+        i = x / self.h
+        lap, i = divmod(i, self.cells)
+        k = min(int(i), self.cells - 1)
+        f = i - k
+        return cum[k] + f * (cum[k + 1] - cum[k]) + lap * cum[-1]
+
+    def ell(self, s, t):
+        """ℓ(s, t) by the trapezoid rule, mm (unrolled s <= t)."""
+        return self._value(self.length, t) - self._value(self.length, s)
+
+    def phi(self, s, t):
+        """Φ(s, t) by the trapezoid rule, rad (unrolled s <= t)."""
+        return self._value(self.turn, t) - self._value(self.turn, s)
+
+    def _search(self, cum, sign, target, x_lo, x_hi):
+        """First x in [x_lo, x_hi] with sign·C(x) = sign·target, sign·C nondecreasing there.
+
+        C is the unrolled cumulative ``cum``. Returns None if the target is
+        not reached by x_hi.
+        """
+        M, h = self.cells, self.h
+        i_lo = int(np.floor(x_lo / h))
+        i_hi = int(np.ceil(x_hi / h))
+        v_lo = self._value(cum, x_lo)
+        if sign * v_lo >= sign * target:
+            return x_lo
+        i = i_lo
+        while i < i_hi:
+            lap, k0 = divmod(i, M)
+            k1 = min(M, k0 + (i_hi - i))
+            seg = sign * (cum[k0:k1 + 1] + lap * cum[-1])
+            j = int(np.searchsorted(seg, sign * target, side="left"))
+            if j <= k1 - k0:
+                k = max(j - 1, 0)
+                a, b = seg[k], seg[k + 1] if k + 1 < seg.size else seg[k]
+                f = 0.0 if b == a else (sign * target - a) / (b - a)
+                x = (lap * M + k0 + k + min(max(f, 0.0), 1.0)) * h
+                return max(x, x_lo) if x <= x_hi else None
+            i += k1 - k0
+        return None
+
+
+@dataclass(frozen=True)
+class MarchResult:
+    """Outcome of :func:`march`.
+
+    Attributes
+    ----------
+    segments : list of Segment
+        Feasible segments found, sorted by start arc; each carries ``iterates``.
+    steps : int
+        Numerical integration steps taken by the endpoints (Theorem 2 bounds
+        it by 6τ/h).
+    grid_cells : int
+        τ/h, the steps of one perimeter integration.
+    restarts : int
+        Marches started (the initial one and one per ε step-over and mode).
+    """
+
+    segments: list
+    steps: int
+    grid_cells: int
+    restarts: int
+
+
+def march_grid(part: Part, h: float) -> MarchGrid:
+    """The h-grid integrals of ``part``, built by the trapezoid rule (cached for the last h)."""
+    cached = part.__dict__.get("_march_grid")
+    if cached is not None and cached.h == h:
+        return cached
+    n = part.n_knots
+    M = int(round(n / h))
+    if M < 4 * n or abs(M * h - n) > 1e-9 * n:
+        raise QueryError(f"step={h!r} must divide the parameter period {n} into at least {4 * n} cells")
+    length = np.empty(M + 1)
+    turn = np.empty(M + 1)
+    kappa = np.empty(M + 1)
+    acc_l = acc_t = 0.0
+    chunk = 1 << 20
+    prev_v = prev_w = None
+    for start in range(0, M + 1, chunk):
+        idx = np.arange(start, min(start + chunk, M + 1))
+        t = idx * h
+        piece = np.minimum(t.astype(np.int64), n - 1)
+        dx, dy, ddx, ddy = part._derivs(piece, t - piece)
+        v = np.hypot(dx, dy)
+        k = _curvature(dx, dy, ddx, ddy)
+        w = k * v
+        kappa[idx] = k
+        if prev_v is None:
+            inc_v = 0.5 * h * (v[1:] + v[:-1])
+            inc_w = 0.5 * h * (w[1:] + w[:-1])
+            length[idx[0]] = 0.0
+            turn[idx[0]] = 0.0
+            length[idx[1:]] = np.cumsum(inc_v)
+            turn[idx[1:]] = np.cumsum(inc_w)
+        else:
+            vv = np.concatenate([[prev_v], v])
+            ww = np.concatenate([[prev_w], w])
+            length[idx] = acc_l + np.cumsum(0.5 * h * (vv[1:] + vv[:-1]))
+            turn[idx] = acc_t + np.cumsum(0.5 * h * (ww[1:] + ww[:-1]))
+        acc_l, acc_t = length[idx[-1]], turn[idx[-1]]
+        prev_v, prev_w = v[-1], w[-1]
+    grid = MarchGrid(h=h, cells=M, length=length, turn=turn, kappa=kappa)
+    part.__dict__["_march_grid"] = grid
+    return grid
+
+
+def _sign_regions(kappa: np.ndarray, h: float):
+    """Inflections (parameters in [0, τ), ascending) and the sign of κ after each.
+
+    κ is sampled on the grid (``kappa[-1]`` repeats ``kappa[0]``). A zero of κ
+    that does not change its sign is no inflection (footnote 5): grid values
+    equal to zero take the sign of the next nonzero value, which is the sign
+    of κ' at a simple zero.
+    """
+    M = kappa.size - 1
+    sgn = np.sign(kappa[:-1])
+    nz = np.flatnonzero(sgn)
+    if nz.size == 0:
+        raise QueryError("the part's curvature vanishes everywhere on the grid")
+    sgn = sgn[nz[np.searchsorted(nz, np.arange(M)) % nz.size]]
+    change = np.flatnonzero(sgn != np.roll(sgn, 1))
+    k0 = kappa[(change - 1) % M]
+    k1 = kappa[change]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.where(k0 != k1, k0 / (k0 - k1), 0.0)
+    z = np.mod((change - 1 + np.clip(f, 0.0, 1.0)) * h, M * h)
+    order = np.argsort(z)
+    return z[order], sgn[change][order]
+
+
+def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_tol: float = 0.004,
+          turn_tol: float = 0.0004, min_separation: float = 0.5, max_iterations: int = 100_000) -> MarchResult:
+    """Counter-clockwise marching over the whole boundary (the paper's algorithm).
+
+    Parameters
+    ----------
+    part : Part
+    length : float, mm
+    turn : float, rad
+    step : float
+        h, the integration step in the parameter domain (paper: 1e-5).
+    length_tol, turn_tol : float, mm and rad
+        Convergence tolerances on ℓ and Φ (paper: 0.004 and 0.0004).
+    min_separation : float, mm
+        Minimum separation of feasible starts (paper: 0.5); the step-over ε
+        is this divided by the largest curve speed.
+    max_iterations : int
+        Iterations of (7) after which a march that has not met the
+        tolerances is reported as ``kind="stalled"`` (κ(s*) ≈ κ(t*)).
+
+    Returns
+    -------
+    MarchResult
+    """
+    from ._solver import Segment
+
+    grid = march_grid(part, step)
+    h, M = grid.h, grid.cells
+    tau = part.n_knots
+    P_num = grid.length[-1]
+    if not 0 < length < P_num:
+        raise QueryError(f"length={length!r} mm is out of range (0, {P_num:.6g}) mm")
+    vmax = float(np.max(np.diff(grid.length))) / h
+    eps = min_separation / vmax
+    state = {"steps": 0, "restarts": 0}
+
+    def moved(a, b):
+        state["steps"] += int(abs(round(b / h) - round(a / h)))
+
+    def end_of(s):
+        """t with ℓ(s, t) = L (a numerical integration from s)."""
+        return grid._search(grid.length, 1.0, grid._value(grid.length, s) + length, s, s + tau)
+
+    # ---- modes (Appendix): cut the starts where s or t = s+L meets an inflection ----
+    z, sign_after = _sign_regions(grid.kappa, h)
+    if z.size == 0:  # convex (or concave) everywhere: one mode, t is free
+        only = float(np.sign(grid.kappa[np.flatnonzero(grid.kappa)[0]]))
+        modes = [(0.0, float(tau), only, only)]
+
+        def region_end(t):
+            return t + tau
+    else:
+        zz = np.concatenate([z - tau, z, z + tau, z + 2 * tau])
+        ss = np.tile(sign_after, 4)
+
+        def sign_at(x):
+            return float(ss[int(np.searchsorted(zz, x, side="right")) - 1])
+
+        def region_end(t):
+            """The next inflection after t: t may not pass it within a mode."""
+            return float(zz[np.searchsorted(zz, t, side="right")])
+
+        back = []  # starts whose end is an inflection: ℓ(s, z_j) = L
+        for zj in z:
+            target = grid._value(grid.length, zj) - length
+            if target < 0:
+                target += P_num
+            sj = grid._search(grid.length, 1.0, target, 0.0, float(tau))
+            if sj is not None:
+                back.append(sj)
+        cuts = np.unique(np.concatenate([[0.0, float(tau)], z, back]))
+        modes = []
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            if b - a <= 0.5 * h:
+                continue
+            mid = 0.5 * (a + b)
+            modes.append((float(a), float(b), sign_at(mid), sign_at(end_of(mid))))
+
+    found = []  # (s, t, iterates, iterations, kind)
+
+    signed_turn = {1.0: grid.turn}
+
+    def march_mode(sa, sb, sgn):
+        """Iteration (7) on sign·Φ for starts in [sa, sb]."""
+        target = sgn * turn
+        if sgn not in signed_turn:
+            signed_turn[sgn] = -grid.turn
+        cum_turn = signed_turn[sgn]
+        s = sa
+        while s < sb:
+            state["restarts"] += 1
+            iterates = [s]
+            tL = end_of(s)
+            if tL is None:
+                return
+            moved(s, tL)
+            psi = sgn * grid.phi(s, tL)
+            if abs(psi - target) <= turn_tol:
+                found.append((s, tL, iterates, 0, "simple"))
+                s = s + eps
+                continue
+            case_a = psi < target  # the first u with Φ(s, u) = Ω lies beyond tL: ℓ(s, u) > L
+            t = tL
+            converged = False
+            for it in range(1, max_iterations + 1):
+                if case_a:
+                    # t_i: Φ(s_i, t_i) = Ω (t increases), s_{i+1}: ℓ(s_{i+1}, t_i) = L
+                    base = grid._value(cum_turn, s)
+                    t_new = grid._search(cum_turn, 1.0, base + target, t, region_end(t))
+                    if t_new is None:
+                        return
+                    moved(t, t_new)
+                    t = t_new
+                    s_new = grid._search(grid.length, 1.0, grid._value(grid.length, t) - length, s, t)
+                    if s_new is None:
+                        return
+                    moved(s, s_new)
+                    s = s_new
+                    iterates.append(s)
+                    if s > sb:
+                        return
+                    if abs(sgn * grid.phi(s, t) - target) <= turn_tol:
+                        converged = True
+                        break
+                else:
+                    # s_{i+1}: Φ(s_{i+1}, t_i) = Ω (s increases), t_{i+1}: ℓ(s_{i+1}, t_{i+1}) = L
+                    # sign·Φ(s, t) decreases as s grows over a same-sign stretch
+                    base_t = grid._value(cum_turn, t)
+                    s_new = grid._search(cum_turn, 1.0, base_t - target, s, min(t, sb + eps))
+                    if s_new is None:
+                        return
+                    moved(s, s_new)
+                    s = s_new
+                    iterates.append(s)
+                    if s > sb:
+                        return
+                    t_new = end_of(s)
+                    if t_new is None:
+                        return
+                    moved(t, t_new)
+                    t = t_new
+                    if abs(sgn * grid.phi(s, t) - target) <= turn_tol and abs(grid.ell(s, t) - length) <= length_tol:
+                        converged = True
+                        break
+            found.append((s, t, iterates, len(iterates) - 1, "simple" if converged else "stalled"))
+            s = s + eps
+
+    def bisect_mode(sa, sb):
+        """Φ along ℓ = L is monotone on a mixed mode: one root iff Φ brackets Ω."""
+        state["restarts"] += 1
+        fa = grid.phi(sa, end_of(sa)) - turn
+        fb = grid.phi(sb, end_of(sb)) - turn
+        if fa * fb > 0:
+            return
+        lo, hi = sa, sb
+        iterates = []
+        t = end_of(lo)
+        for it in range(200):
+            mid = 0.5 * (lo + hi)
+            tm = end_of(mid)
+            moved(lo, mid)
+            moved(t, tm)
+            t = tm
+            fm = grid.phi(mid, tm) - turn
+            iterates.append(mid)
+            if abs(fm) <= turn_tol or hi - lo <= h:
+                found.append((mid, tm, iterates, len(iterates), "simple"))
+                return
+            if (fm > 0) == (fa > 0):
+                lo, fa = mid, fm
+            else:
+                hi = mid
+
+    for sa, sb, s_sign, t_sign in modes:
+        if s_sign == t_sign:
+            march_mode(sa, sb, s_sign)
+        else:
+            bisect_mode(sa, sb)
+
+    segs = []
+    arc = part.arc_at_param
+    for s, t, iterates, iters, kind in found:
+        s_arc = float(part.wrap_arc(arc(s)))
+        segs.append(Segment(
+            start_arc=s_arc, end_arc=float(part.wrap_arc(arc(t))), start_param=float(s % tau),
+            end_param=float(t % tau), length=length, turn=turn, direction="ccw", kind=kind, span=0.0,
+            residual=float(abs(part.total_curvature(s, t) - turn)),
+            iterates=tuple(float(v) for v in part.wrap_arc(arc(np.array(iterates)))), iterations=int(iters)))
+    # a root found at the end of one mode and the start of the next is one root
+    segs.sort(key=lambda g: g.start_arc)
+    out = []
+    for g in segs:
+        if out and abs(part.arc_offset(g.start_arc, out[-1].start_arc)) < min_separation:
+            continue
+        out.append(g)
+    if len(out) > 1 and abs(part.arc_offset(out[0].start_arc, out[-1].start_arc)) < min_separation:
+        out.pop()
+    return MarchResult(segments=out, steps=state["steps"], grid_cells=M, restarts=state["restarts"])
