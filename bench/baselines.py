@@ -32,3 +32,16 @@ def trefoil_part():
     from localizer import load_part
 
     return load_part(PARTS_DIR / "trefoil.json")
+
+
+def random_outline(rng, n: int = 40, amplitude: float = 3.0, radius: float = 40.0):
+    """A random smooth star-shaped outline (simple by construction), mm.
+
+    ``radius`` plus harmonics 2..5 of total size ``amplitude``: about 1.5 mm and
+    below gives convex parts at radius 40, about 4 mm and above non-convex ones.
+    """
+    a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    r = np.full(n, float(radius))
+    for k in range(2, 6):
+        r += amplitude / k * rng.uniform(-1, 1) * np.cos(k * a + rng.uniform(0, 2 * np.pi))
+    return np.c_[r * np.cos(a), r * np.sin(a)]

@@ -24,6 +24,7 @@ higher-order zero, footnote 5: κ' decides the side) is not a mode change.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -57,6 +58,22 @@ class MarchGrid:
     turn: np.ndarray
     kappa: np.ndarray
 
+    # ---- per-part quantities, computed once per grid --------------------
+    @cached_property
+    def max_speed(self) -> float:
+        """Largest |α'| on the grid (trapezoid cell lengths / h), mm per unit parameter."""
+        return float(np.max(np.diff(self.length))) / self.h
+
+    @cached_property
+    def inflections(self):
+        """(z, sign after z): the inflections of :func:`_sign_regions`."""
+        return _sign_regions(self.kappa, self.h)
+
+    @cached_property
+    def negated_turn(self) -> np.ndarray:
+        """-Φ(0, ih): nondecreasing over concave stretches, for concave-concave modes."""
+        return -self.turn
+
     # ---- unrolled evaluation (parameter x may exceed the period) ----------
     def _value(self, cum, x):
         i = x / self.h
@@ -73,29 +90,29 @@ class MarchGrid:
         """Φ(s, t) by the trapezoid rule, rad (unrolled s <= t)."""
         return self._value(self.turn, t) - self._value(self.turn, s)
 
-    def _search(self, cum, sign, target, x_lo, x_hi):
-        """First x in [x_lo, x_hi] with sign·C(x) = sign·target, sign·C nondecreasing there.
+    def _search(self, cum, target, x_lo, x_hi):
+        """First x in [x_lo, x_hi] with C(x) = target, C nondecreasing there, or None.
 
-        C is the unrolled cumulative ``cum``. Returns None if the target is
-        not reached by x_hi.
+        C is the unrolled cumulative ``cum``; the search is a binary search on
+        views of ``cum`` (no copies), then linear interpolation in the cell.
         """
         M, h = self.cells, self.h
-        i_lo = int(np.floor(x_lo / h))
-        i_hi = int(np.ceil(x_hi / h))
-        v_lo = self._value(cum, x_lo)
-        if sign * v_lo >= sign * target:
+        if self._value(cum, x_lo) >= target:
             return x_lo
-        i = i_lo
+        i = int(np.floor(x_lo / h))
+        i_hi = int(np.ceil(x_hi / h))
         while i < i_hi:
             lap, k0 = divmod(i, M)
             k1 = min(M, k0 + (i_hi - i))
-            seg = sign * (cum[k0:k1 + 1] + lap * cum[-1])
-            j = int(np.searchsorted(seg, sign * target, side="left"))
+            v = target - lap * cum[-1]
+            seg = cum[k0:k1 + 1]
+            j = int(np.searchsorted(seg, v, side="left"))
             if j <= k1 - k0:
                 k = max(j - 1, 0)
-                a, b = seg[k], seg[k + 1] if k + 1 < seg.size else seg[k]
-                f = 0.0 if b == a else (sign * target - a) / (b - a)
-                x = (lap * M + k0 + k + min(max(f, 0.0), 1.0)) * h
+                a = seg[k]
+                b = seg[k + 1] if k + 1 <= k1 - k0 else a
+                f = 0.0 if b == a else min(max((v - a) / (b - a), 0.0), 1.0)
+                x = (lap * M + k0 + k + f) * h
                 return max(x, x_lo) if x <= x_hi else None
             i += k1 - k0
         return None
@@ -223,8 +240,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
     P_num = grid.length[-1]
     if not 0 < length < P_num:
         raise QueryError(f"length={length!r} mm is out of range (0, {P_num:.6g}) mm")
-    vmax = float(np.max(np.diff(grid.length))) / h
-    eps = min_separation / vmax
+    eps = min_separation / grid.max_speed
     state = {"steps": 0, "restarts": 0}
 
     def moved(a, b):
@@ -232,10 +248,10 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
 
     def end_of(s):
         """t with ℓ(s, t) = L (a numerical integration from s)."""
-        return grid._search(grid.length, 1.0, grid._value(grid.length, s) + length, s, s + tau)
+        return grid._search(grid.length, grid._value(grid.length, s) + length, s, s + tau)
 
     # ---- modes (Appendix): cut the starts where s or t = s+L meets an inflection ----
-    z, sign_after = _sign_regions(grid.kappa, h)
+    z, sign_after = grid.inflections
     if z.size == 0:  # convex (or concave) everywhere: one mode, t is free
         only = float(np.sign(grid.kappa[np.flatnonzero(grid.kappa)[0]]))
         modes = [(0.0, float(tau), only, only)]
@@ -258,7 +274,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
             target = grid._value(grid.length, zj) - length
             if target < 0:
                 target += P_num
-            sj = grid._search(grid.length, 1.0, target, 0.0, float(tau))
+            sj = grid._search(grid.length, target, 0.0, float(tau))
             if sj is not None:
                 back.append(sj)
         cuts = np.unique(np.concatenate([[0.0, float(tau)], z, back]))
@@ -271,14 +287,10 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
 
     found = []  # (s, t, iterates, iterations, kind)
 
-    signed_turn = {1.0: grid.turn}
-
     def march_mode(sa, sb, sgn):
         """Iteration (7) on sign·Φ for starts in [sa, sb]."""
         target = sgn * turn
-        if sgn not in signed_turn:
-            signed_turn[sgn] = -grid.turn
-        cum_turn = signed_turn[sgn]
+        cum_turn = grid.turn if sgn > 0 else grid.negated_turn
         s = sa
         while s < sb:
             state["restarts"] += 1
@@ -299,12 +311,12 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
                 if case_a:
                     # t_i: Φ(s_i, t_i) = Ω (t increases), s_{i+1}: ℓ(s_{i+1}, t_i) = L
                     base = grid._value(cum_turn, s)
-                    t_new = grid._search(cum_turn, 1.0, base + target, t, region_end(t))
+                    t_new = grid._search(cum_turn, base + target, t, region_end(t))
                     if t_new is None:
                         return
                     moved(t, t_new)
                     t = t_new
-                    s_new = grid._search(grid.length, 1.0, grid._value(grid.length, t) - length, s, t)
+                    s_new = grid._search(grid.length, grid._value(grid.length, t) - length, s, t)
                     if s_new is None:
                         return
                     moved(s, s_new)
@@ -319,7 +331,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
                     # s_{i+1}: Φ(s_{i+1}, t_i) = Ω (s increases), t_{i+1}: ℓ(s_{i+1}, t_{i+1}) = L
                     # sign·Φ(s, t) decreases as s grows over a same-sign stretch
                     base_t = grid._value(cum_turn, t)
-                    s_new = grid._search(cum_turn, 1.0, base_t - target, s, min(t, sb + eps))
+                    s_new = grid._search(cum_turn, base_t - target, s, min(t, sb + eps))
                     if s_new is None:
                         return
                     moved(s, s_new)
