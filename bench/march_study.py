@@ -290,10 +290,25 @@ def _plots(out: Path, prop1, thm2, cost, compl, versus):
             for k, miss in enumerate(r["missed"]):
                 ax.plot(*part.point_at_arc(miss["start_arc"]), "o", mfc="none", mec="tab:red", ms=14,
                         label="missed" if k == 0 else None)
+            miss = r["missed"][0]["start_arc"]
+            zoom = ax.inset_axes([0.58, 0.58, 0.4, 0.4])
+            arcs = miss + np.linspace(-3, 3, 200)
+            zxy = part.point_at_arc(arcs)
+            zoom.plot(zxy[:, 0], zxy[:, 1], color="0.6", lw=1)
+            for e in r["exact"]:
+                if abs(part.arc_offset(e, miss)) < 3:
+                    zoom.plot(*part.point_at_arc(e), "o", color="tab:blue", ms=5)
+            for m in r["march"]:
+                if abs(part.arc_offset(m, miss)) < 3:
+                    zoom.plot(*part.point_at_arc(m), "x", color="tab:orange", ms=6)
+            zoom.plot(*part.point_at_arc(miss), "o", mfc="none", mec="tab:red", ms=11)
+            zoom.set_xticks([])
+            zoom.set_yticks([])
+            zoom.set_title("±3 mm", fontsize=7)
             ax.set_title(f"{'convex' if r['convex'] else 'non-convex'}, L={r['length']:.1f} mm, "
                          f"Ω={np.degrees(r['turn']):.1f}°", fontsize=8)
             ax.set_aspect("equal")
-            ax.legend(fontsize=7)
+            ax.legend(fontsize=7, loc="lower left")
         fig.tight_layout()
         fig.savefig(out / "completeness_failures.png", dpi=110)
         plt.close(fig)

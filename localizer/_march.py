@@ -3,9 +3,10 @@
 Everything is evaluated the paper's way: ℓ and Φ by fixed-step numerical
 integration (trapezoid rule) with step ``h`` in the parameter domain. The
 integrals are accumulated once on the h-grid (``MarchGrid``); between grid
-points they are interpolated linearly. Every move of an endpoint s or t over
-k grid cells counts as k numerical steps, which is what Theorem 2 bounds by
-6τ/h.
+points they are interpolated linearly. The integrals at the two endpoints s
+and t are carried along as they march: moving an endpoint over k grid cells
+(either way, restarts and bisection included) counts as k numerical steps,
+the quantity Theorem 2 bounds by 6τ/h.
 
 The boundary is split into *modes* (Appendix): stretches of start positions
 s on which the signs of κ(s) and κ(t) stay fixed, t being the end with
@@ -243,8 +244,13 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
     eps = min_separation / grid.max_speed
     state = {"steps": 0, "restarts": 0}
 
-    def moved(a, b):
-        state["steps"] += int(abs(round(b / h) - round(a / h)))
+    cur = {"s": 0.0, "t": 0.0}  # where the two endpoints' integrals were last evaluated
+
+    def at(**ends):
+        """Move endpoint s and/or t: integrating over the move costs one step per grid cell."""
+        for name, x in ends.items():
+            state["steps"] += int(abs(round(x / h) - round(cur[name] / h)))
+            cur[name] = x
 
     def end_of(s):
         """t with ℓ(s, t) = L (a numerical integration from s)."""
@@ -276,7 +282,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
                 target += P_num
             sj = grid._search(grid.length, target, 0.0, float(tau))
             if sj is not None:
-                back.append(sj)
+                back.append(sj)  # found during the march as ℓ(z_k, t) >= L: no extra integration
         cuts = np.unique(np.concatenate([[0.0, float(tau)], z, back]))
         modes = []
         for a, b in zip(cuts[:-1], cuts[1:]):
@@ -298,7 +304,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
             tL = end_of(s)
             if tL is None:
                 return
-            moved(s, tL)
+            at(s=s, t=tL)
             psi = sgn * grid.phi(s, tL)
             if abs(psi - target) <= turn_tol:
                 found.append((s, tL, iterates, 0, "simple"))
@@ -314,12 +320,12 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
                     t_new = grid._search(cum_turn, base + target, t, region_end(t))
                     if t_new is None:
                         return
-                    moved(t, t_new)
+                    at(t=t_new)
                     t = t_new
                     s_new = grid._search(grid.length, grid._value(grid.length, t) - length, s, t)
                     if s_new is None:
                         return
-                    moved(s, s_new)
+                    at(s=s_new)
                     s = s_new
                     iterates.append(s)
                     if s > sb:
@@ -334,7 +340,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
                     s_new = grid._search(cum_turn, base_t - target, s, min(t, sb + eps))
                     if s_new is None:
                         return
-                    moved(s, s_new)
+                    at(s=s_new)
                     s = s_new
                     iterates.append(s)
                     if s > sb:
@@ -342,7 +348,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
                     t_new = end_of(s)
                     if t_new is None:
                         return
-                    moved(t, t_new)
+                    at(t=t_new)
                     t = t_new
                     if abs(sgn * grid.phi(s, t) - target) <= turn_tol and abs(grid.ell(s, t) - length) <= length_tol:
                         converged = True
@@ -353,19 +359,19 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
     def bisect_mode(sa, sb):
         """Φ along ℓ = L is monotone on a mixed mode: one root iff Φ brackets Ω."""
         state["restarts"] += 1
-        fa = grid.phi(sa, end_of(sa)) - turn
-        fb = grid.phi(sb, end_of(sb)) - turn
+        ta, tb = end_of(sa), end_of(sb)
+        at(s=sa, t=ta)
+        at(s=sb, t=tb)
+        fa = grid.phi(sa, ta) - turn
+        fb = grid.phi(sb, tb) - turn
         if fa * fb > 0:
             return
         lo, hi = sa, sb
         iterates = []
-        t = end_of(lo)
         for it in range(200):
             mid = 0.5 * (lo + hi)
             tm = end_of(mid)
-            moved(lo, mid)
-            moved(t, tm)
-            t = tm
+            at(s=mid, t=tm)
             fm = grid.phi(mid, tm) - turn
             iterates.append(mid)
             if abs(fm) <= turn_tol or hi - lo <= h:
