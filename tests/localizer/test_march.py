@@ -110,3 +110,20 @@ def test_clockwise_march_matches_exact():
 def test_bad_step():
     with pytest.raises(QueryError, match="step=0.3 must divide the parameter period 90"):
         march(trefoil(), 10.0, 0.1, step=0.3)
+
+
+def test_a_zero_of_curvature_that_keeps_its_sign_is_no_inflection():
+    """Footnote 5: only sign changes are inflections; at a zero the side is κ' 's."""
+    from localizer._march import _sign_regions
+
+    h = 0.01
+    x = np.arange(401) * h  # one period of 4 parameter units, last sample = first
+    kappa = np.cos(np.pi * x / 2) ** 2 - 0.0  # touches zero at x = 1 and 3, never negative
+    kappa[-1] = kappa[0]
+    z, after = _sign_regions(kappa, h)
+    assert z.size == 0
+    kappa2 = np.cos(np.pi * x / 2)  # simple zeros at x = 1 and 3
+    kappa2[-1] = kappa2[0]
+    z2, after2 = _sign_regions(kappa2, h)
+    assert np.allclose(z2, [1.0, 3.0], atol=1e-3)
+    assert list(after2) == [-1.0, 1.0]
