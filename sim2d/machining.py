@@ -1,0 +1,33 @@
+"""Machining error: the real part differs from its model by a smooth random normal deviation."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from localizer import Part, part_from_points
+
+from .noise import NoiseModel
+
+__all__ = ["machined_part"]
+
+
+def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Part:
+    """The part as machined: each knot moved along the model's outward normal.
+
+    The deviation is a random sum of harmonics of the arc position with
+    wavelengths down to ``noise.machining_wavelength`` mm, scaled to an RMS of
+    ``noise.machining_error`` mm. Knot i of the result corresponds to knot i
+    of the model, so spline parameters map one to one.
+    """
+    if noise.machining_error <= 0:
+        return part
+    P = part.perimeter
+    kmax = max(1, int(P / noise.machining_wavelength))
+    knots = np.arange(part.n_knots, dtype=float)
+    sigma = part.arc_at_param(knots)
+    dev = np.zeros(part.n_knots)
+    for k in range(1, kmax + 1):
+        dev += rng.normal() / k * np.cos(2 * np.pi * k * sigma / P + rng.uniform(0, 2 * np.pi))
+    dev *= noise.machining_error / max(np.sqrt(np.mean(dev ** 2)), 1e-300)
+    pts = part.points + dev[:, None] * part.normal(knots)
+    return part_from_points(pts, name=f"{part.name} (machined)")
