@@ -1,0 +1,383 @@
+"""Calibration, contact, rolling and the localization pipeline, written once against ``Rig``.
+
+Paper §III-B (calibration without weights: 11 taps from -50 to 50 mm on the
+jaw, Δv1 held constant by feedback, a cubic spline of the ratio Δv2/Δv1
+against contact location, read back by intersecting it) and §III-C (rolling:
+rotate the jaw by a small angle about the tool axis, then translate along the
+jaw normal until Δv1 is back at about 0.4 V).
+
+Angles are radians, lengths mm, voltages V. Poses are (x, y, φ) as in
+:class:`driver.rig.Rig`: pressing means moving along m = (-sin φ, cos φ).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from localizer import Localization, Part, localize
+
+from .rig import Rig, RigError
+
+__all__ = ["Calibration", "Hand", "RollResult", "RollingRun", "zero", "press", "establish_contact",
+           "calibrate", "edge_offset", "roll", "localize_by_rolling"]
+
+
+# ------------------------------------------------------------------ hand
+class Hand:
+    """The commanded hand pose, moved in the jaw's own frame.
+
+    The arm's reading (``rig.pose()``) is quantized; commands are built from
+    the commanded pose so that quantization does not accumulate.
+    """
+
+    def __init__(self, rig: Rig, pose):
+        self.rig = rig
+        self.pose = tuple(float(v) for v in pose)
+        rig.move(*self.pose)
+
+    def go(self, x, y, phi) -> None:
+        self.pose = (float(x), float(y), float(phi))
+        self.rig.move(*self.pose)
+
+    def press_by(self, s: float) -> None:
+        """Translate by ``s`` mm along the jaw normal towards the part."""
+        x, y, phi = self.pose
+        self.go(x - s * math.sin(phi), y + s * math.cos(phi), phi)
+
+    def slide_by(self, s: float) -> None:
+        """Translate by ``s`` mm along the jaw."""
+        x, y, phi = self.pose
+        self.go(x + s * math.cos(phi), y + s * math.sin(phi), phi)
+
+    def rotate_by(self, angle: float) -> None:
+        """Rotate by ``angle`` rad about the tool axis (the wrist's axis)."""
+        x, y, phi = self.pose
+        self.go(x, y, phi + angle)
+
+
+# ---------------------------------------------------------------- sensing
+def zero(rig: Rig, n: int = 256) -> tuple:
+    """The default readings (v1, v2) with the jaw clear of everything, V."""
+    return rig.read(n)
+
+
+def _delta(rig: Rig, baseline, n: int):
+    v1, v2 = rig.read(n)
+    return v1 - baseline[0], v2 - baseline[1]
+
+
+def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0.01, n: int = 32,
+          slope: float = 0.4, search_step: float = 0.25, max_travel: float = 15.0,
+          overload: float = 2.0, max_steps: int = 60) -> tuple:
+    """Translate along the jaw normal until Δv1 = ``target`` ± ``tol`` V (the paper's feedback).
+
+    Parameters
+    ----------
+    slope : float, V/mm
+        First guess of dΔv1/d(press); refined from the readings (secant).
+    search_step : float, mm
+        Advance per reading while there is no contact yet.
+    max_travel : float, mm
+        Give up (RigError) after pressing this far without contact.
+    overload : float, V
+        Δv1 above this backs the jaw off and stops the run (wrist protection).
+
+    Returns
+    -------
+    (dv1, dv2) : the last reading, V, relative to ``baseline``.
+    """
+    dv1, dv2 = _delta(rig, baseline, n)
+    travelled = 0.0
+    threshold = 0.1 * target
+    while dv1 < threshold:
+        if travelled >= max_travel:
+            raise RigError(f"no contact after pressing {travelled:.1f} mm along the jaw normal "
+                           f"(Δv1 = {dv1:.3f} V); start closer to the part")
+        hand.press_by(search_step)
+        travelled += search_step
+        dv1, dv2 = _delta(rig, baseline, n)
+    prev = None
+    for _ in range(max_steps):
+        if dv1 > overload:
+            hand.press_by(-max_travel)
+            raise RigError(f"Δv1 = {dv1:.3f} V exceeds the overload limit {overload} V: backed off")
+        if abs(dv1 - target) <= tol:
+            return dv1, dv2
+        if prev is not None and abs(dv1 - prev[1]) > 4 * tol and prev[0] != 0:
+            slope = max((dv1 - prev[1]) / prev[0], 0.05 * slope)
+        move = float(np.clip((target - dv1) / slope, -1.0, 1.0))
+        if dv1 < threshold:  # lost the contact: search forward again
+            move = search_step
+        hand.press_by(move)
+        prev = (move, dv1)
+        dv1, dv2 = _delta(rig, baseline, n)
+    raise RigError(f"Δv1 did not settle at {target} ± {tol} V in {max_steps} moves (last {dv1:.3f} V)")
+
+
+def establish_contact(rig: Rig, approach_pose, *, baseline=None, target: float = 0.4, **press_options):
+    """Move to ``approach_pose`` (clear of the part), zero the sensor, press until Δv1 ≈ target.
+
+    Returns (hand, baseline, (dv1, dv2)).
+    """
+    hand = Hand(rig, approach_pose)
+    if baseline is None:
+        baseline = zero(rig)
+    reading = press(rig, hand, baseline, target=target, **press_options)
+    return hand, baseline, reading
+
+
+# ------------------------------------------------------------ calibration
+@dataclass(frozen=True)
+class Calibration:
+    """Contact location on the jaw from the ratio Δv2/Δv1 (paper §III-B, Fig. 6a).
+
+    Attributes
+    ----------
+    positions : tuple of float, mm
+        Jaw positions of the taps.
+    ratios : tuple of float
+        Measured Δv2/Δv1 at each tap.
+    target : float, V
+        Δv1 held during the taps.
+    """
+
+    positions: tuple
+    ratios: tuple
+    target: float = 0.4
+
+    def __post_init__(self):
+        d = np.asarray(self.positions, float)
+        r = np.asarray(self.ratios, float)
+        if d.size < 4 or d.size != r.size or not np.all(np.isfinite(r)):
+            raise RigError(f"calibration needs >= 4 finite (position, ratio) pairs, got {d.size} and {r.size}")
+        if np.any(np.diff(d) <= 0):
+            raise RigError("calibration positions must increase")
+        grid = np.linspace(d[0], d[-1], 2001)
+        rg = CubicSpline(d, r)(grid)
+        steps = np.diff(rg)
+        if not (np.all(steps < 0) or np.all(steps > 0)):
+            k = int(np.argmax(np.sign(steps) != np.sign(steps[0])))
+            raise RigError(f"calibration is not monotone near {grid[k]:.1f} mm on the jaw: a ratio there "
+                           "matches two contact locations; recalibrate with more averaging")
+        order = np.argsort(rg)
+        object.__setattr__(self, "_r", rg[order])
+        object.__setattr__(self, "_d", grid[order])
+
+    def position(self, ratio: float) -> float:
+        """Contact location (mm) for a ratio Δv2/Δv1, by intersecting the spline."""
+        r = float(ratio)
+        lo, hi = self._r[0], self._r[-1]
+        margin = 0.02 * (hi - lo)
+        if not (lo - margin <= r <= hi + margin):
+            raise RigError(f"ratio Δv2/Δv1 = {r:.5f} is outside the calibrated range [{lo:.5f}, {hi:.5f}]: "
+                           f"the contact is beyond the calibrated span {self.positions[0]:.0f}..{self.positions[-1]:.0f} mm")
+        if r < lo or r > hi:  # a little beyond the ends: extrapolate the end slope
+            j = (0, 1) if r < lo else (-2, -1)
+            return float(self._d[j[0]] + (r - self._r[j[0]]) * (self._d[j[1]] - self._d[j[0]]) / (self._r[j[1]] - self._r[j[0]]))
+        return float(np.interp(r, self._r, self._d))
+
+    def save(self, path) -> None:
+        """Write as JSON."""
+        Path(path).write_text(json.dumps({"positions": list(self.positions), "ratios": list(self.ratios),
+                                          "target": self.target}, indent=2) + "\n")
+
+    @classmethod
+    def load(cls, path) -> "Calibration":
+        """Read a calibration written by :meth:`save`."""
+        try:
+            data = json.loads(Path(path).read_text())
+            return cls(tuple(data["positions"]), tuple(data["ratios"]), float(data.get("target", 0.4)))
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise RigError(f"calibration file {path}: {exc}") from None
+
+
+def calibrate(rig: Rig, approach_pose, *, taps: int = 11, span: float = 50.0, target: float = 0.4,
+              n: int = 256, backoff: float = 2.0, **press_options) -> Calibration:
+    """Tap an immobilized object at ``taps`` jaw positions from -span to +span mm (paper §III-B).
+
+    ``approach_pose`` faces the object's contact point with jaw position 0, clear of it.
+    Before each tap the jaw slides along itself so that the same object point meets the
+    jaw ``span/5`` mm further on; Δv1 is held at ``target`` by feedback while Δv2 is read.
+    """
+    x0, y0, phi = (float(v) for v in approach_pose)
+    Hand(rig, (x0, y0, phi))
+    baseline = zero(rig)  # clear of the object
+    positions = np.linspace(-span, span, taps)
+    ratios = []
+    for d in positions:
+        hand = Hand(rig, (x0 - d * math.cos(phi), y0 - d * math.sin(phi), phi))
+        press(rig, hand, baseline, target=target, **press_options)
+        dv1, dv2 = _delta(rig, baseline, n)
+        ratios.append(dv2 / dv1)
+        hand.press_by(-backoff - 1.0)
+    return Calibration(tuple(float(v) for v in positions), tuple(float(v) for v in ratios), target)
+
+
+# --------------------------------------------------------------- rolling
+@dataclass(frozen=True)
+class RollResult:
+    """One roll: the estimate (L, Ω) and what it was made from.
+
+    Attributes
+    ----------
+    length : float, mm
+        Contact travel on the jaw (eq. 3), from the calibrated contact locations.
+    turn : float, rad
+        Jaw rotation from the arm's encoder (eq. 4).
+    positions : tuple of float, mm
+        Contact location on the jaw before the roll and after each step.
+    angles : tuple of float, rad
+        The arm's reading of φ at the same moments.
+    largest_jump : float, mm
+        Largest change of contact location in one step (a bridge across a concavity
+        shows as a jump).
+    jaw_travel : float, mm
+        The contact's travel on the jaw itself, signed in the rolling direction.
+    offset : float, mm
+        Distance of the tool axis from the pressed jaw edge (the wrist's give
+        at the working force, measured by :func:`edge_offset`); see below.
+
+    Notes
+    -----
+    The paper's analysis (§III-C) puts the centre of rotation on the jaw's
+    edge. Ours is the tool axis, which the pressed jaw's edge misses by the
+    wrist's give δ: each rotation by θ then shifts the contact along the jaw
+    by δ·θ as well, so ``length = jaw_travel + offset·|turn|`` (without it a
+    1 mm give costs 1 mm of L per radian rolled).
+    """
+
+    length: float
+    turn: float
+    positions: tuple
+    angles: tuple
+    largest_jump: float
+    jaw_travel: float = 0.0
+    offset: float = 0.0
+
+
+def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 64) -> float:
+    """How far the wrist has given at the present force, mm: Δv1 over dΔv1/d(press).
+
+    Presses ``probe`` mm in and out around the present pose (Δv1 is
+    proportional to the give of a linear wrist) and returns to it.
+    """
+    here = _delta(rig, baseline, n)[0]
+    hand.press_by(probe)
+    deeper = _delta(rig, baseline, n)[0]
+    hand.press_by(-2 * probe)
+    shallower = _delta(rig, baseline, n)[0]
+    hand.press_by(probe)
+    slope = (deeper - shallower) / (2 * probe)
+    if not slope > 0:
+        raise RigError(f"Δv1 did not grow when pressing (slope {slope:.4f} V/mm): no stable contact")
+    return here / slope
+
+
+def _location(rig, baseline, calibration, n):
+    dv1, dv2 = _delta(rig, baseline, n)
+    if dv1 <= 0.1 * calibration.target:
+        raise RigError(f"lost contact while rolling (Δv1 = {dv1:.3f} V)")
+    return calibration.position(dv2 / dv1)
+
+
+def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float, *,
+         step: float = math.radians(0.2), n: int = 32, offset: float | None = None,
+         **press_options) -> RollResult:
+    """Roll by ``angle`` rad (positive: counter-clockwise) in steps of about ``step`` (paper §III-C).
+
+    Each step rotates the jaw about the tool axis, then presses along the jaw
+    normal until Δv1 is back at the calibration's level. ``offset`` (mm) is
+    the tool axis's distance from the pressed edge (measured with
+    :func:`edge_offset` when None; 0 gives the paper's estimate).
+    """
+    if not (math.isfinite(angle) and angle != 0):
+        raise RigError(f"roll angle {angle!r} rad must be finite and nonzero")
+    if not step > 0:
+        raise RigError(f"roll step {step!r} rad must be positive")
+    k = max(1, int(round(abs(angle) / step)))
+    if offset is None:
+        offset = edge_offset(rig, hand, baseline)
+    d = [_location(rig, baseline, calibration, n)]
+    phis = [rig.pose()[2]]
+    for _ in range(k):
+        hand.rotate_by(angle / k)
+        press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+        d.append(_location(rig, baseline, calibration, n))
+        phis.append(rig.pose()[2])
+    sign = 1.0 if angle > 0 else -1.0
+    jumps = np.abs(np.diff(d))
+    travel = sign * (d[-1] - d[0])
+    turn = phis[-1] - phis[0]
+    return RollResult(length=travel + offset * abs(turn), turn=turn, positions=tuple(d), angles=tuple(phis),
+                      largest_jump=float(jumps.max()), jaw_travel=travel, offset=float(offset))
+
+
+@dataclass(frozen=True)
+class RollingRun:
+    """Result of :func:`localize_by_rolling`.
+
+    Attributes
+    ----------
+    rolls : tuple of RollResult
+    estimates : tuple of (float, float)
+        (L mm, Ω rad) of each roll, as given to the localizer.
+    localization : Localization
+    samples : list of dict
+        The rig's log of readings (with ground truth on a simulated rig), if it keeps one.
+    """
+
+    rolls: tuple
+    estimates: tuple
+    localization: Localization
+    samples: list = field(default_factory=list, repr=False)
+
+    @property
+    def estimate_arc(self) -> float:
+        """The present contact's arc position on the part, mm (the best candidate's end)."""
+        best = self.localization.best
+        return float("nan") if best is None else best.end_arc
+
+    def as_dict(self) -> dict:
+        return {"estimates": [list(e) for e in self.estimates], "rolls": [asdict(r) for r in self.rolls],
+                "estimate_arc": self.estimate_arc, "ambiguous": self.localization.ambiguous,
+                "candidates": [c.as_dict() for c in self.localization.candidates]}
+
+
+def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration, approach_pose,
+                        step: float = math.radians(0.2), n: int = 32, bridge_jump: float = 3.0,
+                        rule: str = "likelihood", sd_length: float = 0.5,
+                        sd_turn: float = math.radians(0.03), **press_options) -> RollingRun:
+    """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
+
+    All rolls turn the same way. A straight jaw cannot follow a concave
+    stretch: it bridges it, the contact jumping along the jaw while the jaw
+    does not turn. Such a roll measures the part's convex hull, not the part,
+    so this pipeline refuses it: a step whose contact moves more than
+    ``bridge_jump`` mm on the jaw raises :class:`RigError`.
+    """
+    rolls = [float(a) for a in rolls]
+    if not rolls:
+        raise RigError("rolls is empty: give at least one roll angle")
+    if len({a > 0 for a in rolls}) != 1:
+        raise RigError(f"rolls {rolls!r} must all turn the same way")
+    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
+    results = []
+    for k, angle in enumerate(rolls):
+        r = roll(rig, hand, baseline, calibration, angle, step=step, n=n, **press_options)
+        if r.largest_jump > bridge_jump:
+            hand.press_by(-5.0)
+            raise RigError(f"roll {k + 1} bridged a concave stretch: the contact jumped {r.largest_jump:.1f} mm "
+                           f"on the jaw in one step (limit {bridge_jump} mm). A straight jaw touches the convex "
+                           "hull there; start where the rolls stay on convex stretches")
+        results.append(r)
+    estimates = tuple((r.length, r.turn) for r in results)
+    direction = "ccw" if rolls[0] > 0 else "cw"
+    loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)
+    return RollingRun(rolls=tuple(results), estimates=estimates, localization=loc,
+                      samples=list(getattr(rig, "samples", [])))

@@ -1,0 +1,29 @@
+"""The rig protocol that the simulated and the serial rig both satisfy, and its error."""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+__all__ = ["Rig", "RigError"]
+
+
+class RigError(IOError):
+    """A rig that did not do what was asked: no contact, contact off the jaw, a bad reply, a limit."""
+
+
+@runtime_checkable
+class Rig(Protocol):
+    """An arm that places the hand and a wrist sensor that reads two voltages.
+
+    Poses are (x mm, y mm, φ rad): the wrist's axis on the jaw's edge line and
+    the jaw's direction; the part lies on the jaw's left, (-sin φ, cos φ).
+    """
+
+    def move(self, x: float, y: float, phi: float) -> None:
+        """Move the hand to the pose and return when it is there."""
+
+    def pose(self) -> tuple:
+        """The arm's reading of the hand pose, (x, y, φ)."""
+
+    def read(self, n: int = 32) -> tuple:
+        """The sensor's (v1, v2) in volts, averaged over ``n`` samples."""

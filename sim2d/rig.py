@@ -1,0 +1,117 @@
+"""``SimRig``: a simulated arm and wrist sensor that satisfies ``driver.Rig``.
+
+The arm takes hand poses (x, y mm; φ rad) and reports them with the encoder's
+quantization; the sensor reports raw (v1, v2) in volts, averaged over a
+number of samples. Every reading is logged with the ground truth beside it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from localizer import Part
+
+from ._errors import SimError
+from .machining import machined_part
+from .noise import NoiseModel, load_noise
+from .quasistatic import QuasiStaticWorld
+from .wrist import Wrist, encoder_angle
+
+__all__ = ["SimRig"]
+
+ENGINES = ("quasistatic",)
+
+
+class SimRig:
+    """A simulated rig.
+
+    Parameters
+    ----------
+    part : Part
+        The part's model (what the localizer is given); the simulated part is
+        this one machined with ``noise.machining_error``.
+    noise : str, Path or NoiseModel
+        ``"none"``, ``"paper"`` or a TOML file (see :func:`sim2d.noise.load_noise`).
+    seed : int
+        Seeds every random draw: the same seed gives the same run.
+    engine : {"quasistatic"}
+        The world that computes contact.
+    wrist : Wrist
+        Sensor geometry and sensitivity.
+    stiffness : float, N/mm
+        The wrist's compliance along the jaw normal.
+    linear_speed, angular_speed : float, mm/s and rad/s
+        Speed limits of the arm (moves take time, which the drift sees).
+    sample_period : float, s
+        Time between two raw sensor samples.
+    """
+
+    def __init__(self, part: Part, *, noise="none", seed: int = 0, engine: str = "quasistatic",
+                 wrist: Wrist = Wrist(), stiffness: float = 1.0, linear_speed: float = 20.0,
+                 angular_speed: float = math.radians(30.0), sample_period: float = 1e-3):
+        if engine not in ENGINES:
+            raise SimError(f"unknown engine {engine!r}; use one of {list(ENGINES)}")
+        self.model = part
+        self.noise: NoiseModel = load_noise(noise)
+        self.rng = np.random.default_rng(seed)
+        self.part = machined_part(part, self.noise, self.rng)
+        self.world = QuasiStaticWorld(self.part, stiffness=stiffness)
+        self.wrist = wrist
+        self.linear_speed = float(linear_speed)
+        self.angular_speed = float(angular_speed)
+        self.sample_period = float(sample_period)
+        self.time = 0.0
+        self.samples: list[dict] = []
+
+    # ------------------------------------------------------------ Rig: arm
+    def move(self, x: float, y: float, phi: float) -> None:
+        """Move the hand to (x, y) mm with jaw angle φ rad (blocks until there)."""
+        pose = (float(x), float(y), float(phi))
+        if not all(math.isfinite(v) for v in pose):
+            raise SimError(f"move to {pose!r}: the pose must be finite")
+        x0, y0, p0 = self.world.hand
+        self.time += max(math.hypot(pose[0] - x0, pose[1] - y0) / self.linear_speed,
+                         abs(pose[2] - p0) / self.angular_speed)
+        self.world.set_hand(*pose)
+
+    def pose(self) -> tuple:
+        """The arm's reading of the hand pose: (x mm, y mm, φ rad quantized by the encoder)."""
+        x, y, phi = self.world.hand
+        return x, y, float(encoder_angle(phi, self.noise))
+
+    # --------------------------------------------------------- Rig: sensor
+    def read(self, n: int = 32) -> tuple:
+        """Average of ``n`` raw samples of (v1, v2), V; logged with the truth."""
+        c = self.world.contact()
+        times = self.time + self.sample_period * np.arange(1, n + 1)
+        v1, v2 = self.wrist.voltages(np.full(n, c.force), np.full(n, c.jaw_position), times, self.noise, self.rng)
+        self.time = float(times[-1])
+        out = (float(np.mean(v1)), float(np.mean(v2)))
+        x, y, phi = self.world.hand
+        self.samples.append({
+            "time": self.time, "x": x, "y": y, "phi": phi, "phi_measured": self.pose()[2],
+            "v1": out[0], "v2": out[1], "force": c.force, "jaw_position": c.jaw_position,
+            "contact_arc": float(self.model.wrap_arc(self.model.arc_at_param(c.param))) if c.force > 0 else float("nan"),
+            "at_edge": c.at_edge,
+        })
+        return out
+
+    def truth(self) -> dict:
+        """Ground truth of the present contact (simulation only)."""
+        c = self.world.contact()
+        arc = float(self.model.wrap_arc(self.model.arc_at_param(c.param))) if c.force > 0 else float("nan")
+        return {"force": c.force, "jaw_position": c.jaw_position, "contact_arc": arc, "at_edge": c.at_edge}
+
+    # ------------------------------------------------- simulation helpers
+    def approach_pose(self, arc: float, jaw_position: float = -30.0, standoff: float = 2.0) -> tuple:
+        """A hand pose with the jaw parallel to the model's tangent at ``arc`` (mm),
+        that point facing jaw position ``jaw_position`` (mm), ``standoff`` mm off the part."""
+        t = self.model.param_at_arc(arc)
+        c = self.model.point(t)
+        phi = float(self.model.tangent_angle(t))
+        e = np.array([math.cos(phi), math.sin(phi)])
+        m = np.array([-math.sin(phi), math.cos(phi)])
+        d = c - jaw_position * e - standoff * m
+        return float(d[0]), float(d[1]), phi
