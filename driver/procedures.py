@@ -245,11 +245,17 @@ class RollResult:
 
     Notes
     -----
-    The paper's analysis (§III-C) puts the centre of rotation on the jaw's
-    edge. Ours is the tool axis, which the pressed jaw's edge misses by the
-    wrist's give δ: each rotation by θ then shifts the contact along the jaw
-    by δ·θ as well, so ``length = jaw_travel + offset·|turn|`` (without it a
-    1 mm give costs 1 mm of L per radian rolled).
+    Rotating by θ about the tool axis and pressing back moves the contact on
+    the jaw by (to second order)
+
+        Δu = s·(1 - θ²/6) - δ·θ - u·θ²/2
+
+    for an arc s on the part: the paper's |A'B'| = s + O(s²) (§III-C), with
+    the O(θ²) term -u·θ²/2 of the contact's distance u from the axis, and a
+    first-order term -δ·θ because the tool axis misses the pressed edge by the
+    wrist's give δ. ``jaw_travel`` is the paper's estimate Σ Δu; ``length``
+    inverts the expansion step by step with the measured u and δ, so its error
+    is O(θ²) over a roll instead of O(θ) (and of δ).
     """
 
     length: float
@@ -288,13 +294,19 @@ def _location(rig, baseline, calibration, n):
 
 def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float, *,
          step: float = math.radians(0.2), n: int = 32, offset: float | None = None,
-         **press_options) -> RollResult:
+         bridge_jump: float | None = 3.0, **press_options) -> RollResult:
     """Roll by ``angle`` rad (positive: counter-clockwise) in steps of about ``step`` (paper §III-C).
 
     Each step rotates the jaw about the tool axis, then presses along the jaw
     normal until Δv1 is back at the calibration's level. ``offset`` (mm) is
     the tool axis's distance from the pressed edge (measured with
     :func:`edge_offset` when None; 0 gives the paper's estimate).
+
+    A straight jaw cannot follow a concave stretch: it bridges it, the
+    contact jumping along the jaw while the jaw does not turn. Such a roll
+    measures the part's convex hull, not the part, so a step whose contact
+    moves more than ``bridge_jump`` mm on the jaw stops the roll with
+    :class:`RigError` (None: no check).
     """
     if not (math.isfinite(angle) and angle != 0):
         raise RigError(f"roll angle {angle!r} rad must be finite and nonzero")
@@ -305,17 +317,32 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
         offset = edge_offset(rig, hand, baseline)
     d = [_location(rig, baseline, calibration, n)]
     phis = [rig.pose()[2]]
-    for _ in range(k):
+    for j in range(k):
         hand.rotate_by(angle / k)
         press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
-        d.append(_location(rig, baseline, calibration, n))
+        try:
+            d.append(_location(rig, baseline, calibration, n))
+        except RigError:
+            if bridge_jump is not None and j > 0:  # left the calibrated span in one jump
+                hand.press_by(-5.0)
+                raise RigError(f"step {j + 1} of the roll bridged a concave stretch: the contact left the "
+                               f"calibrated span from {d[-1]:.1f} mm in one step. A straight jaw touches the "
+                               "convex hull there; start where the rolls stay on convex stretches") from None
+            raise
         phis.append(rig.pose()[2])
+        if bridge_jump is not None and abs(d[-1] - d[-2]) > bridge_jump:
+            hand.press_by(-5.0)
+            raise RigError(f"step {j + 1} of the roll bridged a concave stretch: the contact jumped "
+                           f"{abs(d[-1] - d[-2]):.1f} mm on the jaw (limit {bridge_jump} mm). A straight jaw "
+                           "touches the convex hull there; start where the rolls stay on convex stretches")
     sign = 1.0 if angle > 0 else -1.0
-    jumps = np.abs(np.diff(d))
-    travel = sign * (d[-1] - d[0])
-    turn = phis[-1] - phis[0]
-    return RollResult(length=travel + offset * abs(turn), turn=turn, positions=tuple(d), angles=tuple(phis),
-                      largest_jump=float(jumps.max()), jaw_travel=travel, offset=float(offset))
+    u = np.asarray(d)
+    du = np.diff(u)
+    theta = abs(angle) / k
+    arcs = (sign * du + offset * theta + sign * 0.5 * (u[1:] + u[:-1]) * theta ** 2 / 2) / (1 - theta ** 2 / 6)
+    return RollResult(length=float(arcs.sum()), turn=phis[-1] - phis[0], positions=tuple(d), angles=tuple(phis),
+                      largest_jump=float(np.abs(du).max()), jaw_travel=float(sign * (u[-1] - u[0])),
+                      offset=float(offset))
 
 
 @dataclass(frozen=True)
@@ -355,11 +382,9 @@ def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration
                         sd_turn: float = math.radians(0.03), **press_options) -> RollingRun:
     """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
 
-    All rolls turn the same way. A straight jaw cannot follow a concave
-    stretch: it bridges it, the contact jumping along the jaw while the jaw
-    does not turn. Such a roll measures the part's convex hull, not the part,
-    so this pipeline refuses it: a step whose contact moves more than
-    ``bridge_jump`` mm on the jaw raises :class:`RigError`.
+    All rolls turn the same way. Rolls that bridge a concave stretch are
+    refused (:func:`roll`, ``bridge_jump``): the pipeline localizes on the part,
+    never on its convex hull.
     """
     rolls = [float(a) for a in rolls]
     if not rolls:
@@ -369,13 +394,11 @@ def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration
     hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
     results = []
     for k, angle in enumerate(rolls):
-        r = roll(rig, hand, baseline, calibration, angle, step=step, n=n, **press_options)
-        if r.largest_jump > bridge_jump:
-            hand.press_by(-5.0)
-            raise RigError(f"roll {k + 1} bridged a concave stretch: the contact jumped {r.largest_jump:.1f} mm "
-                           f"on the jaw in one step (limit {bridge_jump} mm). A straight jaw touches the convex "
-                           "hull there; start where the rolls stay on convex stretches")
-        results.append(r)
+        try:
+            results.append(roll(rig, hand, baseline, calibration, angle, step=step, n=n,
+                                bridge_jump=bridge_jump, **press_options))
+        except RigError as exc:
+            raise RigError(f"roll {k + 1}: {exc}") from None
     estimates = tuple((r.length, r.turn) for r in results)
     direction = "ccw" if rolls[0] > 0 else "cw"
     loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)

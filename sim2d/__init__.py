@@ -1,1 +1,8 @@
-"""The pymunk planar world and its simulated instruments (issue 4; depends on localizer)."""
+"""The simulated rig: instruments, noise model, worlds and ``SimRig`` (depends on localizer)."""
+
+from ._errors import SimError
+from .noise import PRESETS, NoiseModel, load_noise
+from .rig import SimRig
+from .wrist import Wrist, encoder_angle
+
+__all__ = ["SimError", "NoiseModel", "PRESETS", "load_noise", "SimRig", "Wrist", "encoder_angle"]

@@ -90,7 +90,7 @@ class QuasiStaticWorld:
         p = self.part.point(t)
         du = float((p - (x, y)) @ e)
         dd = float(-((p - (x, y)) @ m))
-        at_edge = abs(du) > self.half_span
+        at_edge = abs(du) > self.half_span + 1e-6
         if at_edge:  # the deepest point lies beyond the jaw: the jaw's end is what touches
             t, du, dd = float(self._t[k]), float(u[k]), float(depth[k])
         if dd <= 0:
