@@ -19,7 +19,7 @@ from localizer import Part
 
 from ._errors import SimError
 
-__all__ = ["Contact", "QuasiStaticWorld"]
+__all__ = ["Contact", "QuasiStaticWorld", "tangent_point"]
 
 
 @dataclass(frozen=True)
@@ -98,15 +98,23 @@ class QuasiStaticWorld:
         return Contact(self.stiffness * dd, du, float(t) % self.part.n_knots, dd, at_edge)
 
     def _refine(self, t0: float, phi: float) -> float:
-        """Newton on the tangent angle: the deepest point has its tangent along the jaw."""
-        t = t0
-        for _ in range(8):
-            f = float(np.angle(np.exp(1j * (self.part.tangent_angle(t) - phi))))
-            df = float(self.part.curvature(t) * self.part.speed(t))
-            if df <= 0:  # concave there: not a support point; keep the sample
-                return t0
-            step = np.clip(f / df, -1.0 / 32, 1.0 / 32)
-            t -= step
-            if abs(step) < 1e-13:
-                break
-        return t
+        return tangent_point(self.part, t0, phi)
+
+
+def tangent_point(part: Part, t0: float, phi: float) -> float:
+    """Spline parameter near ``t0`` where the part's tangent has angle ``phi`` (mod 2π).
+
+    Newton on the tangent angle: where a straight edge at angle φ touches a
+    convex stretch. Returns ``t0`` if the part is concave there.
+    """
+    t = t0
+    for _ in range(8):
+        f = float(np.angle(np.exp(1j * (part.tangent_angle(t) - phi))))
+        df = float(part.curvature(t) * part.speed(t))
+        if df <= 0:
+            return t0
+        step = float(np.clip(f / df, -1.0 / 32, 1.0 / 32))
+        t -= step
+        if abs(step) < 1e-13:
+            break
+    return t

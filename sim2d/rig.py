@@ -21,7 +21,7 @@ from .wrist import Wrist, encoder_angle
 
 __all__ = ["SimRig"]
 
-ENGINES = ("quasistatic",)
+ENGINES = ("quasistatic", "pymunk")
 
 
 class SimRig:
@@ -36,8 +36,9 @@ class SimRig:
         ``"none"``, ``"paper"`` or a TOML file (see :func:`sim2d.noise.load_noise`).
     seed : int
         Seeds every random draw: the same seed gives the same run.
-    engine : {"quasistatic"}
-        The world that computes contact.
+    engine : {"quasistatic", "pymunk"}
+        The world that computes contact: static equilibrium of a rigid edge on a
+        linear wrist, or the pymunk rigid-body simulation (slower, dynamic).
     wrist : Wrist
         Sensor geometry and sensitivity.
     stiffness : float, N/mm
@@ -46,18 +47,27 @@ class SimRig:
         Speed limits of the arm (moves take time, which the drift sees).
     sample_period : float, s
         Time between two raw sensor samples.
+    world_options : dict, optional
+        Further arguments of the world (e.g. ``chord_tolerance``, ``friction``).
     """
 
     def __init__(self, part: Part, *, noise="none", seed: int = 0, engine: str = "quasistatic",
                  wrist: Wrist = Wrist(), stiffness: float = 1.0, linear_speed: float = 20.0,
-                 angular_speed: float = math.radians(30.0), sample_period: float = 1e-3):
+                 angular_speed: float = math.radians(30.0), sample_period: float = 1e-3,
+                 world_options: dict | None = None):
         if engine not in ENGINES:
             raise SimError(f"unknown engine {engine!r}; use one of {list(ENGINES)}")
         self.model = part
         self.noise: NoiseModel = load_noise(noise)
         self.rng = np.random.default_rng(seed)
         self.part = machined_part(part, self.noise, self.rng)
-        self.world = QuasiStaticWorld(self.part, stiffness=stiffness)
+        if engine == "pymunk":
+            from .pymunk_world import PymunkWorld
+
+            self.world = PymunkWorld(self.part, stiffness=stiffness, linear_speed=linear_speed,
+                                     angular_speed=angular_speed, **(world_options or {}))
+        else:
+            self.world = QuasiStaticWorld(self.part, stiffness=stiffness, **(world_options or {}))
         self.wrist = wrist
         self.linear_speed = float(linear_speed)
         self.angular_speed = float(angular_speed)
@@ -71,14 +81,14 @@ class SimRig:
         pose = (float(x), float(y), float(phi))
         if not all(math.isfinite(v) for v in pose):
             raise SimError(f"move to {pose!r}: the pose must be finite")
-        x0, y0, p0 = self.world.hand
+        x0, y0, p0 = self.world.hand or pose
         self.time += max(math.hypot(pose[0] - x0, pose[1] - y0) / self.linear_speed,
                          abs(pose[2] - p0) / self.angular_speed)
         self.world.set_hand(*pose)
 
     def pose(self) -> tuple:
         """The arm's reading of the hand pose: (x mm, y mm, φ rad quantized by the encoder)."""
-        x, y, phi = self.world.hand
+        x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
         return x, y, float(encoder_angle(phi, self.noise))
 
     # --------------------------------------------------------- Rig: sensor
@@ -89,7 +99,7 @@ class SimRig:
         v1, v2 = self.wrist.voltages(np.full(n, c.force), np.full(n, c.jaw_position), times, self.noise, self.rng)
         self.time = float(times[-1])
         out = (float(np.mean(v1)), float(np.mean(v2)))
-        x, y, phi = self.world.hand
+        x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
         self.samples.append({
             "time": self.time, "x": x, "y": y, "phi": phi, "phi_measured": self.pose()[2],
             "v1": out[0], "v2": out[1], "force": c.force, "jaw_position": c.jaw_position,

@@ -1,0 +1,211 @@
+"""The pymunk world: a kinematic hand, a dynamic jaw on a compliant wrist, a static polygonised part.
+
+Units inside the space: millimetres, kilograms, seconds, so a force is in
+kg·mm/s² = mN. The part is a chain of static segments through the spline,
+polygonised to a chord tolerance; the hand is a kinematic body without shapes,
+driven only by commands (velocity control with speed limits); the jaw is a
+dynamic box whose edge (local y = 0, x in ±half_span) faces the part. The wrist
+joins them: a groove lets the jaw slide along the jaw normal only, a damped
+spring along that groove gives the wrist's compliance, and a gear joint keeps
+the jaw's angle equal to the hand's. Contact force and location come from the
+jaw's arbiters after each step. No randomness: a world is deterministic.
+
+It offers the same ``set_hand`` / ``contact`` interface as
+:class:`sim2d.quasistatic.QuasiStaticWorld`: ``set_hand`` drives the hand to the
+pose at the speed limits and steps the space until the jaw has settled.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pymunk
+
+from localizer import Part
+
+from ._errors import SimError
+from .quasistatic import Contact, tangent_point
+
+__all__ = ["PymunkWorld", "polygonise"]
+
+_MN_PER_N = 1000.0
+
+
+def polygonise(part: Part, chord_tolerance: float) -> np.ndarray:
+    """Points on the spline whose chords stay within ``chord_tolerance`` mm of it (closed, first = last).
+
+    Each piece gets n chords with the sagitta bound κ_max·h²/8 <= tolerance,
+    h the longest chord (uniform parameter, speed variation allowed for).
+    """
+    return _polygon(part, chord_tolerance)[0]
+
+
+def _polygon(part: Part, chord_tolerance: float):
+    """(points, parameters) of :func:`polygonise`."""
+    if not chord_tolerance > 0:
+        raise SimError(f"chord_tolerance={chord_tolerance!r} mm must be positive")
+    ts = []
+    for i in range(part.n_knots):
+        u = i + np.linspace(0.0, 1.0, 33)
+        speed = part.speed(u)
+        kappa = np.abs(part.curvature(u)).max()
+        length = float(part.arc_length(float(i), float(i + 1)))
+        h_max = math.sqrt(8.0 * chord_tolerance / max(kappa, 1e-12))
+        n = max(1, math.ceil(length * (speed.max() / speed.mean()) / h_max))
+        ts.append(i + np.arange(n) / n)
+    ts = np.concatenate(ts)
+    pts = part.point(ts)
+    return np.vstack([pts, pts[:1]]), ts
+
+
+class PymunkWorld:
+    """The jaw rolling on the part in a pymunk space.
+
+    Parameters
+    ----------
+    part : Part
+        The real part.
+    stiffness : float, N/mm
+        Wrist compliance along the jaw normal.
+    half_span : float, mm
+        Half the jaw's length.
+    chord_tolerance : float, mm
+        Polygonisation tolerance of the part (default 1e-4 mm). pymunk decides
+        whether, how hard and at which polygon vertex the jaw touches; the contact
+        location is then refined on the spline the polygon approximates.
+    friction : float
+        Coulomb friction coefficient between jaw and part.
+    dt : float, s
+        Physics step.
+    linear_speed, angular_speed : float, mm/s and rad/s
+        The hand's speed limits.
+    settle_steps : int
+        Steps run after the hand reaches a commanded pose.
+    """
+
+    def __init__(self, part: Part, *, stiffness: float = 1.0, half_span: float = 50.0,
+                 chord_tolerance: float = 1e-4, friction: float = 0.3, dt: float = 1e-3,
+                 linear_speed: float = 20.0, angular_speed: float = math.radians(30.0),
+                 settle_steps: int = 150):
+        if not (stiffness > 0 and half_span > 0 and dt > 0 and friction >= 0):
+            raise SimError(f"stiffness={stiffness!r}, half_span={half_span!r}, dt={dt!r} must be positive "
+                           f"and friction={friction!r} >= 0")
+        self.part = part
+        self.stiffness = float(stiffness)
+        self.half_span = float(half_span)
+        self.dt = float(dt)
+        self.linear_speed = float(linear_speed)
+        self.angular_speed = float(angular_speed)
+        self.settle_steps = int(settle_steps)
+        self.steps = 0
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.collision_slop = 1e-4
+        space.iterations = 30
+        self.space = space
+        pts, self._poly_t = _polygon(part, chord_tolerance)
+        self.polygon = pts
+        body = space.static_body
+        segs = []
+        n = len(pts) - 1
+        for i in range(n):
+            s = pymunk.Segment(body, tuple(pts[i]), tuple(pts[i + 1]), 0.0)
+            s.friction = friction
+            segs.append(s)
+        for i, s in enumerate(segs):
+            s.set_neighbors(tuple(pts[i - 1]), tuple(pts[(i + 2) % n]))
+        space.add(*segs)
+        self.hand_body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        mass, width = 0.05, 6.0
+        verts = [(-half_span, -width), (half_span, -width), (half_span, 0.0), (-half_span, 0.0)]
+        self.jaw_body = pymunk.Body(mass, pymunk.moment_for_poly(mass, verts))
+        jaw = pymunk.Poly(self.jaw_body, verts)
+        jaw.friction = friction
+        rest = 20.0
+        k = self.stiffness * _MN_PER_N  # mN/mm
+        damping = 2.0 * math.sqrt(k * mass)  # critical
+        groove = pymunk.GrooveJoint(self.hand_body, self.jaw_body, (0.0, -200.0), (0.0, 200.0), (0.0, 0.0))
+        spring = pymunk.DampedSpring(self.hand_body, self.jaw_body, (0.0, -rest), (0.0, 0.0), rest, k, damping)
+        gear = pymunk.GearJoint(self.hand_body, self.jaw_body, 0.0, 1.0)
+        space.add(self.hand_body, self.jaw_body, jaw, groove, spring, gear)
+        self.hand = None  # not placed yet: the first command puts the arm there directly
+
+    def _place(self, x, y, phi):
+        for b in (self.hand_body, self.jaw_body):
+            b.position = (x, y)
+            b.angle = phi
+            b.velocity = (0.0, 0.0)
+            b.angular_velocity = 0.0
+        self.space.reindex_shapes_for_body(self.jaw_body)
+
+    def set_hand(self, x: float, y: float, phi: float) -> None:
+        """Drive the hand to the pose at the speed limits, then let the jaw settle.
+
+        The first command places the hand and jaw there directly (the arm's
+        start-up pose must be clear of the part).
+        """
+        if self.hand is None:
+            self._place(float(x), float(y), float(phi))
+        target = np.array([x, y], float)
+        hb = self.hand_body
+        dt = self.dt
+        for _ in range(1_000_000):
+            pos = np.array(hb.position)
+            dp = target - pos
+            da = phi - hb.angle
+            dist = float(np.hypot(*dp))
+            if dist < 1e-9 and abs(da) < 1e-12:
+                break
+            # a common time to arrive, within both speed limits
+            t = max(dist / self.linear_speed, abs(da) / self.angular_speed, dt)
+            frac = dt / t
+            hb.velocity = tuple(dp * frac / dt)
+            hb.angular_velocity = da * frac / dt
+            self._step()
+        hb.velocity = (0.0, 0.0)
+        hb.angular_velocity = 0.0
+        hb.position = (float(x), float(y))
+        hb.angle = float(phi)
+        for _ in range(self.settle_steps):
+            self._step()
+        self.hand = (float(x), float(y), float(phi))
+
+    def _step(self):
+        self.space.step(self.dt)
+        self.steps += 1
+
+    def contact(self) -> Contact:
+        """Force (N) and location on the jaw (mm) from the jaw's arbiters after the last step."""
+        jb = self.jaw_body
+        e = np.array([math.cos(jb.angle), math.sin(jb.angle)])
+        m = np.array([-math.sin(jb.angle), math.cos(jb.angle)])
+        if self.hand is None:
+            return Contact(0.0, 0.0, float("nan"), 0.0, False)
+        hx, hy, _ = self.hand
+        total = 0.0
+        points, depths = [], []
+
+        def visit(arb):
+            nonlocal total
+            total += abs(float(np.dot(arb.total_impulse, m))) / self.dt / _MN_PER_N
+            for p in arb.contact_point_set.points:
+                if p.distance < 0:
+                    points.append(np.array(p.point_a if arb.shapes[0].body is jb else p.point_b))
+                    depths.append(-p.distance)
+
+        jb.each_arbiter(visit)
+        if total <= 0 or not points:
+            return Contact(0.0, 0.0, float("nan"), 0.0, False)
+        # The solver spreads the force over the polygon vertices that overlap the
+        # edge in no particular way; the deepest one is the polygon's contact. The
+        # real part is the spline: refine to its tangent point at the jaw's angle
+        # (the jaw twists a little against the hand under load, as the paper notes).
+        deepest = np.asarray(points)[int(np.argmax(depths))]
+        k = int(np.argmin(np.sum((self.polygon[:-1] - deepest) ** 2, axis=1)))
+        t = tangent_point(self.part, float(self._poly_t[k]), jb.angle) % self.part.n_knots
+        if abs(float((self.part.point(t) - deepest) @ e)) > 2.0:  # a bridge or a corner: keep the vertex
+            t = float(self._poly_t[k])
+        u = float((self.part.point(t) - np.array(jb.position)) @ e)
+        depth = float(-((np.array(jb.position) - (hx, hy)) @ m))
+        return Contact(total, u, t, depth, abs(u) > self.half_span + 1e-6)
