@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from localizer import Localization, Part, localize
+from localizer import Localization, Part, arc_from_jaw_positions, localize
 
 from .rig import Rig, RigError
 
@@ -242,20 +242,18 @@ class RollResult:
     offset : float, mm
         Distance of the tool axis from the pressed jaw edge (the wrist's give
         at the working force, measured by :func:`edge_offset`); see below.
+    step : float, rad
+        The signed rotation of each step.
+    readings : tuple of (Δv1 V, Δv2 V, φ rad)
+        The reading behind each contact location, with the arm's angle.
+    truth : tuple of (contact arc mm, jaw position mm)
+        Ground truth at each reading (NaN on a real rig).
 
     Notes
     -----
-    Rotating by θ about the tool axis and pressing back moves the contact on
-    the jaw by (to second order)
-
-        Δu = s·(1 - θ²/6) - δ·θ - u·θ²/2
-
-    for an arc s on the part: the paper's |A'B'| = s + O(s²) (§III-C), with
-    the O(θ²) term -u·θ²/2 of the contact's distance u from the axis, and a
-    first-order term -δ·θ because the tool axis misses the pressed edge by the
-    wrist's give δ. ``jaw_travel`` is the paper's estimate Σ Δu; ``length``
-    inverts the expansion step by step with the measured u and δ, so its error
-    is O(θ²) over a roll instead of O(θ) (and of δ).
+    ``jaw_travel`` is the paper's estimate of L, the contact's travel on the
+    jaw; ``length`` corrects it to second order in the step angle and for the
+    tool axis's offset from the edge (:func:`localizer.arc_from_jaw_positions`).
     """
 
     length: float
@@ -265,6 +263,9 @@ class RollResult:
     largest_jump: float
     jaw_travel: float = 0.0
     offset: float = 0.0
+    step: float = 0.0
+    readings: tuple = ()
+    truth: tuple = ()
 
 
 def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 64) -> float:
@@ -285,8 +286,13 @@ def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 
     return here / slope
 
 
-def _location(rig, baseline, calibration, n):
+def _location(rig, baseline, calibration, n, readings=None, truth=None):
+    """Contact location on the jaw (mm) from one averaged reading; logs the reading."""
     dv1, dv2 = _delta(rig, baseline, n)
+    if readings is not None:
+        readings.append((dv1, dv2, rig.pose()[2]))
+        t = rig.truth() if hasattr(rig, "truth") else {}
+        truth.append((t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
     if dv1 <= 0.1 * calibration.target:
         raise RigError(f"lost contact while rolling (Δv1 = {dv1:.3f} V)")
     return calibration.position(dv2 / dv1)
@@ -315,13 +321,14 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
     k = max(1, int(round(abs(angle) / step)))
     if offset is None:
         offset = edge_offset(rig, hand, baseline)
-    d = [_location(rig, baseline, calibration, n)]
+    readings, truth = [], []
+    d = [_location(rig, baseline, calibration, n, readings, truth)]
     phis = [rig.pose()[2]]
     for j in range(k):
         hand.rotate_by(angle / k)
         press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
         try:
-            d.append(_location(rig, baseline, calibration, n))
+            d.append(_location(rig, baseline, calibration, n, readings, truth))
         except RigError:
             if bridge_jump is not None and j > 0:  # left the calibrated span in one jump
                 hand.press_by(-5.0)
@@ -336,13 +343,11 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
                            f"{abs(d[-1] - d[-2]):.1f} mm on the jaw (limit {bridge_jump} mm). A straight jaw "
                            "touches the convex hull there; start where the rolls stay on convex stretches")
     sign = 1.0 if angle > 0 else -1.0
-    u = np.asarray(d)
-    du = np.diff(u)
-    theta = abs(angle) / k
-    arcs = (sign * du + offset * theta + sign * 0.5 * (u[1:] + u[:-1]) * theta ** 2 / 2) / (1 - theta ** 2 / 6)
-    return RollResult(length=float(arcs.sum()), turn=phis[-1] - phis[0], positions=tuple(d), angles=tuple(phis),
-                      largest_jump=float(np.abs(du).max()), jaw_travel=float(sign * (u[-1] - u[0])),
-                      offset=float(offset))
+    du = np.diff(d)
+    return RollResult(length=arc_from_jaw_positions(d, angle / k, offset), turn=phis[-1] - phis[0],
+                      positions=tuple(d), angles=tuple(phis), largest_jump=float(np.abs(du).max()),
+                      jaw_travel=float(sign * (d[-1] - d[0])), offset=float(offset), step=angle / k,
+                      readings=tuple(readings), truth=tuple(truth))
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from .wrist import Wrist, encoder_angle
 
 __all__ = ["SimRig"]
 
-ENGINES = ("quasistatic", "pymunk")
+ENGINES = ("kinematic", "pymunk")
 
 
 class SimRig:
@@ -36,9 +36,10 @@ class SimRig:
         ``"none"``, ``"paper"`` or a TOML file (see :func:`sim2d.noise.load_noise`).
     seed : int
         Seeds every random draw: the same seed gives the same run.
-    engine : {"quasistatic", "pymunk"}
-        The world that computes contact: static equilibrium of a rigid edge on a
-        linear wrist, or the pymunk rigid-body simulation (slower, dynamic).
+    engine : {"kinematic", "pymunk"}
+        The world that computes contact: "kinematic", the static equilibrium of a rigid edge on a
+        linear wrist from the geometry alone (:class:`QuasiStaticWorld`), or "pymunk",
+        the rigid-body simulation (dynamic, about ten times slower).
     wrist : Wrist
         Sensor geometry and sensitivity.
     stiffness : float, N/mm
@@ -51,7 +52,7 @@ class SimRig:
         Further arguments of the world (e.g. ``chord_tolerance``, ``friction``).
     """
 
-    def __init__(self, part: Part, *, noise="none", seed: int = 0, engine: str = "quasistatic",
+    def __init__(self, part: Part, *, noise="none", seed: int = 0, engine: str = "kinematic",
                  wrist: Wrist = Wrist(), stiffness: float = 1.0, linear_speed: float = 20.0,
                  angular_speed: float = math.radians(30.0), sample_period: float = 1e-3,
                  world_options: dict | None = None):
