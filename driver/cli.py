@@ -8,11 +8,18 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
+from dataclasses import asdict
 
 import numpy as np
 
 from localizer import DIRECTIONS, RULES, LocalizerError, load_part, localize
+
+from .rig import RigError
+
+# sim2d errors are ValueErrors; caught by their base so that the CLI imports no physics at start
+SimErrorBase = ValueError
 
 __all__ = ["main", "build_parser"]
 
@@ -52,7 +59,134 @@ def build_parser() -> argparse.ArgumentParser:
                      help="paper rule: turn tolerance (default 0.0004 rad = 0.0229 deg)")
     loc.add_argument("--json", action="store_true", help="print the result as JSON")
     loc.add_argument("--plot", metavar="FILE.png", help="draw the part, the candidate segments and the contact")
+
+    sim = sub.add_parser("simulate", help="roll a simulated jaw on a part and save the trace",
+                         description="Calibrate a simulated rig, establish contact at --start, roll, "
+                                     "localize, and save the readings with their ground truth.")
+    sim.add_argument("part", help="part file")
+    sim.add_argument("--start", type=float, required=True, metavar="MM",
+                     help="arc position of the first contact, mm counter-clockwise from the part's first point")
+    sim.add_argument("--roll", type=float, action="append", required=True, metavar="DEG",
+                     help="a roll's rotation, degrees (positive: counter-clockwise); repeat for more rolls")
+    sim.add_argument("--noise", default="paper", metavar="none|paper|FILE.toml",
+                     help="noise model: a preset or a TOML file (default paper)")
+    sim.add_argument("--engine", choices=("pymunk", "kinematic"), default="pymunk",
+                     help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk)")
+    sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    sim.add_argument("--step", type=_positive, default=0.2, metavar="DEG", help="rolling step, degrees (default 0.2)")
+    sim.add_argument("--out", required=True, metavar="TRACE.npz", help="trace file to write")
+    sim.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
+    sim.add_argument("--json", action="store_true", help="print the result as JSON")
+
+    lct = sub.add_parser("locate", help="localize from a saved trace",
+                         description="Recompute the rolls' (L, Ω) from a trace's readings and localize.")
+    lct.add_argument("trace", help="trace file (.npz) from 'rolltouch simulate'")
+    lct.add_argument("--part", required=True, help="part file (the model the localizer is given)")
+    lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
+    lct.add_argument("--json", action="store_true", help="print the result as JSON")
+    lct.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
     return parser
+
+
+def _run_summary(part, trace, loc) -> dict:
+    """The JSON object of 'simulate' and 'locate'."""
+    best = loc.best
+    estimate = best.end_arc if best is not None else None
+    doc = {
+        "part": part.name,
+        "estimates": [{"length": L, "turn": w, "turn_deg": math.degrees(w)} for L, w in loc.rolls],
+        "estimate_arc": estimate,
+        "ambiguous": loc.ambiguous,
+        "candidates": [c.as_dict() for c in loc.candidates],
+    }
+    true_arc = trace.true_arc
+    if math.isfinite(true_arc):
+        doc["true_arc"] = true_arc
+        doc["error_mm"] = None if estimate is None else abs(float(part.arc_offset(estimate, true_arc)))
+    return doc
+
+
+def _print_run(doc) -> None:
+    for k, e in enumerate(doc["estimates"]):
+        print(f"roll {k + 1}: L = {e['length']:.3f} mm, Ω = {e['turn_deg']:.3f}°")
+    if doc["estimate_arc"] is None:
+        print("no place on the part fits these rolls")
+    else:
+        verdict = "AMBIGUOUS" if doc["ambiguous"] else "localized"
+        print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm "
+              f"(p={doc['candidates'][0]['probability']:.3f})")
+    if "true_arc" in doc:
+        err = doc["error_mm"]
+        print(f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
+              f"({'success' if err is not None and err < 0.3 else 'failure'} at 0.3 mm)")
+
+
+def _simulate(args) -> int:
+    from driver.procedures import calibrate, localize_by_rolling
+    from driver.trace import Trace
+    from sim2d import SimRig, load_noise
+
+    part = load_part(args.part)
+    noise = load_noise(args.noise)
+    rolls = [math.radians(r) for r in args.roll]
+    if not 0 <= args.start < part.perimeter:
+        raise LocalizerError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
+    # calibrate on the part's most curved point (on the hull), with its own rig instance
+    t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
+    cal_arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+    cal_rig = SimRig(part, noise=noise, seed=args.seed + 1, engine=args.engine)
+    calibration = calibrate(cal_rig, cal_rig.approach_pose(cal_arc, jaw_position=0.0, standoff=1.0))
+    rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine)
+    jaw_start = -40.0 if rolls[0] > 0 else 40.0
+    run = localize_by_rolling(rig, part, rolls, calibration=calibration, step=math.radians(args.step),
+                              approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0))
+    first = run.rolls[0].truth[0][0]
+    if math.isfinite(first) and abs(float(part.arc_offset(first, args.start))) > 1.0:
+        raise RigError(f"--start {args.start} mm is not on the part's convex hull: a straight jaw laid there "
+                       f"touches at {first:.2f} mm instead")
+    trace = Trace.from_run(run, calibration, part={"name": part.name, "file": str(args.part),
+                                                   "perimeter": part.perimeter},
+                           engine=args.engine, noise_name=str(args.noise), noise=asdict(noise), seed=args.seed,
+                           start_arc=args.start, rolls_deg=list(args.roll), step_deg=args.step)
+    trace.save(args.out)
+    doc = _run_summary(part, trace, run.localization)
+    doc["trace"] = str(args.out)
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        _print_run(doc)
+        print(f"trace written to {args.out}")
+    if args.plot:
+        from driver.plotting import plot_run
+
+        plot_run(part, trace, run.localization, args.plot)
+        if not args.json:
+            print(f"plot written to {args.plot}")
+    return 0
+
+
+def _locate(args) -> int:
+    from driver.trace import Trace
+
+    part = load_part(args.part)
+    trace = Trace.load(args.trace)
+    estimates = trace.estimates()
+    direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"
+    loc = localize(part, estimates, rule=args.rule, direction=direction)
+    doc = _run_summary(part, trace, loc)
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        _print_run(doc)
+    if args.plot:
+        from driver.plotting import plot_run
+
+        plot_run(part, trace, loc, args.plot)
+        if not args.json:
+            print(f"plot written to {args.plot}")
+    return 0
 
 
 def _localize(args) -> int:
@@ -109,7 +243,11 @@ def main(argv=None) -> int:
     try:
         if args.command == "localize":
             return _localize(args)
-    except LocalizerError as exc:
+        if args.command == "simulate":
+            return _simulate(args)
+        if args.command == "locate":
+            return _locate(args)
+    except (LocalizerError, RigError, SimErrorBase) as exc:
         print(f"rolltouch: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:

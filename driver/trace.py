@@ -1,0 +1,128 @@
+"""Traces: what a rolling run read, saved as ``.npz`` arrays plus JSON metadata (never pickled).
+
+One row per contact-location reading (before each roll and after each of its
+steps): roll index, step index, Δv1 and Δv2 (V, relative to the zero
+reading), the arm's angle φ (rad), and on a simulated rig the ground truth:
+the contact's arc position on the part (mm) and its location on the jaw (mm).
+The metadata holds the calibration, the rolls' step angles and edge offsets,
+the estimates (L, Ω) of the run, and how the run was made (part, engine,
+noise model, seed, start).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from localizer import arc_from_jaw_positions
+
+from .procedures import Calibration, RollingRun
+from .rig import RigError
+
+__all__ = ["Trace", "COLUMNS", "FORMAT"]
+
+COLUMNS = ("roll", "step", "dv1", "dv2", "phi", "true_arc", "true_jaw_position")
+FORMAT = "rolltouch-trace/1"
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A rolling run's readings and metadata.
+
+    Attributes
+    ----------
+    columns : dict of str -> ndarray
+        The per-reading columns of :data:`COLUMNS`.
+    metadata : dict
+        JSON-able description of the run (see module notes).
+    """
+
+    columns: dict
+    metadata: dict
+
+    @classmethod
+    def from_run(cls, run: RollingRun, calibration: Calibration, **metadata) -> "Trace":
+        """Collect the readings of a :class:`RollingRun` with ``metadata`` about how it was made."""
+        rows = []
+        for k, r in enumerate(run.rolls):
+            for j, ((dv1, dv2, phi), (arc, jaw)) in enumerate(zip(r.readings, r.truth)):
+                rows.append((k, j, dv1, dv2, phi, arc, jaw))
+        arr = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
+        columns = {name: arr[:, i] for i, name in enumerate(COLUMNS)}
+        columns["roll"] = columns["roll"].astype(np.int64)
+        columns["step"] = columns["step"].astype(np.int64)
+        meta = dict(metadata)
+        meta.update({
+            "format": FORMAT,
+            "calibration": {"positions": list(calibration.positions), "ratios": list(calibration.ratios),
+                            "target": calibration.target},
+            "steps": [r.step for r in run.rolls],
+            "offsets": [r.offset for r in run.rolls],
+            "estimates": [list(e) for e in run.estimates],
+        })
+        return cls(columns, meta)
+
+    def save(self, path) -> None:
+        """Write ``path`` (.npz): the columns and a ``metadata`` JSON string."""
+        np.savez(path, metadata=np.array(json.dumps(self.metadata)), **self.columns)
+
+    @classmethod
+    def load(cls, path) -> "Trace":
+        """Read a trace written by :meth:`save`.
+
+        Raises
+        ------
+        RigError
+            Missing or unreadable file, not a rolltouch trace, missing columns.
+        """
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                meta = json.loads(str(data["metadata"]))
+                columns = {name: np.array(data[name]) for name in COLUMNS}
+        except FileNotFoundError:
+            raise RigError(f"trace {path}: no such file") from None
+        except (OSError, ValueError, KeyError) as exc:
+            raise RigError(f"trace {path}: not a rolltouch trace ({exc})") from None
+        if meta.get("format") != FORMAT:
+            raise RigError(f"trace {path}: format {meta.get('format')!r}, expected {FORMAT!r}")
+        return cls(columns, meta)
+
+    # ------------------------------------------------------------ analysis
+    @property
+    def calibration(self) -> Calibration:
+        c = self.metadata["calibration"]
+        return Calibration(tuple(c["positions"]), tuple(c["ratios"]), float(c["target"]))
+
+    def estimates(self) -> list:
+        """(L mm, Ω rad) of each roll, recomputed from the readings and the calibration."""
+        cal = self.calibration
+        out = []
+        rolls = self.columns["roll"]
+        for k, (step, offset) in enumerate(zip(self.metadata["steps"], self.metadata["offsets"])):
+            sel = rolls == k
+            if sel.sum() < 2:
+                raise RigError(f"roll {k + 1} of the trace has fewer than two readings")
+            ratios = self.columns["dv2"][sel] / self.columns["dv1"][sel]
+            positions = [cal.position(r) for r in ratios]
+            phi = self.columns["phi"][sel]
+            out.append((arc_from_jaw_positions(positions, step, offset), float(phi[-1] - phi[0])))
+        return out
+
+    @property
+    def true_arc(self) -> float:
+        """The last reading's true contact arc position (NaN if the trace has no truth)."""
+        arc = self.columns["true_arc"]
+        return float(arc[-1]) if arc.size else math.nan
+
+    @property
+    def true_start_arc(self) -> float:
+        arc = self.columns["true_arc"]
+        return float(arc[0]) if arc.size else math.nan
+
+    def jaw_positions(self) -> np.ndarray:
+        """Calibrated contact locations on the jaw of every reading, mm."""
+        cal = self.calibration
+        return np.array([cal.position(a / b) for a, b in zip(self.columns["dv2"], self.columns["dv1"])])
