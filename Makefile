@@ -1,4 +1,4 @@
-# make demo : set up .venv and localize on a shipped part (plot in out/)
+# make demo : set up .venv, simulate two rolls on a shipped part with the paper's noise, localize (plot in out/)
 # make test : set up .venv and run the tests, the doctests and the benchmark smoke run
 PYTHON ?= python3.11
 VENV   := .venv
@@ -15,7 +15,8 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	@mkdir -p out
-	$(VENV)/bin/rolltouch localize parts/trefoil.json --length 25.2 --turn 31.8 --then 19.9 34.4 --plot out/demo.png
+	$(VENV)/bin/rolltouch simulate parts/trefoil.json --start 120 --roll 20 --roll 15 --noise paper --engine pymunk --out out/demo.npz --plot out/demo.png
+	$(VENV)/bin/rolltouch locate out/demo.npz --part parts/trefoil.json
 
 test: $(STAMP)
 	$(PY) -m pytest -q tests localizer

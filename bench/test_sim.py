@@ -1,0 +1,61 @@
+"""Simulated rolling: pymunk steps per second, and a whole rolling step on each engine.
+
+Run: ``pytest bench --benchmark-only``.
+"""
+
+import math
+
+import pytest
+
+from bench.baselines import PARTS_DIR
+from driver.procedures import Calibration, establish_contact, roll
+from localizer import load_part
+from sim2d import SimRig
+from sim2d.pymunk_world import PymunkWorld
+
+STEP = math.radians(0.2)
+
+
+@pytest.fixture(scope="module")
+def part():
+    return load_part(PARTS_DIR / "cam.json")
+
+
+@pytest.fixture(scope="module")
+def calibration():
+    # the wrist's exact ratio line: this benchmark measures rolling, not calibration
+    positions = tuple(float(d) for d in range(-50, 51, 10))
+    return Calibration(positions, tuple(-d / (32 * 25.0) for d in positions))
+
+
+def test_pymunk_steps_per_second(benchmark, part):
+    w = PymunkWorld(part)
+    arc = 40.0
+    t = part.param_at_arc(arc)
+    c, phi = part.point(t), float(part.tangent_angle(t))
+    e, m = (math.cos(phi), math.sin(phi)), (-math.sin(phi), math.cos(phi))
+    w.set_hand(c[0] + 20 * e[0] + 0.5 * m[0], c[1] + 20 * e[1] + 0.5 * m[1], phi)
+
+    def run(n=2000):
+        for _ in range(n):
+            w._step()
+        return w.contact()
+
+    contact = benchmark.pedantic(run, rounds=5, iterations=1)
+    assert contact.force > 0
+    if not benchmark.disabled:
+        benchmark.extra_info["steps_per_second"] = 2000 / benchmark.stats.stats.mean
+
+
+@pytest.mark.parametrize("engine", ["kinematic", "pymunk"])
+def test_rolling_step(benchmark, part, calibration, engine):
+    rig = SimRig(part, engine=engine)
+    hand, base, _ = establish_contact(rig, rig.approach_pose(30.0, jaw_position=-40.0, standoff=1.0))
+
+    def one_step():
+        return roll(rig, hand, base, calibration, STEP, step=STEP, offset=1.0)
+
+    r = benchmark.pedantic(one_step, rounds=10, iterations=1)
+    assert r.length > 0
+    if not benchmark.disabled:
+        benchmark.extra_info["rolling_steps_per_second"] = 1 / benchmark.stats.stats.mean

@@ -1,0 +1,83 @@
+"""rolltouch simulate / locate, and the trace format."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from driver.cli import main
+from driver.rig import RigError
+from driver.trace import COLUMNS, Trace
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+
+
+@pytest.fixture(scope="module")
+def trace_file(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sim") / "t.npz"
+    rc = main(["simulate", str(PARTS / "trefoil.json"), "--start", "120", "--roll", "20", "--roll", "15",
+               "--noise", "none", "--engine", "kinematic", "--out", str(out)])
+    assert rc == 0
+    return out
+
+
+def test_simulate_then_locate_json_contract(trace_file, capsys):
+    capsys.readouterr()
+    rc = main(["locate", str(trace_file), "--part", str(PARTS / "trefoil.json"), "--json"])
+    assert rc == 0
+    doc = json.loads(capsys.readouterr().out)
+    for key in ("estimate_arc", "candidates", "true_arc", "error_mm"):
+        assert key in doc
+    assert doc["error_mm"] < 0.3
+    assert abs(doc["true_arc"] - doc["estimate_arc"]) < 0.3 or doc["error_mm"] < 0.3
+
+
+def test_trace_roundtrip_and_recomputed_estimates(trace_file):
+    tr = Trace.load(trace_file)
+    assert set(COLUMNS) <= set(tr.columns)
+    assert tr.metadata["start_arc"] == 120.0 and tr.metadata["engine"] == "kinematic"
+    assert tr.true_start_arc == pytest.approx(120.0, abs=0.05)
+    # locate recomputes exactly what the run estimated
+    assert np.allclose(tr.estimates(), tr.metadata["estimates"], atol=1e-9)
+    raw = np.load(trace_file, allow_pickle=False)  # no pickles anywhere
+    assert "metadata" in raw.files
+
+
+def test_simulate_json_and_plot(tmp_path, capsys):
+    out, png = tmp_path / "t.npz", tmp_path / "t.png"
+    rc = main(["simulate", str(PARTS / "cam.json"), "--start", "60", "--roll", "25", "--roll", "20",
+               "--noise", "paper", "--engine", "kinematic", "--seed", "3", "--out", str(out), "--plot", str(png),
+               "--json"])
+    assert rc == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["trace"] == str(out) and "error_mm" in doc
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_simulate_errors(tmp_path, capsys):
+    rc = main(["simulate", str(PARTS / "cam.json"), "--start", "9999", "--roll", "20", "--noise", "none",
+               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    assert rc == 2 and "--start 9999.0 mm must be in" in capsys.readouterr().err
+    rc = main(["simulate", str(PARTS / "cam.json"), "--start", "10", "--roll", "20", "--noise", "lab",
+               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    assert rc == 2 and "use a preset" in capsys.readouterr().err
+    # a start in a concavity is not on the hull
+    from localizer import load_part
+
+    part = load_part(PARTS / "trefoil.json")
+    t = np.linspace(0, part.n_knots, 9000, endpoint=False)
+    concave = float(part.arc_at_param(t[np.argmin(part.curvature(t))]))
+    rc = main(["simulate", str(PARTS / "trefoil.json"), "--start", f"{concave:.3f}", "--roll", "10", "--noise", "none",
+               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    err = capsys.readouterr().err
+    assert rc == 2 and ("convex hull" in err or "bridged" in err)
+
+
+def test_locate_bad_trace(tmp_path, capsys):
+    bad = tmp_path / "bad.npz"
+    np.savez(bad, x=np.zeros(3))
+    rc = main(["locate", str(bad), "--part", str(PARTS / "cam.json")])
+    assert rc == 2 and "not a rolltouch trace" in capsys.readouterr().err
+    with pytest.raises(RigError, match="no such file"):
+        Trace.load(tmp_path / "missing.npz")
