@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -244,8 +245,9 @@ class RollResult:
         at the working force, measured by :func:`edge_offset`); see below.
     step : float, rad
         The signed rotation of each step.
-    readings : tuple of (Δv1 V, Δv2 V, φ rad)
-        The reading behind each contact location, with the arm's angle.
+    readings : tuple of (Δv1 V, Δv2 V, φ rad, time s, x mm, y mm, φ commanded rad)
+        The reading behind each contact location, with the arm's reading of φ,
+        the time and the commanded hand pose.
     truth : tuple of (contact arc mm, jaw position mm)
         Ground truth at each reading (NaN on a real rig).
 
@@ -286,11 +288,18 @@ def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 
     return here / slope
 
 
-def _location(rig, baseline, calibration, n, readings=None, truth=None):
+def _clock(rig) -> float:
+    """The rig's clock (s): a simulated rig's own time, else the process's monotonic clock."""
+    t = getattr(rig, "time", None)
+    return float(t) if isinstance(t, (int, float)) else time.monotonic()
+
+
+def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=None):
     """Contact location on the jaw (mm) from one averaged reading; logs the reading."""
     dv1, dv2 = _delta(rig, baseline, n)
     if readings is not None:
-        readings.append((dv1, dv2, rig.pose()[2]))
+        x, y, phi_cmd = hand.pose if hand is not None else (math.nan,) * 3
+        readings.append((dv1, dv2, rig.pose()[2], _clock(rig), x, y, phi_cmd))
         t = rig.truth() if hasattr(rig, "truth") else {}
         truth.append((t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
     if dv1 <= 0.1 * calibration.target:
@@ -322,13 +331,13 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
     if offset is None:
         offset = edge_offset(rig, hand, baseline)
     readings, truth = [], []
-    d = [_location(rig, baseline, calibration, n, readings, truth)]
+    d = [_location(rig, baseline, calibration, n, readings, truth, hand)]
     phis = [rig.pose()[2]]
     for j in range(k):
         hand.rotate_by(angle / k)
         press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
         try:
-            d.append(_location(rig, baseline, calibration, n, readings, truth))
+            d.append(_location(rig, baseline, calibration, n, readings, truth, hand))
         except RigError:
             if bridge_jump is not None and j > 0:  # left the calibrated span in one jump
                 hand.press_by(-5.0)

@@ -1,9 +1,10 @@
 """Traces: what a rolling run read, saved as ``.npz`` arrays plus JSON metadata (never pickled).
 
 One row per contact-location reading (before each roll and after each of its
-steps): roll index, step index, Δv1 and Δv2 (V, relative to the zero
-reading), the arm's angle φ (rad), and on a simulated rig the ground truth:
-the contact's arc position on the part (mm) and its location on the jaw (mm).
+steps): roll and step index, time (s), the commanded hand pose (x, y mm,
+φ rad), the arm's reading of φ (rad), Δv1 and Δv2 (V, relative to the zero
+reading), and on a simulated rig the ground truth: the contact's arc position
+on the part (mm) and its location on the jaw (mm).
 The metadata holds the calibration, the rolls' step angles and edge offsets,
 the estimates (L, Ω) of the run, and how the run was made (part, engine,
 noise model, seed, start).
@@ -24,7 +25,7 @@ from .rig import RigError
 
 __all__ = ["Trace", "COLUMNS", "FORMAT"]
 
-COLUMNS = ("roll", "step", "dv1", "dv2", "phi", "true_arc", "true_jaw_position")
+COLUMNS = ("roll", "step", "time", "x", "y", "phi_command", "phi", "dv1", "dv2", "true_arc", "true_jaw_position")
 FORMAT = "rolltouch-trace/1"
 
 
@@ -48,8 +49,8 @@ class Trace:
         """Collect the readings of a :class:`RollingRun` with ``metadata`` about how it was made."""
         rows = []
         for k, r in enumerate(run.rolls):
-            for j, ((dv1, dv2, phi), (arc, jaw)) in enumerate(zip(r.readings, r.truth)):
-                rows.append((k, j, dv1, dv2, phi, arc, jaw))
+            for j, ((dv1, dv2, phi, tm, x, y, phi_cmd), (arc, jaw)) in enumerate(zip(r.readings, r.truth)):
+                rows.append((k, j, tm, x, y, phi_cmd, phi, dv1, dv2, arc, jaw))
         arr = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
         columns = {name: arr[:, i] for i, name in enumerate(COLUMNS)}
         columns["roll"] = columns["roll"].astype(np.int64)
