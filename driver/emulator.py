@@ -1,0 +1,246 @@
+"""A device emulator: the arm controller and the DAQ of docs/protocol.md, backed by a simulated rig.
+
+Serves both devices on loopback TCP (arm on PORT, DAQ on PORT+1) or on two
+pseudo-terminals, one thread per device, with injectable faults.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import socket
+import threading
+import tty
+from dataclasses import dataclass
+
+import numpy as np
+
+from .protocol import ARM_COMMANDS, DAQ_COMMANDS, MAX_LINE, encode_reply, parse_request
+
+__all__ = ["Faults", "Emulator"]
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Faults the emulator injects (all off by default).
+
+    Attributes
+    ----------
+    drop : float
+        Probability that a reply is not sent.
+    garble : float
+        Probability that a reply is corrupted (one byte changed).
+    delay : float, s
+        Added before every reply.
+    disconnect_after : int or None
+        Close both devices when the arm receives command N+1.
+    saturate : float or None, V
+        The DAQ's channels clip at ±this value.
+    """
+
+    drop: float = 0.0
+    garble: float = 0.0
+    delay: float = 0.0
+    disconnect_after: int | None = None
+    saturate: float | None = None
+
+    @classmethod
+    def parse(cls, specs) -> "Faults":
+        """From strings ``name=value`` (``drop``, ``garble``, ``delay``, ``disconnect-after``, ``saturate``)."""
+        kwargs = {}
+        names = {"drop": float, "garble": float, "delay": float, "disconnect-after": int, "saturate": float}
+        for spec in specs or ():
+            name, _, value = str(spec).partition("=")
+            if name not in names or not value:
+                raise ValueError(f"fault {spec!r}: use NAME=VALUE with NAME one of {sorted(names)}")
+            try:
+                kwargs[name.replace("-", "_")] = names[name](value)
+            except ValueError:
+                raise ValueError(f"fault {spec!r}: {value!r} is not a {names[name].__name__}") from None
+        return cls(**kwargs)
+
+
+class Emulator:
+    """The two devices over one simulated rig.
+
+    Parameters
+    ----------
+    rig : sim2d.SimRig
+        The simulated rig the commands act on.
+    start_pose : (x, y, φ) or None
+        Where the hand starts (mm, mm, rad): the operator's jog position.
+    faults : Faults
+    seed : int
+        Seeds the fault injection.
+    """
+
+    def __init__(self, rig, *, start_pose=None, faults: Faults = Faults(), seed: int = 0):
+        self.rig = rig
+        self.faults = faults
+        self.rng = np.random.default_rng(seed)
+        self.lock = threading.Lock()
+        self.arm_commands = 0
+        self.stopped = threading.Event()
+        self.zero = (0.0, 0.0)
+        self._closers = []
+        if start_pose is not None:
+            rig.move(*start_pose)
+
+    # ------------------------------------------------------------ devices
+    def _arm(self, seq, cmd, args):
+        if cmd == "MOVE":
+            x, y, phi_deg = args
+            self.rig.move(x, y, math.radians(phi_deg))
+            return [encode_reply(seq, "OK")]
+        if cmd == "POSE":
+            x, y, phi = self.rig.pose()
+            return [encode_reply(seq, "OK", float(x), float(y), float(math.degrees(phi)))]
+        if cmd == "STOP":
+            return [encode_reply(seq, "OK")]
+        return [encode_reply(seq, "OK", "READY")]
+
+    def _sample(self, n):
+        v1, v2 = self.rig.read(n)
+        v1, v2 = v1 - self.zero[0], v2 - self.zero[1]
+        s = self.faults.saturate
+        if s is not None:
+            v1, v2 = float(np.clip(v1, -s, s)), float(np.clip(v2, -s, s))
+        return float(v1), float(v2)
+
+    def _daq(self, seq, cmd, args):
+        if cmd == "READ":
+            n = int(args[0])
+            if not 1 <= n <= 10000:
+                return [encode_reply(seq, "ERR", "BADARG", "READ n must be in 1..10000")]
+            return [encode_reply(seq, "OK", *self._sample(n))]
+        if cmd == "STREAM":
+            n = int(args[0])
+            if not 1 <= n <= 10000:
+                return [encode_reply(seq, "ERR", "BADARG", "STREAM n must be in 1..10000")]
+            return [encode_reply(seq, "DATA", *self._sample(1)) for _ in range(n)] + [encode_reply(seq, "OK")]
+        if cmd == "ZERO":
+            self.zero = self.rig.read(256)
+            return [encode_reply(seq, "OK")]
+        return [encode_reply(seq, "OK", "READY")]
+
+    def handle(self, device: str, line: bytes) -> list:
+        """Replies to one request line of ``device`` ("arm" or "daq")."""
+        commands = ARM_COMMANDS if device == "arm" else DAQ_COMMANDS
+        try:
+            seq, cmd, args = parse_request(line, commands)
+        except (ValueError, UnicodeDecodeError) as exc:
+            words = line.split()
+            seq = int(words[0]) if words and words[0].isdigit() else 0
+            code, _, msg = str(exc).partition(" ")
+            return [encode_reply(seq, "ERR", code if code.isupper() else "BADCMD", msg.replace("\n", " ")[:120])]
+        with self.lock:
+            if device == "arm":
+                self.arm_commands += 1
+                if self.faults.disconnect_after is not None and self.arm_commands > self.faults.disconnect_after:
+                    self.close()
+                    return []
+                return self._arm(seq, cmd, args)
+            return self._daq(seq, cmd, args)
+
+    def _faulty(self, replies):
+        out = []
+        for r in replies:
+            if self.faults.drop and self.rng.random() < self.faults.drop:
+                continue
+            if self.faults.garble and self.rng.random() < self.faults.garble:
+                b = bytearray(r)
+                i = int(self.rng.integers(0, max(1, len(b) - 1)))
+                b[i] = (b[i] + 1 + int(self.rng.integers(0, 90))) % 95 + 32
+                r = bytes(b)
+            out.append(r)
+        return out
+
+    def _serve(self, device, read, write):
+        buf = b""
+        while not self.stopped.is_set():
+            try:
+                chunk = read()
+            except OSError:
+                return
+            if not chunk:
+                return
+            buf += chunk
+            while b"\n" in buf:
+                line, buf = buf.split(b"\n", 1)
+                if len(line) > MAX_LINE:
+                    continue
+                replies = self._faulty(self.handle(device, line))
+                if self.stopped.is_set():
+                    return
+                if self.faults.delay:
+                    self.stopped.wait(self.faults.delay)
+                try:
+                    for r in replies:
+                        write(r)
+                except OSError:
+                    return
+            if len(buf) > 4 * MAX_LINE:
+                buf = b""
+
+    # ---------------------------------------------------------- transports
+    def serve_tcp(self, port: int, host: str = "127.0.0.1"):
+        """Listen on host:port (arm) and host:port+1 (DAQ); returns the two URLs.
+
+        ``port=0`` lets the system pick two free ports (for tests).
+        """
+        urls = []
+        for device, p in (("arm", port), ("daq", port + 1 if port else 0)):
+            srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            srv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            srv.bind((host, p))
+            srv.listen(4)
+            srv.settimeout(0.2)
+            self._closers.append(srv.close)
+            threading.Thread(target=self._accept, args=(device, srv), daemon=True).start()
+            urls.append(f"socket://{host}:{srv.getsockname()[1]}")
+        return tuple(urls)
+
+    def _accept(self, device, srv):
+        while not self.stopped.is_set():
+            try:
+                conn, _ = srv.accept()
+            except socket.timeout:
+                continue
+            except OSError:
+                return
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            self._closers.append(conn.close)
+
+            def shutdown(c=conn):
+                try:
+                    c.shutdown(socket.SHUT_RDWR)
+                except OSError:
+                    pass
+            self._closers.append(shutdown)
+            threading.Thread(target=self._serve, args=(device, lambda c=conn: c.recv(4096), conn.sendall),
+                             daemon=True).start()
+
+    def serve_pty(self):
+        """Serve on two pseudo-terminals; returns their device paths (arm, DAQ)."""
+        paths = []
+        for device in ("arm", "daq"):
+            master, slave = os.openpty()
+            tty.setraw(master)
+            tty.setraw(slave)
+            self._closers.append(lambda m=master: os.close(m))
+            self._closers.append(lambda s=slave: os.close(s))
+            threading.Thread(target=self._serve, args=(device, lambda m=master: os.read(m, 4096),
+                                                       lambda data, m=master: os.write(m, data)),
+                             daemon=True).start()
+            paths.append(os.ttyname(slave))
+        return tuple(paths)
+
+    def close(self) -> None:
+        """Stop serving and close every connection (a pulled cable)."""
+        self.stopped.set()
+        for c in reversed(self._closers):
+            try:
+                c()
+            except OSError:
+                pass
+        self._closers.clear()

@@ -1,0 +1,193 @@
+"""``SerialRig``: the arm and the DAQ over pyserial URLs, speaking docs/protocol.md; satisfies ``Rig``.
+
+Every command has a deadline; a missing, garbled or stale reply is retried a
+bounded number of times, then the run stops with a :class:`RigError` saying
+what happened. Moves outside the workspace are refused before they are sent;
+a reading with Δv1 above the overload limit stops the run. :meth:`safe_stop`
+stops the arm and backs the jaw off the part; use the rig as a context
+manager to get it on any error.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import serial
+
+from .protocol import MAX_LINE, Reply, encode_request, parse_reply
+from .rig import RigError
+
+__all__ = ["SerialRig", "Workspace"]
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """Reachable hand poses: x, y in mm, φ in rad (a box; defaults are generous)."""
+
+    x: tuple = (-500.0, 500.0)
+    y: tuple = (-500.0, 500.0)
+    phi: tuple = (-4 * math.pi, 4 * math.pi)
+
+    def check(self, x, y, phi) -> None:
+        for name, v, (lo, hi) in (("x", x, self.x), ("y", y, self.y), ("phi", phi, self.phi)):
+            if not (math.isfinite(v) and lo <= v <= hi):
+                raise RigError(f"move refused: {name}={v!r} is outside the workspace [{lo}, {hi}]")
+
+
+class SerialRig:
+    """The real rig (or its emulator) over two pyserial URLs.
+
+    Parameters
+    ----------
+    arm_url, daq_url : str
+        pyserial URLs: a device path (``/dev/ttyUSB0``), ``socket://host:port``,
+        ``loop://``.
+    timeout : float, s
+        Deadline of a reply (a MOVE gets ``timeout`` plus the move's duration at
+        ``move_speed``).
+    retries : int
+        Further tries of a command whose reply is missing or garbled.
+    overload : float, V
+        Largest raw v1 allowed; above it the run stops and the jaw backs off.
+    backoff : float, mm
+        How far :meth:`safe_stop` backs the jaw off along its normal.
+    workspace : Workspace
+    move_speed : float, mm/s
+        The arm's speed, for MOVE deadlines.
+    log : callable or None
+        Called with a dict for every command and reading (see :mod:`driver.runlog`).
+    """
+
+    def __init__(self, arm_url: str, daq_url: str, *, timeout: float = 2.0, retries: int = 2,
+                 overload: float = 2.0, backoff: float = 5.0, workspace: Workspace = Workspace(),
+                 move_speed: float = 20.0, log=None, baudrate: int = 115200):
+        self.timeout = float(timeout)
+        self.retries = int(retries)
+        self.overload = float(overload)
+        self.backoff = float(backoff)
+        self.workspace = workspace
+        self.move_speed = float(move_speed)
+        self.log = log
+        self._seq = 0
+        self._commanded = None
+        self.ports = {}
+        try:
+            for name, url in (("arm", arm_url), ("daq", daq_url)):
+                self.ports[name] = serial.serial_for_url(url, timeout=self.timeout, write_timeout=self.timeout,
+                                                         baudrate=baudrate)
+        except (serial.SerialException, ValueError) as exc:
+            self.close()
+            raise RigError(f"cannot open the {name} at {url}: {exc}") from None
+
+    # ------------------------------------------------------------ transport
+    def _readline(self, port, deadline):
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            return b""
+        port.timeout = remaining
+        return port.read_until(b"\n", MAX_LINE + 1)
+
+    def _transact(self, device: str, command: str, *args, timeout: float | None = None) -> Reply:
+        port = self.ports[device]
+        timeout = self.timeout if timeout is None else timeout
+        problem = "no reply"
+        for attempt in range(self.retries + 1):
+            self._seq = (self._seq + 1) % 65536
+            seq = self._seq
+            try:
+                port.write(encode_request(seq, command, *args))
+                port.flush()
+                deadline = time.monotonic() + timeout
+                while True:
+                    line = self._readline(port, deadline)
+                    if not line:
+                        problem = f"no reply within {timeout:.1f} s"
+                        break
+                    if not line.endswith(b"\n"):
+                        problem = f"a partial reply {line[:40]!r} (timeout or line too long)"
+                        break
+                    try:
+                        reply = parse_reply(line)
+                    except RigError as exc:
+                        problem = str(exc)
+                        break
+                    if reply.seq != seq:
+                        continue  # a late reply to an earlier try: skip it
+                    if reply.status == "ERR":
+                        raise RigError(f"the {device} refused {command}: {reply.error}")
+                    if reply.status == "DATA":
+                        continue
+                    return reply
+            except serial.SerialException as exc:
+                raise RigError(f"the {device} connection failed during {command}: {exc}") from None
+            except OSError as exc:
+                raise RigError(f"the {device} connection failed during {command}: {exc}") from None
+            self._emit({"event": "retry", "device": device, "command": command, "try": attempt + 1,
+                        "problem": problem})
+        raise RigError(f"the {device} did not answer {command} after {self.retries + 1} tries: {problem}")
+
+    def _emit(self, event: dict) -> None:
+        if self.log is not None:
+            self.log(dict(event, time=time.time()))
+
+    # ------------------------------------------------------------------ Rig
+    def move(self, x: float, y: float, phi: float) -> None:
+        """MOVE to (x, y) mm, φ rad; returns when the arm reports arrival."""
+        self.workspace.check(x, y, phi)
+        distance = 0.0 if self._commanded is None else math.hypot(x - self._commanded[0], y - self._commanded[1])
+        self._transact("arm", "MOVE", float(x), float(y), math.degrees(phi),
+                       timeout=self.timeout + distance / self.move_speed)
+        self._commanded = (float(x), float(y), float(phi))
+
+    def pose(self) -> tuple:
+        """POSE: the arm's (x mm, y mm, φ rad)."""
+        x, y, phi_deg = self._transact("arm", "POSE").numbers(3)
+        return x, y, math.radians(phi_deg)
+
+    def read(self, n: int = 32) -> tuple:
+        """READ n: averaged (v1, v2) in volts; stops the run above the overload limit."""
+        v1, v2 = self._transact("daq", "READ", int(n)).numbers(2)
+        self._emit({"event": "sample", "v1": v1, "v2": v2, "n": int(n)})
+        if v1 > self.overload:
+            self.safe_stop()
+            raise RigError(f"v1 = {v1:.3f} V is above the overload limit {self.overload} V: stopped and backed off")
+        return v1, v2
+
+    # --------------------------------------------------------------- safety
+    def stop(self) -> None:
+        """STOP the arm."""
+        self._transact("arm", "STOP")
+
+    def safe_stop(self) -> None:
+        """Best effort: stop the arm and back the jaw ``backoff`` mm off the part. Never raises."""
+        for action in (self.stop, self._back_off):
+            try:
+                action()
+            except (RigError, OSError, serial.SerialException):
+                pass
+        self._emit({"event": "safe_stop"})
+
+    def _back_off(self):
+        if self._commanded is None:
+            return
+        x, y, phi = self._commanded
+        d = self.backoff
+        self.move(x + d * math.sin(phi), y - d * math.cos(phi), phi)
+
+    def close(self) -> None:
+        for port in self.ports.values():
+            try:
+                port.close()
+            except (OSError, serial.SerialException):
+                pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is not None:
+            self.safe_stop()
+        self.close()
+        return False
