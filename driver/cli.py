@@ -85,6 +85,45 @@ def build_parser() -> argparse.ArgumentParser:
     lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
     lct.add_argument("--json", action="store_true", help="print the result as JSON")
     lct.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
+    emu = sub.add_parser("emulate", help="serve the arm and DAQ protocols, backed by a simulated rig",
+                         description="Emulate the arm controller and the DAQ of docs/protocol.md on "
+                                     "loopback TCP (arm on PORT, DAQ on PORT+1) or on two pseudo-terminals, "
+                                     "until killed.")
+    emu.add_argument("part", help="part file")
+    emu.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
+    emu.add_argument("--start", type=float, metavar="MM",
+                     help="the hand starts with the jaw's centre facing this arc position, 1 mm off "
+                          "(default: the part's most curved point)")
+    emu.add_argument("--noise", default="paper", metavar="none|paper|FILE.toml", help="noise model (default paper)")
+    emu.add_argument("--engine", choices=("pymunk", "kinematic"), default="kinematic",
+                     help="the simulated world (default kinematic)")
+    emu.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    emu.add_argument("--fault", action="append", default=[], metavar="NAME=VALUE",
+                     help="inject a fault: drop=P, garble=P, delay=S, disconnect-after=N, saturate=V; repeatable")
+
+    cal = sub.add_parser("calibrate", help="calibrate the wrist sensor on a rig (paper §III-B)",
+                         description="With the jaw's centre facing an immobilized object, clear of it: tap it "
+                                     "at 11 jaw positions from -50 to 50 mm and save the ratio spline.")
+    cal.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
+    cal.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
+    cal.add_argument("--out", required=True, metavar="CAL.json", help="calibration file to write")
+    cal.add_argument("--timeout", type=_positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
+
+    run = sub.add_parser("run", help="roll on a rig and localize",
+                         description="From the present pose (the jaw's centre facing the start point, clear "
+                                     "of the part): calibrate if no calibration is given, slide 40 mm, "
+                                     "establish contact, roll, localize.")
+    run.add_argument("part", help="part file")
+    run.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
+    run.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
+    run.add_argument("--calibration", metavar="CAL.json", help="calibration from 'rolltouch calibrate'")
+    run.add_argument("--roll", type=float, action="append", metavar="DEG",
+                     help="a roll's rotation in degrees; repeat (default 20 then 15)")
+    run.add_argument("--step", type=_positive, default=0.2, metavar="DEG", help="rolling step (default 0.2°)")
+    run.add_argument("--log", metavar="FILE.jsonl", help="run log, JSON Lines, flushed per sample")
+    run.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses and the estimate")
+    run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
+    run.add_argument("--timeout", type=_positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
     return parser
 
 
@@ -237,6 +276,112 @@ def _localize(args) -> int:
     return 0
 
 
+def _emulate(args) -> int:
+    import signal
+    import threading
+
+    from driver.emulator import Emulator, Faults
+    from sim2d import SimRig
+
+    part = load_part(args.part)
+    try:
+        faults = Faults.parse(args.fault)
+    except ValueError as exc:
+        raise RigError(str(exc)) from None
+    rig = SimRig(part, noise=args.noise, seed=args.seed, engine=args.engine)
+    if args.start is None:
+        t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
+        start = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+    else:
+        start = float(args.start) % part.perimeter
+    emulator = Emulator(rig, start_pose=rig.approach_pose(start, jaw_position=0.0, standoff=1.0),
+                        faults=faults, seed=args.seed)
+    if args.tcp is not None:
+        arm, daq = emulator.serve_tcp(args.tcp)
+    else:
+        arm, daq = emulator.serve_pty()
+    print(f"arm {arm}", flush=True)
+    print(f"daq {daq}", flush=True)
+    done = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: done.set())
+    try:
+        while not done.wait(0.5) and not emulator.stopped.is_set():
+            pass
+    except KeyboardInterrupt:
+        pass
+    emulator.close()
+    return 0
+
+
+def _calibrate(args) -> int:
+    from driver.procedures import calibrate
+    from driver.serial_rig import SerialRig
+
+    with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
+        calibration = calibrate(rig, rig.pose())
+    calibration.save(args.out)
+    print(f"calibration written to {args.out}: ratio {calibration.ratios[0]:.5f} at -50 mm to "
+          f"{calibration.ratios[-1]:.5f} at +50 mm")
+    return 0
+
+
+def _progress(event) -> None:
+    if event.get("event") == "reading":
+        sys.stderr.write(f"\rroll {event['roll'] + 1}  step {event['step']:>4}/{event['steps']}  "
+                         f"Δv1 {event['dv1']:.3f} V  contact {event['jaw_position']:+7.2f} mm ")
+        sys.stderr.flush()
+
+
+def _run(args) -> int:
+    from driver.procedures import Calibration, run_from_here
+    from driver.runlog import RunLog
+    from driver.serial_rig import SerialRig
+    from driver.trace import Trace
+
+    part = load_part(args.part)
+    rolls = args.roll or [20.0, 15.0]
+    calibration = Calibration.load(args.calibration) if args.calibration else None
+    header = {"part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+              "arm": args.arm, "daq": args.daq, "rolls_deg": rolls, "step_deg": args.step}
+    if calibration is not None:
+        header["calibration"] = {"positions": list(calibration.positions), "ratios": list(calibration.ratios),
+                                 "target": calibration.target}
+    log = RunLog(args.log, header) if args.log else None
+
+    def observer(event):
+        if log is not None:
+            log(event)
+        _progress(event)
+
+    try:
+        with SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+            run, calibration = run_from_here(rig, part, [math.radians(r) for r in rolls], calibration=calibration,
+                                             step=math.radians(args.step), observer=observer)
+        sys.stderr.write("\n")
+    except BaseException as exc:
+        sys.stderr.write("\n")
+        if log is not None:
+            log({"event": "error", "message": str(exc) or type(exc).__name__})
+            log.close()
+        raise
+    trace = Trace.from_run(run, calibration, part=header["part"], arm=args.arm, daq=args.daq,
+                           rolls_deg=rolls, step_deg=args.step, engine="serial")
+    doc = _run_summary(part, trace, run.localization)
+    if log is not None:
+        log({"event": "result", **doc})
+        log.close()
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        _print_run(doc)
+    if args.plot:
+        from driver.plotting import plot_run
+
+        plot_run(part, trace, run.localization, args.plot)
+    return 0
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -247,9 +392,18 @@ def main(argv=None) -> int:
             return _simulate(args)
         if args.command == "locate":
             return _locate(args)
+        if args.command == "emulate":
+            return _emulate(args)
+        if args.command == "calibrate":
+            return _calibrate(args)
+        if args.command == "run":
+            return _run(args)
     except (LocalizerError, RigError, SimErrorBase) as exc:
         print(f"rolltouch: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("rolltouch: interrupted: the arm was stopped and the jaw backed off", file=sys.stderr)
+        return 130
     except BrokenPipeError:
         return 0
     parser.error(f"unknown command {args.command!r}")

@@ -82,6 +82,7 @@ class Emulator:
         self.arm_commands = 0
         self.stopped = threading.Event()
         self.zero = (0.0, 0.0)
+        self.input_range = 10.0  # V: the DAQ's input range, reported by STATUS
         self._closers = []
         if start_pose is not None:
             rig.move(*start_pose)
@@ -121,7 +122,7 @@ class Emulator:
         if cmd == "ZERO":
             self.zero = self.rig.read(256)
             return [encode_reply(seq, "OK")]
-        return [encode_reply(seq, "OK", "READY")]
+        return [encode_reply(seq, "OK", "READY", float(self.faults.saturate or self.input_range))]
 
     def handle(self, device: str, line: bytes) -> list:
         """Replies to one request line of ``device`` ("arm" or "daq")."""

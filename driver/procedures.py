@@ -309,7 +309,7 @@ def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=Non
 
 def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float, *,
          step: float = math.radians(0.2), n: int = 32, offset: float | None = None,
-         bridge_jump: float | None = 3.0, **press_options) -> RollResult:
+         bridge_jump: float | None = 3.0, observer=None, index: int = 0, **press_options) -> RollResult:
     """Roll by ``angle`` rad (positive: counter-clockwise) in steps of about ``step`` (paper §III-C).
 
     Each step rotates the jaw about the tool axis, then presses along the jaw
@@ -322,6 +322,11 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
     measures the part's convex hull, not the part, so a step whose contact
     moves more than ``bridge_jump`` mm on the jaw stops the roll with
     :class:`RigError` (None: no check).
+
+    ``observer``, if given, is called with a dict for the roll's start
+    (``event="roll"``) and for every contact-location reading
+    (``event="reading"``), as they happen (see :mod:`driver.runlog`); ``index``
+    numbers the roll in those events.
     """
     if not (math.isfinite(angle) and angle != 0):
         raise RigError(f"roll angle {angle!r} rad must be finite and nonzero")
@@ -331,7 +336,20 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
     if offset is None:
         offset = edge_offset(rig, hand, baseline)
     readings, truth = [], []
+    k_steps = k
+    if observer is not None:
+        observer({"event": "roll", "roll": index, "angle": angle, "step": angle / k_steps, "steps": k_steps,
+                  "offset": float(offset)})
+
+    def observe(j):
+        if observer is not None:
+            dv1, dv2, phi, tm, x, y, phi_cmd = readings[-1]
+            observer({"event": "reading", "roll": index, "step": j, "time": tm, "x": x, "y": y,
+                      "phi_command": phi_cmd, "phi": phi, "dv1": dv1, "dv2": dv2, "jaw_position": d[-1],
+                      "true_arc": truth[-1][0], "true_jaw_position": truth[-1][1], "steps": k_steps})
+
     d = [_location(rig, baseline, calibration, n, readings, truth, hand)]
+    observe(0)
     phis = [rig.pose()[2]]
     for j in range(k):
         hand.rotate_by(angle / k)
@@ -346,6 +364,7 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
                                "convex hull there; start where the rolls stay on convex stretches") from None
             raise
         phis.append(rig.pose()[2])
+        observe(j + 1)
         if bridge_jump is not None and abs(d[-1] - d[-2]) > bridge_jump:
             hand.press_by(-5.0)
             raise RigError(f"step {j + 1} of the roll bridged a concave stretch: the contact jumped "
@@ -393,7 +412,7 @@ class RollingRun:
 def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration, approach_pose,
                         step: float = math.radians(0.2), n: int = 32, bridge_jump: float = 3.0,
                         rule: str = "likelihood", sd_length: float = 0.5,
-                        sd_turn: float = math.radians(0.03), **press_options) -> RollingRun:
+                        sd_turn: float = math.radians(0.03), observer=None, **press_options) -> RollingRun:
     """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
 
     All rolls turn the same way. Rolls that bridge a concave stretch are
@@ -410,7 +429,7 @@ def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration
     for k, angle in enumerate(rolls):
         try:
             results.append(roll(rig, hand, baseline, calibration, angle, step=step, n=n,
-                                bridge_jump=bridge_jump, **press_options))
+                                bridge_jump=bridge_jump, observer=observer, index=k, **press_options))
         except RigError as exc:
             raise RigError(f"roll {k + 1}: {exc}") from None
     estimates = tuple((r.length, r.turn) for r in results)
@@ -418,3 +437,33 @@ def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration
     loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)
     return RollingRun(rolls=tuple(results), estimates=estimates, localization=loc,
                       samples=list(getattr(rig, "samples", [])))
+
+
+def run_from_here(rig: Rig, part: Part, rolls, *, calibration: Calibration | None = None,
+                  slide: float = 40.0, observer=None, **options):
+    """The whole job from the arm's present pose, as ``rolltouch run`` does it.
+
+    The operator has jogged the jaw's centre to face the start point on the
+    part, clear of it. Without a calibration the jaw first calibrates there
+    (the part's own start point as the immobilized object, §III-B). Then the
+    jaw slides ``slide`` mm along itself so that the contact starts near the
+    end it rolls away from, establishes contact, rolls and localizes.
+
+    Returns (RollingRun, Calibration).
+    """
+    rolls = [float(a) for a in rolls]
+    if not rolls:
+        raise RigError("rolls is empty: give at least one roll angle")
+    here = tuple(rig.pose())
+    if calibration is None:
+        calibration = calibrate(rig, here)
+        if observer is not None:
+            observer({"event": "calibration", "positions": list(calibration.positions),
+                      "ratios": list(calibration.ratios), "target": calibration.target})
+        Hand(rig, here)
+    x, y, phi = here
+    s = slide if rolls[0] > 0 else -slide
+    start = (x + s * math.cos(phi), y + s * math.sin(phi), phi)
+    run = localize_by_rolling(rig, part, rolls, calibration=calibration, approach_pose=start,
+                              observer=observer, **options)
+    return run, calibration

@@ -80,6 +80,15 @@ class SerialRig:
         except (serial.SerialException, ValueError) as exc:
             self.close()
             raise RigError(f"cannot open the {name} at {url}: {exc}") from None
+        # the DAQ reports its input range: readings at its ends are saturated
+        try:
+            status = self._transact("daq", "STATUS")
+            self.input_range = 10.0
+            if len(status.fields) >= 2:
+                self.input_range = float(Reply(status.seq, "OK", status.fields[1:]).numbers(1)[0])
+        except RigError:
+            self.close()
+            raise
 
     # ------------------------------------------------------------ transport
     def _readline(self, port, deadline):
@@ -150,6 +159,10 @@ class SerialRig:
         """READ n: averaged (v1, v2) in volts; stops the run above the overload limit."""
         v1, v2 = self._transact("daq", "READ", int(n)).numbers(2)
         self._emit({"event": "sample", "v1": v1, "v2": v2, "n": int(n)})
+        if max(abs(v1), abs(v2)) >= 0.999 * self.input_range:
+            self.safe_stop()
+            raise RigError(f"the sensor saturated (v1 = {v1:.3f} V, v2 = {v2:.3f} V at the DAQ's "
+                           f"±{self.input_range:g} V range): stopped and backed off")
         if v1 > self.overload:
             self.safe_stop()
             raise RigError(f"v1 = {v1:.3f} V is above the overload limit {self.overload} V: stopped and backed off")

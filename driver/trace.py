@@ -71,14 +71,50 @@ class Trace:
         np.savez(path, metadata=np.array(json.dumps(self.metadata)), **self.columns)
 
     @classmethod
+    def from_log(cls, path) -> "Trace":
+        """A trace from a run log (JSON Lines, :mod:`driver.runlog`), cut short or not.
+
+        Rolls that the log shows begun but without two readings are dropped.
+        """
+        from .runlog import read_log
+
+        events = read_log(path)
+        start = events[0]
+        rolls = {e["roll"]: e for e in events if e.get("event") == "roll"}
+        rows = [e for e in events if e.get("event") == "reading"]
+        counts = {}
+        for e in rows:
+            counts[e["roll"]] = counts.get(e["roll"], 0) + 1
+        keep = [k for k in sorted(rolls) if counts.get(k, 0) >= 2]
+        rows = [e for e in rows if e["roll"] in keep]
+        columns = {}
+        for name in COLUMNS:
+            vals = [e.get(name) for e in rows]
+            columns[name] = np.array([math.nan if v is None else v for v in vals], dtype=float)
+        columns["roll"] = columns["roll"].astype(np.int64)
+        columns["step"] = columns["step"].astype(np.int64)
+        meta = {k: v for k, v in start.items() if k not in ("event", "format", "time")}
+        cal = [e for e in events if e.get("event") == "calibration"]
+        if cal and "calibration" not in meta:
+            meta["calibration"] = {k: cal[0][k] for k in ("positions", "ratios", "target")}
+        meta.update({"format": FORMAT, "steps": [rolls[k]["step"] for k in keep],
+                     "offsets": [rolls[k]["offset"] for k in keep], "log": str(path),
+                     "complete": any(e.get("event") == "result" for e in events)})
+        if "calibration" not in meta:
+            raise RigError(f"run log {path}: its start event has no calibration")
+        return cls(columns, meta)
+
+    @classmethod
     def load(cls, path) -> "Trace":
-        """Read a trace written by :meth:`save`.
+        """Read a trace written by :meth:`save`, or a run log (``.jsonl``).
 
         Raises
         ------
         RigError
             Missing or unreadable file, not a rolltouch trace, missing columns.
         """
+        if str(path).endswith(".jsonl"):
+            return cls.from_log(path)
         try:
             with np.load(path, allow_pickle=False) as data:
                 meta = json.loads(str(data["metadata"]))

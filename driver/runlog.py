@@ -1,0 +1,103 @@
+"""The run log: JSON Lines, one event per line, flushed as it is written.
+
+A killed process leaves a readable log of everything read until then; a
+truncated last line is ignored when the log is read back. Events:
+
+``start``
+    ``format``, the calibration, and how the run was made (part, rolls, …).
+``roll``
+    a roll begins: ``roll`` index, ``angle``, ``step`` (rad), ``steps``, ``offset`` (mm).
+``reading``
+    a contact-location reading: ``roll``, ``step``, ``time``, ``x``, ``y``,
+    ``phi_command``, ``phi``, ``dv1``, ``dv2`` (and ``true_arc``,
+    ``true_jaw_position`` on a simulated rig).
+``sample``, ``retry``, ``safe_stop``
+    from the serial rig: every raw reading, every retried command, a safe stop.
+``result`` / ``error``
+    how the run ended.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+
+import numpy as np
+
+from .rig import RigError
+
+__all__ = ["RunLog", "read_log", "LOG_FORMAT"]
+
+LOG_FORMAT = "rolltouch-log/1"
+
+
+def _clean(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, (np.floating, np.integer)):
+        return _clean(value.item())
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    return value
+
+
+class RunLog:
+    """Append events to a JSON Lines file, flushing each one.
+
+    Parameters
+    ----------
+    path : str or Path
+    header : dict
+        Written as the ``start`` event (with ``format``).
+    """
+
+    def __init__(self, path, header: dict):
+        self.path = str(path)
+        try:
+            self._f = open(self.path, "w", encoding="utf-8")
+        except OSError as exc:
+            raise RigError(f"cannot write the run log {self.path}: {exc.strerror or exc}") from None
+        self({"event": "start", "format": LOG_FORMAT, **header})
+
+    def __call__(self, event: dict) -> None:
+        if self._f.closed:
+            return
+        event = dict(event)
+        event.setdefault("time", time.time())
+        self._f.write(json.dumps(_clean(event)) + "\n")
+        self._f.flush()
+
+    def close(self) -> None:
+        if not self._f.closed:
+            self._f.close()
+
+
+def read_log(path):
+    """The events of a run log, skipping a truncated last line.
+
+    Raises
+    ------
+    RigError
+        Unreadable file, no ``start`` event, a bad line other than the last.
+    """
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().split("\n")
+    except OSError as exc:
+        raise RigError(f"run log {path}: {exc.strerror or exc}") from None
+    events = []
+    for k, line in enumerate(lines):
+        if not line.strip():
+            continue
+        try:
+            events.append(json.loads(line))
+        except json.JSONDecodeError:
+            if k >= len(lines) - 2:  # the last line, cut off by a killed process
+                break
+            raise RigError(f"run log {path}: line {k + 1} is not JSON") from None
+    if not events or events[0].get("event") != "start" or events[0].get("format") != LOG_FORMAT:
+        raise RigError(f"run log {path}: not a rolltouch run log (no '{LOG_FORMAT}' start event)")
+    return events
