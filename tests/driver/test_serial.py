@@ -1,0 +1,224 @@
+"""The serial rig against the emulator over real I/O: equality with SimRig, faults, fuzzing."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from driver.emulator import Emulator, Faults
+from driver.procedures import run_from_here
+from driver.protocol import encode_reply, encode_request, parse_reply, parse_request, ARM_COMMANDS
+from driver.rig import RigError
+from driver.runlog import RunLog
+from driver.serial_rig import SerialRig, Workspace
+from driver.trace import Trace
+from localizer import load_part
+from sim2d import SimRig
+
+ROOT = Path(__file__).resolve().parents[2]
+PART = load_part(ROOT / "parts" / "trefoil.json")
+ROLLS = [math.radians(20), math.radians(15)]
+START = 120.0
+
+
+def sim(seed=3, noise="paper"):
+    rig = SimRig(PART, noise=noise, seed=seed)
+    rig.move(*rig.approach_pose(START, jaw_position=0.0, standoff=1.0))
+    return rig
+
+
+def emulator(faults=Faults(), seed=3, noise="paper"):
+    rig = SimRig(PART, noise=noise, seed=seed)
+    return Emulator(rig, start_pose=rig.approach_pose(START, jaw_position=0.0, standoff=1.0), faults=faults)
+
+
+@pytest.fixture(scope="module")
+def direct():
+    run, cal = run_from_here(sim(), PART, ROLLS)
+    return run
+
+
+@pytest.mark.parametrize("transport", ["tcp", "pty"])
+def test_same_seed_same_localization_over_real_io(direct, transport):
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0) if transport == "tcp" else emu.serve_pty()
+    try:
+        with SerialRig(arm, daq) as rig:
+            run, _ = run_from_here(rig, PART, ROLLS)
+    finally:
+        emu.close()
+    assert np.allclose(run.estimates, direct.estimates, rtol=0, atol=1e-9)
+    assert run.estimate_arc == pytest.approx(direct.estimate_arc, abs=1e-9)
+
+
+def run_with_log(tmp_path, faults, timeout=0.5, retries=2, **kw):
+    emu = emulator(faults)
+    arm, daq = emu.serve_tcp(0)
+    log = RunLog(tmp_path / "run.jsonl", {"part": {"name": PART.name}})
+    t0 = time.monotonic()
+    try:
+        with SerialRig(arm, daq, timeout=timeout, retries=retries, log=log) as rig:
+            run_from_here(rig, PART, ROLLS, observer=log, **kw)
+        outcome = None
+    except RigError as exc:
+        outcome = exc
+    finally:
+        log.close()
+        elapsed = time.monotonic() - t0
+    hand = emu.rig.world.hand
+    force = emu.rig.world.contact().force
+    emu.close()
+    events = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
+    return outcome, events, elapsed, hand, force
+
+
+def test_garbled_lines_are_retried(tmp_path):
+    outcome, events, _, _, _ = run_with_log(tmp_path, Faults(garble=0.02), retries=3)
+    assert outcome is None
+    assert any(e["event"] == "retry" and "garbled" in e["problem"] for e in events)
+
+
+def test_always_garbled_stops_with_a_clear_error(tmp_path):
+    outcome, events, elapsed, _, _ = run_with_log(tmp_path, Faults(garble=1.0))
+    assert isinstance(outcome, RigError)
+    assert "did not answer STATUS after 3 tries" in str(outcome) and "garbled" in str(outcome)
+    assert elapsed < 5
+
+
+def test_dropped_replies_time_out_and_stop(tmp_path):
+    outcome, events, elapsed, _, _ = run_with_log(tmp_path, Faults(drop=1.0), timeout=0.2)
+    assert isinstance(outcome, RigError) and "no reply within 0.2 s" in str(outcome)
+    assert elapsed < 5
+
+
+def test_slow_device(tmp_path):
+    outcome, _, elapsed, _, _ = run_with_log(tmp_path, Faults(delay=0.5), timeout=0.2, retries=1)
+    assert isinstance(outcome, RigError) and "no reply" in str(outcome)
+    assert elapsed < 10
+
+
+def test_disconnect_mid_roll_leaves_a_readable_log(tmp_path):
+    outcome, events, elapsed, _, _ = run_with_log(tmp_path, Faults(disconnect_after=200))
+    assert isinstance(outcome, RigError)
+    assert "connection failed" in str(outcome) or "no reply" in str(outcome)
+    readings = [e for e in events if e["event"] == "reading"]
+    samples = [e for e in events if e["event"] == "sample"]
+    assert readings and samples  # everything read before the fault is there
+    trace = Trace.from_log(tmp_path / "run.jsonl")
+    assert len(trace.columns["dv1"]) <= len(readings)
+    assert elapsed < 10
+
+
+def test_saturated_sensor_stops_and_backs_off(tmp_path):
+    outcome, events, _, hand, force = run_with_log(tmp_path, Faults(saturate=0.3))
+    assert isinstance(outcome, RigError) and "saturated" in str(outcome)
+    assert force == 0.0  # the jaw is off the part
+    assert any(e["event"] == "safe_stop" for e in events)
+
+
+def test_ctrl_c_backs_off_the_jaw(tmp_path):
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+
+    def interrupt(event):
+        if event.get("event") == "reading" and event["step"] == 10:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        with SerialRig(arm, daq) as rig:
+            run_from_here(rig, PART, ROLLS, observer=interrupt)
+    assert emu.rig.world.contact().force == 0.0
+    emu.close()
+
+
+def test_workspace_and_unreachable_device():
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    with SerialRig(arm, daq, workspace=Workspace(x=(-10.0, 10.0))) as rig:
+        with pytest.raises(RigError, match=r"x=50.0 is outside the workspace \[-10.0, 10.0\]"):
+            rig.move(50.0, 0.0, 0.0)
+    emu.close()
+    with pytest.raises(RigError, match="cannot open the arm"):
+        SerialRig("socket://127.0.0.1:1", "socket://127.0.0.1:1", timeout=0.2)
+
+
+def test_device_errors_are_reported():
+    emu = emulator()
+    reply = emu.handle("arm", b"7 FLY 1 2 3")
+    assert parse_reply(reply[0]).status == "ERR" and "unknown command 'FLY'" in parse_reply(reply[0]).error
+    reply = emu.handle("daq", b"8 READ 0")
+    assert "BADARG" in parse_reply(reply[0]).error
+    emu.close()
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.binary(max_size=300))
+def test_reply_parser_only_raises_rig_error(data):
+    try:
+        parse_reply(data)
+    except RigError:
+        pass
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 65535), st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), max_size=4))
+def test_replies_round_trip(seq, values):
+    r = parse_reply(encode_reply(seq, "OK", *values))
+    assert r.seq == seq and r.numbers(len(values)) == tuple(values)
+
+
+def test_requests_round_trip():
+    seq, cmd, args = parse_request(encode_request(12, "MOVE", 1.5, -2.25, 30.0), ARM_COMMANDS)
+    assert (seq, cmd, args) == (12, "MOVE", [1.5, -2.25, 30.0])
+
+
+def test_cli_emulate_and_run(tmp_path):
+    port = 47000 + os.getpid() % 1000
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    exe = [sys.executable, "-m", "driver.cli"]
+    emu = subprocess.Popen(exe + ["emulate", str(ROOT / "parts" / "trefoil.json"), "--tcp", str(port),
+                                  "--start", "120", "--seed", "3"], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert emu.stdout.readline().startswith("arm socket://127.0.0.1:")
+        emu.stdout.readline()
+        out = subprocess.run(exe + ["run", str(ROOT / "parts" / "trefoil.json"), "--arm",
+                                    f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}",
+                                    "--json", "--log", str(tmp_path / "r.jsonl")],
+                             capture_output=True, text=True, timeout=120, env=env)
+    finally:
+        emu.terminate()
+        emu.wait(10)
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    assert "estimate_arc" in doc and "candidates" in doc
+    loc = subprocess.run(exe + ["locate", str(tmp_path / "r.jsonl"), "--part", str(ROOT / "parts" / "trefoil.json"),
+                                "--json"], capture_output=True, text=True, timeout=60, env=env)
+    assert loc.returncode == 0 and json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"])
+
+
+def test_cli_run_fails_with_one_line_on_disconnect(tmp_path):
+    port = 48000 + os.getpid() % 1000
+    exe = [sys.executable, "-m", "driver.cli"]
+    emu = subprocess.Popen(exe + ["emulate", str(ROOT / "parts" / "trefoil.json"), "--tcp", str(port),
+                                  "--start", "120", "--fault", "disconnect-after=50"], stdout=subprocess.PIPE,
+                           text=True)
+    try:
+        emu.stdout.readline()
+        emu.stdout.readline()
+        out = subprocess.run(exe + ["run", str(ROOT / "parts" / "trefoil.json"), "--arm",
+                                    f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}",
+                                    "--timeout", "0.5"], capture_output=True, text=True, timeout=60)
+    finally:
+        emu.terminate()
+        emu.wait(10)
+    assert out.returncode != 0
+    last = [line for line in out.stderr.splitlines() if line.startswith("rolltouch:")]
+    assert len(last) == 1 and "error" in last[0]
