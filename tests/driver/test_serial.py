@@ -222,3 +222,30 @@ def test_cli_run_fails_with_one_line_on_disconnect(tmp_path):
     assert out.returncode != 0
     last = [line for line in out.stderr.splitlines() if line.startswith("rolltouch:")]
     assert len(last) == 1 and "error" in last[0]
+
+
+def test_overload_stops_before_the_wrist_is_overloaded(tmp_path):
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with pytest.raises(RigError, match="above the overload limit 0.3 V"):
+            with SerialRig(arm, daq, overload=0.3) as rig:
+                run_from_here(rig, PART, ROLLS)
+        assert emu.rig.world.contact().force == 0.0
+    finally:
+        emu.close()
+
+
+def test_cli_calibrate_over_the_emulator(tmp_path, capsys):
+    from driver.cli import main
+    from driver.procedures import Calibration
+
+    emu = emulator(noise="none")
+    arm, daq = emu.serve_tcp(0)
+    try:
+        assert main(["calibrate", "--arm", arm, "--daq", daq, "--out", str(tmp_path / "cal.json")]) == 0
+    finally:
+        emu.close()
+    cal = Calibration.load(tmp_path / "cal.json")
+    assert np.allclose(cal.ratios, [-d / (32 * 25.0) for d in cal.positions], atol=2e-4)
+    assert "calibration written" in capsys.readouterr().out
