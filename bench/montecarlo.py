@@ -1,0 +1,240 @@
+"""The Monte Carlo runner: trials in parallel, appended to ``trials.csv`` as they finish, resumable.
+
+Local processes by default; with a scheduler address the same trials run on
+a Dask distributed cluster through its ``concurrent.futures`` executor.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+from .study import TRIAL_COLUMNS, Study, StudyError, TrialSpec, run_trial
+
+__all__ = ["run_study", "read_trials", "summarize", "wilson"]
+
+
+def wilson(successes: int, n: int, z: float = 1.96):
+    """Wilson 95% interval of a success rate, (low, high)."""
+    if n == 0:
+        return (math.nan, math.nan)
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def read_trials(path) -> list:
+    """Rows of a trials.csv; a truncated last line (a killed run) is dropped."""
+    path = Path(path)
+    if not path.exists():
+        return []
+    with open(path, newline="") as f:
+        text = f.read()
+    lines = text.split("\n")
+    complete = text.endswith("\n")
+    if not complete:
+        lines = lines[:-1]
+    rows = []
+    reader = csv.DictReader(lines)
+    for r in reader:
+        if r is None or None in r.values() or len(r) != len(TRIAL_COLUMNS):
+            continue
+        rows.append(r)
+    return rows
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        return repr(v)
+    return "" if v is None else str(v)
+
+
+def run_study(study: Study, out, *, workers: int | None = None, scheduler: str | None = None,
+              resume: bool = False, progress: bool = True) -> dict:
+    """Run every (level, trial) of ``study`` not yet in ``out/trials.csv``; write the summary and plots.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Local worker processes (default: all cores); 1 runs in this process.
+    scheduler : str, optional
+        Address of a Dask distributed scheduler; trials then run on that cluster.
+    resume : bool
+        Keep the finished trials of ``out/trials.csv`` and run only the missing ones.
+        Without it an existing table is replaced.
+    """
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    table = out / "trials.csv"
+    (out / "study.json").write_text(json.dumps(study.as_dict(), indent=2) + "\n")
+    done = set()
+    if resume and table.exists():
+        rows = read_trials(table)
+        done = {(int(r["level"]), int(r["trial"])) for r in rows}
+        # rewrite without a truncated tail so that appending continues a clean file
+        with open(table, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=TRIAL_COLUMNS)
+            w.writeheader()
+            for r in rows:
+                w.writerow(r)
+    else:
+        with open(table, "w", newline="") as f:
+            csv.DictWriter(f, fieldnames=TRIAL_COLUMNS).writeheader()
+    specs = [TrialSpec(study, level, trial) for level in range(study.levels) for trial in range(study.trials)
+             if (level, trial) not in done]
+    total = study.levels * study.trials
+    finished = len(done)
+    successes = sum(int(r["success"]) for r in read_trials(table)) if done else 0
+    t0 = time.monotonic()
+
+    def record(row, f, writer):
+        nonlocal finished, successes
+        writer.writerow({k: _fmt(row.get(k)) for k in TRIAL_COLUMNS})
+        f.flush()
+        finished += 1
+        successes += int(row["success"])
+        if progress:
+            rate = (finished - len(done)) / max(time.monotonic() - t0, 1e-9)
+            bar = "#" * int(30 * finished / total)
+            sys.stderr.write(f"\r[{bar:<30}] {finished}/{total} trials  {rate:.2f}/s  "
+                             f"success {successes / max(finished, 1):.1%} ")
+            sys.stderr.flush()
+
+    with open(table, "a", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=TRIAL_COLUMNS)
+        if not specs:
+            pass
+        elif scheduler:
+            try:
+                from distributed import Client
+            except ImportError:
+                raise StudyError("--scheduler needs dask.distributed: pip install 'rolltouch[dask]'") from None
+            with Client(scheduler) as client:
+                executor = client.get_executor(pure=False)
+                futures = [executor.submit(run_trial, s) for s in specs]
+                for fut in as_completed(futures):
+                    record(fut.result(), f, writer)
+        elif (workers or os.cpu_count() or 1) == 1:
+            for s in specs:
+                record(run_trial(s), f, writer)
+        else:
+            with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+                futures = [pool.submit(run_trial, s) for s in specs]
+                for fut in as_completed(futures):
+                    record(fut.result(), f, writer)
+    if progress:
+        sys.stderr.write("\n")
+    summary = summarize(study, read_trials(table))
+    summary["wall_s"] = time.monotonic() - t0
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    plot_study(study, read_trials(table), out)
+    return summary
+
+
+def summarize(study: Study, rows) -> dict:
+    """Success rate per level with its 95% interval, error quantiles, failures."""
+    levels = []
+    for level in range(study.levels):
+        sel = [r for r in rows if int(r["level"]) == level]
+        n = len(sel)
+        ok = sum(int(r["success"]) for r in sel)
+        err = np.array([float(r["error_mm"]) for r in sel]) if sel else np.array([])
+        levels.append({
+            "level": level, "parameter": study.parameter, "value": study.level_value(level), "trials": n,
+            "success": ok, "success_rate": ok / n if n else None, "ci95": list(wilson(ok, n)),
+            "error_median_mm": float(np.median(err)) if n else None,
+            "error_p90_mm": float(np.quantile(err, 0.9)) if n else None,
+            "ambiguous": sum(int(r["ambiguous"]) for r in sel),
+            "broken": sum(bool(r["failure"]) for r in sel),
+            "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,
+        })
+    return {"study": study.name, "method": study.method, "engine": study.engine, "noise": study.noise,
+            "success_radius": study.success_radius, "levels": levels}
+
+
+def plot_study(study: Study, rows, out: Path) -> None:
+    """success.png (rate against the swept value), errors.png, failures.png (where on the parts)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from localizer import load_part
+
+    summ = summarize(study, rows)["levels"]
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    x = [lv["value"] if lv["value"] is not None else k for k, lv in enumerate(summ)]
+    rate = np.array([lv["success_rate"] if lv["success_rate"] is not None else np.nan for lv in summ])
+    lo = np.array([lv["ci95"][0] for lv in summ])
+    hi = np.array([lv["ci95"][1] for lv in summ])
+    ax.errorbar(x, rate, yerr=[rate - lo, hi - rate], fmt="o-", capsize=4, label=f"{study.name} ({study.method} rule)")
+    ax.axhline(0.45, color="tab:red", lw=1, ls="--", label="the paper's rig: about 45%")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel(study.parameter or "level")
+    ax.set_ylabel(f"success rate (error < {study.success_radius} mm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "success.png", dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    bins = np.logspace(-4, 3, 36)
+    for lv in range(study.levels):
+        e = np.array([float(r["error_mm"]) for r in rows if int(r["level"]) == lv])
+        e = np.clip(e[np.isfinite(e)], 1e-4, 1e3)
+        if e.size:
+            label = f"{study.parameter}={study.level_value(lv):g}" if study.parameter else "all trials"
+            ax.hist(e, bins=bins, histtype="step", lw=1.5, label=label)
+    ax.axvline(study.success_radius, color="tab:red", lw=1, ls="--", label=f"{study.success_radius} mm")
+    ax.set_xscale("log")
+    ax.set_xlabel("arc error of the final contact (mm)")
+    ax.set_ylabel("trials")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "errors.png", dpi=110)
+    plt.close(fig)
+
+    names = sorted({r["part"] for r in rows})
+    if names:
+        fig, axes = plt.subplots(1, len(names), figsize=(4.3 * len(names), 4.4), squeeze=False)
+        by_name = {Path(p).name: p for p in study.parts}
+        for ax, name in zip(axes[0], names):
+            part = load_part(by_name[name])
+            xy = part.sample(16)
+            ax.plot(xy[:, 0], xy[:, 1], color="0.6", lw=1)
+            sel = [r for r in rows if r["part"] == name and r["true_arc"] not in ("", "nan")]
+            for ok, colour, label in ((1, "tab:green", "success"), (0, "tab:red", "failure")):
+                arcs = np.array([float(r["true_arc"]) for r in sel if int(r["success"]) == ok])
+                arcs = arcs[np.isfinite(arcs)]
+                if arcs.size:
+                    p = part.point_at_arc(arcs)
+                    ax.plot(p[:, 0], p[:, 1], "o", ms=3, color=colour, alpha=0.6, label=f"{label} ({arcs.size})")
+            ax.set_title(f"{name}: final true contacts", fontsize=9)
+            ax.set_aspect("equal")
+            ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(out / "failures.png", dpi=110)
+        plt.close(fig)
+
+
+def print_summary(summary: dict) -> None:
+    print(f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
+          f"noise {Path(str(summary['noise'])).name}")
+    for lv in summary["levels"]:
+        v = "" if lv["value"] is None else f"{lv['parameter']} = {lv['value']:g}: "
+        rate = lv["success_rate"]
+        print(f"  {v}{lv['success']}/{lv['trials']} within {summary['success_radius']} mm = "
+              f"{rate:.1%} (95% CI {lv['ci95'][0]:.1%}–{lv['ci95'][1]:.1%}), median error "
+              f"{lv['error_median_mm']:.3f} mm" if rate is not None else f"  {v}no trials")
