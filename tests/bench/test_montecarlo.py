@@ -1,7 +1,6 @@
 """The Monte Carlo runner: reproducibility, resume, Dask, bad study files."""
 
 import json
-import os
 import signal
 import subprocess
 import sys
