@@ -2,6 +2,7 @@
 
 from ._errors import LocalizerError, PartError, QueryError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
+from ._passivity import PassivityController, PassivityStep
 from ._rolling import arc_from_jaw_positions
 from ._march import MarchGrid, MarchResult, march, march_grid
 from ._disambiguate import RULES, Candidate, Localization, localize
@@ -10,4 +11,5 @@ from ._solver import DIRECTIONS, METHODS, Segment, feasible_segments
 __all__ = ["LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
            "Segment", "feasible_segments", "METHODS", "DIRECTIONS",
            "Candidate", "Localization", "localize", "RULES",
-           "march", "march_grid", "MarchResult", "MarchGrid", "arc_from_jaw_positions"]
+           "march", "march_grid", "MarchResult", "MarchGrid", "arc_from_jaw_positions",
+           "PassivityController", "PassivityStep"]
