@@ -104,18 +104,15 @@ def build_parser() -> argparse.ArgumentParser:
     cal = sub.add_parser("calibrate", help="calibrate the wrist sensor on a rig (paper §III-B)",
                          description="With the jaw's centre facing an immobilized object, clear of it: tap it "
                                      "at 11 jaw positions from -50 to 50 mm and save the ratio spline.")
-    cal.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
-    cal.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
+    _rig_arguments(cal)
     cal.add_argument("--out", required=True, metavar="CAL.json", help="calibration file to write")
-    cal.add_argument("--timeout", type=_positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
 
     run = sub.add_parser("run", help="roll on a rig and localize",
                          description="From the present pose (the jaw's centre facing the start point, clear "
                                      "of the part): calibrate if no calibration is given, slide 40 mm, "
                                      "establish contact, roll, localize.")
     run.add_argument("part", help="part file")
-    run.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
-    run.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
+    _rig_arguments(run)
     run.add_argument("--calibration", metavar="CAL.json", help="calibration from 'rolltouch calibrate'")
     run.add_argument("--roll", type=float, action="append", metavar="DEG",
                      help="a roll's rotation in degrees; repeat (default 20 then 15)")
@@ -123,8 +120,14 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--log", metavar="FILE.jsonl", help="run log, JSON Lines, flushed per sample")
     run.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses and the estimate")
     run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
-    run.add_argument("--timeout", type=_positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
     return parser
+
+
+def _rig_arguments(p) -> None:
+    """--arm, --daq and --timeout of the commands that talk to a rig."""
+    p.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
+    p.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
+    p.add_argument("--timeout", type=_positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
 
 
 def _run_summary(part, trace, loc) -> dict:
@@ -143,6 +146,23 @@ def _run_summary(part, trace, loc) -> dict:
         doc["true_arc"] = true_arc
         doc["error_mm"] = None if estimate is None else abs(float(part.arc_offset(estimate, true_arc)))
     return doc
+
+
+def _emit_run(args, doc, part, trace, loc) -> None:
+    """Print a run's result (JSON or text) and draw it if asked: simulate, locate and run alike."""
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        _print_run(doc)
+        if "trace" in doc:
+            print(f"trace written to {doc['trace']}")
+    if args.plot:
+        from driver.plotting import plot_run
+
+        plot_run(part, trace, loc, args.plot)
+        if not args.json:
+            print(f"plot written to {args.plot}")
 
 
 def _print_run(doc) -> None:
@@ -190,18 +210,7 @@ def _simulate(args) -> int:
     trace.save(args.out)
     doc = _run_summary(part, trace, run.localization)
     doc["trace"] = str(args.out)
-    if args.json:
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    else:
-        _print_run(doc)
-        print(f"trace written to {args.out}")
-    if args.plot:
-        from driver.plotting import plot_run
-
-        plot_run(part, trace, run.localization, args.plot)
-        if not args.json:
-            print(f"plot written to {args.plot}")
+    _emit_run(args, doc, part, trace, run.localization)
     return 0
 
 
@@ -213,18 +222,7 @@ def _locate(args) -> int:
     estimates = trace.estimates()
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"
     loc = localize(part, estimates, rule=args.rule, direction=direction)
-    doc = _run_summary(part, trace, loc)
-    if args.json:
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    else:
-        _print_run(doc)
-    if args.plot:
-        from driver.plotting import plot_run
-
-        plot_run(part, trace, loc, args.plot)
-        if not args.json:
-            print(f"plot written to {args.plot}")
+    _emit_run(args, _run_summary(part, trace, loc), part, trace, loc)
     return 0
 
 
@@ -370,15 +368,7 @@ def _run(args) -> int:
     if log is not None:
         log({"event": "result", **doc})
         log.close()
-    if args.json:
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    else:
-        _print_run(doc)
-    if args.plot:
-        from driver.plotting import plot_run
-
-        plot_run(part, trace, run.localization, args.plot)
+    _emit_run(args, doc, part, trace, run.localization)
     return 0
 
 

@@ -7,6 +7,20 @@ import numpy as np
 __all__ = ["plot_localization", "plot_run"]
 
 
+def _finish(fig, ax, path) -> None:
+    """Equal axes in mm, legend, grid; write the PNG and close the figure."""
+    import matplotlib.pyplot as plt
+
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.legend(loc="best", fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def _arc_points(part, start, length, sign, n=80):
     s = start + sign * np.linspace(0.0, length, n)
     return part.point_at_arc(s)
@@ -57,14 +71,7 @@ def plot_localization(part, result, path, *, title: str | None = None):
     verdict = "ambiguous" if result.ambiguous else "localized"
     rolls = ", ".join(f"({L:.2f} mm, {np.degrees(w):.2f}°)" for L, w in result.rolls)
     ax.set_title(title or f"{part.name}: {verdict} from rolls {rolls}\nrule: {result.rule}", fontsize=9)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.legend(loc="best", fontsize=7)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _finish(fig, ax, path)
 
 
 def plot_run(part, trace, result, path, *, half_span: float = 50.0):
@@ -117,11 +124,4 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
         err = abs(float(part.arc_offset(result.best.end_arc, cols["true_arc"][-1])))
         title += f"\nerror {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)"
     ax.set_title(title, fontsize=9)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.legend(loc="best", fontsize=7)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _finish(fig, ax, path)
