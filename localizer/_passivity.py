@@ -20,6 +20,24 @@ options here, each separately switchable:
     force is held instead (it does no work at v = 0, so E is unchanged).
 ``force_limit``
     Bound on |α·v| (N); energy the bound leaves undissipated stays in E.
+
+Two bookings of the port energy (``booking``):
+
+``"assumed"`` (default; the running form of Hannaford & Ryu 2002)
+    E(n) = E(n-1) + ΔT·[f(n)·v(n) + α(n-1)·v(n-1)²]: the force and velocity of
+    the same sample are paired, and the controller's dissipation is assumed to
+    have happened as computed.
+``"observed"`` (a sampled port with a zero-order hold)
+    E(n) = E(n-1) + ΔT·f_out(n-1)·v(n). The output f_out(n-1) = f(n-1) + control
+    is held over the interval (t_(n-1), t_n] and v(n), differenced from the
+    encoder, is the motion over that same interval, so this is the energy that
+    actually crossed the port, the controller's own force included: its
+    dissipation is observed, not assumed. A sampled stiff spring f = K·x(n) is
+    passive under "assumed" (Σ K·x(n)·Δx(n) ≥ 0 for any sequence) and active
+    under "observed" (Σ K·x(n-1)·Δx(n) = ΔU − K·ΣΔx²/2), which is the real
+    behaviour of a sampled wall (Colgate). Under "observed" a control force that
+    meets a velocity sign change does produce energy, and a controller that
+    cannot act while v = 0 leaves E negative: the two cases Ryu et al. name.
 """
 
 from __future__ import annotations
@@ -63,6 +81,8 @@ class PassivityController:
         The two fixes of Ryu et al. (see module notes).
     force_limit : float or None, N
         Bound on the control force.
+    booking : {"assumed", "observed"}
+        How the port energy is booked (see module notes).
 
     Examples
     --------
@@ -74,11 +94,14 @@ class PassivityController:
     """
 
     def __init__(self, dt: float, *, sign_fix: bool = False, hold_fix: bool = False,
-                 force_limit: float | None = None):
+                 force_limit: float | None = None, booking: str = "assumed"):
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt={dt!r} s must be a positive number")
         if force_limit is not None and not force_limit > 0:
             raise ValueError(f"force_limit={force_limit!r} N must be positive or None")
+        if booking not in ("assumed", "observed"):
+            raise ValueError(f"booking={booking!r}: use 'assumed' or 'observed'")
+        self.booking = booking
         self.dt = float(dt)
         self.sign_fix = bool(sign_fix)
         self.hold_fix = bool(hold_fix)
@@ -92,6 +115,7 @@ class PassivityController:
         self._prev_alpha = 0.0
         self._last_sign = 0.0
         self._held = 0.0
+        self._prev_out = 0.0
 
     def update(self, f: float, v: float) -> PassivityStep:
         """One sample: observe f·v at the port, then damp what was produced.
@@ -103,10 +127,16 @@ class PassivityController:
         v : float, m/s
             Port velocity.
         """
+        if not (math.isfinite(f) and math.isfinite(v)):
+            raise ValueError(f"f={f!r} N and v={v!r} m/s must be finite")
         dt = self.dt
-        # the previous sample's dissipation, now booked
-        self.energy += dt * self._prev_alpha * self._prev_v ** 2
-        step = dt * f * v
+        if self.booking == "assumed":
+            # the previous sample's dissipation, now booked
+            self.energy += dt * self._prev_alpha * self._prev_v ** 2
+            step = dt * f * v
+        else:
+            # the output held over the last interval, against the motion over it
+            step = dt * self._prev_out * v
         sign = math.copysign(1.0, v) if v != 0 else 0.0
         flipped = sign != 0 and self._last_sign != 0 and sign != self._last_sign
         if not (self.sign_fix and flipped and step < 0):
@@ -125,5 +155,6 @@ class PassivityController:
         elif v != 0:
             self._held = control
         self._prev_alpha, self._prev_v = alpha, v
+        self._prev_out = f + control
         return PassivityStep(force=f + control, control=control, alpha=alpha,
                              energy=self.energy + dt * alpha * v * v)

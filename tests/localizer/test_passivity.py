@@ -81,3 +81,52 @@ def test_bad_parameters():
         PassivityController(0)
     with pytest.raises(ValueError, match="force_limit=-1"):
         PassivityController(DT, force_limit=-1)
+
+
+def test_observed_booking_pairs_the_held_output_with_the_next_motion():
+    pc = PassivityController(DT, booking="observed")
+    s0 = pc.update(2.0, 0.01)              # nothing was held before: books 0
+    assert s0.energy == 0.0 and s0.control == 0.0
+    s1 = pc.update(5.0, 0.02)              # 2 N held while moving 0.02 m/s
+    assert pc.energy == pytest.approx(DT * 2.0 * 0.02)
+    s2 = pc.update(0.0, -0.01)             # 5 N held, moving back: produces 5e-5 J
+    e = DT * (2.0 * 0.02 - 5.0 * 0.01)
+    assert pc.energy == pytest.approx(e) and e < 0
+    assert s2.control == pytest.approx(-e / (DT * -0.01))   # α·v with α = -E/(ΔT v²)
+    assert s2.energy == pytest.approx(0.0, abs=1e-18)
+    # the control force is part of the held output: its work is observed, not assumed
+    pc.update(0.0, -0.01)
+    assert pc.energy == pytest.approx(e + DT * s2.control * -0.01)
+    assert s1.control == 0.0
+
+
+def test_a_sampled_spring_is_passive_when_assumed_and_active_when_observed():
+    k, q = 20000.0, 1e-5                   # N/m, m: a stiff wall dithering one count
+    xs = [0, q, 0, q, 0, q, 0]
+    assumed = PassivityController(DT)
+    observed = PassivityController(DT, booking="observed")
+    for a, b in zip(xs, xs[1:]):
+        v = (b - a) / DT
+        assumed.update(k * b, v)
+        observed.update(k * b, v)
+    assert assumed.energy > 0
+    assert observed.energy < 0 < assumed.energy
+
+
+def test_observed_sign_change_of_a_held_control_force_is_what_the_sign_fix_drops():
+    seq = [(0.0, 0.01), (3.0, 0.01), (0.0, -0.01)]    # hold 3 N, then reverse under it
+    plain = PassivityController(DT, booking="observed")
+    fixed = PassivityController(DT, booking="observed", sign_fix=True)
+    a = [plain.update(f, v) for f, v in seq]
+    b = [fixed.update(f, v) for f, v in seq]
+    assert a[:2] == b[:2]
+    # reversing under the held 3 N produces 3e-5 J: the plain PC answers it with 3 N
+    assert a[2].control == pytest.approx(-3.0)
+    assert b[2].control == 0.0 and b[2].energy == pytest.approx(b[1].energy)
+
+
+def test_bad_booking_and_non_finite_samples():
+    with pytest.raises(ValueError, match="booking='zoh'"):
+        PassivityController(DT, booking="zoh")
+    with pytest.raises(ValueError, match="v=nan"):
+        PassivityController(DT).update(1.0, float("nan"))
