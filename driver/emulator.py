@@ -98,6 +98,18 @@ class Emulator:
             return [encode_reply(seq, "OK", float(x), float(y), float(math.degrees(phi)))]
         if cmd == "STOP":
             return [encode_reply(seq, "OK")]
+        if cmd == "SERVO":
+            target, gain, guard, ms = args
+            if not (target > 0 and gain >= 0 and guard in (0, 1) and 1 <= ms <= 10000):
+                return [encode_reply(seq, "ERR", "BADARG", "SERVO target>0 gain>=0 guard 0|1 ms 1..10000")]
+            if not hasattr(self.rig, "servo"):
+                return [encode_reply(seq, "ERR", "UNSUPPORTED", "this arm has no force servo")]
+            try:
+                r = self.rig.servo(float(target), float(gain), guard=bool(guard), duration=ms / 1000.0)
+            except Exception as exc:  # the arm refuses, it does not crash
+                return [encode_reply(seq, "ERR", "FAULT", str(exc).replace(" ", "_")[:80])]
+            return [encode_reply(seq, "OK", r["dv1"], r["dv1_std"], float(r["contact_lost"]),
+                                 r["min_energy"])]
         return [encode_reply(seq, "OK", "READY")]
 
     def _sample(self, n):

@@ -25,7 +25,7 @@ from localizer import Localization, Part, arc_from_jaw_positions, localize
 
 from .rig import Rig, RigError
 
-__all__ = ["Calibration", "Hand", "RollResult", "RollingRun", "zero", "press", "establish_contact",
+__all__ = ["hold_force", "Calibration", "Hand", "RollResult", "RollingRun", "zero", "press", "establish_contact",
            "calibrate", "edge_offset", "roll", "localize_by_rolling"]
 
 
@@ -119,6 +119,43 @@ def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0
         prev = (move, dv1)
         dv1, dv2 = _delta(rig, baseline, n)
     raise RigError(f"Δv1 did not settle at {target} ± {tol} V in {max_steps} moves (last {dv1:.3f} V)")
+
+
+def hold_force(rig: Rig, *, target: float = 0.4, gain: float = 2.0, guard: bool = True,
+               duration: float = 0.5, max_std: float | None = None) -> dict:
+    """Hold Δv1 = ``target`` V with the arm's own sampled force servo, optionally passivity-guarded.
+
+    The paper's feedback (translate along the normal until Δv1 ≈ 0.4 V) as a
+    1 kHz loop in the arm's controller rather than move-and-read steps from the
+    host. On a stiff contact a high ``gain`` makes the bare loop ring or lose
+    the part; ``guard`` puts the passivity observer/controller with both
+    low-velocity fixes on the loop's port (docs/passivity.md).
+
+    Parameters
+    ----------
+    target : float, V
+    gain : float
+        Force-error gain of the servo (N/N).
+    guard : bool
+    duration : float, s
+    max_std : float or None, V
+        Raise RigError when the held Δv1's standard deviation exceeds this (a ringing loop).
+
+    Returns
+    -------
+    dict
+        The rig's report: ``dv1``, ``dv1_std``, ``contact_lost``, ``min_energy``, ``guard``.
+    """
+    servo = getattr(rig, "servo", None)
+    if servo is None:
+        raise RigError(f"{type(rig).__name__} has no force servo; use press() (move-and-read)")
+    report = servo(target, gain, guard=guard, duration=duration)
+    if report["contact_lost"] > 0:
+        raise RigError(f"the force servo lost the part for {report['contact_lost']} samples at gain {gain:g} "
+                       f"(guard {'on' if guard else 'off'}); lower the gain or switch the guard on")
+    if max_std is not None and report["dv1_std"] > max_std:
+        raise RigError(f"the force servo rings: Δv1 std {report['dv1_std']:.4f} V > {max_std} V at gain {gain:g}")
+    return report
 
 
 def establish_contact(rig: Rig, approach_pose, *, baseline=None, target: float = 0.4, **press_options):

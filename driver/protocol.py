@@ -18,7 +18,7 @@ __all__ = ["Reply", "encode_request", "encode_reply", "parse_reply", "parse_requ
            "ARM_COMMANDS", "DAQ_COMMANDS", "MAX_LINE"]
 
 #: Commands of each device and their argument counts.
-ARM_COMMANDS = {"MOVE": 3, "POSE": 0, "STOP": 0, "STATUS": 0}
+ARM_COMMANDS = {"MOVE": 3, "POSE": 0, "STOP": 0, "STATUS": 0, "SERVO": 4}
 DAQ_COMMANDS = {"READ": 1, "STREAM": 1, "ZERO": 0, "STATUS": 0}
 #: Longest line either side sends, bytes (a longer one is garbage).
 MAX_LINE = 256

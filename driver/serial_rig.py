@@ -168,6 +168,19 @@ class SerialRig:
             raise RigError(f"v1 = {v1:.3f} V is above the overload limit {self.overload} V: stopped and backed off")
         return v1, v2
 
+    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5) -> dict:
+        """SERVO: the arm holds Δv1 = ``target`` V with its own 1 kHz force loop for ``duration`` s.
+
+        ``guard`` switches on the controller's passivity observer/controller on
+        the loop's port. Returns the same dict as :meth:`sim2d.SimRig.servo`.
+        """
+        ms = int(round(duration * 1000))
+        dv1, std, lost, energy = self._transact("arm", "SERVO", float(target), float(gain), int(bool(guard)), ms,
+                                                timeout=self.timeout + duration).numbers(4)
+        result = {"dv1": dv1, "dv1_std": std, "contact_lost": int(lost), "min_energy": energy, "guard": bool(guard)}
+        self._emit(dict(result, event="servo", target=float(target), gain=float(gain)))
+        return result
+
     # --------------------------------------------------------------- safety
     def stop(self) -> None:
         """STOP the arm."""

@@ -109,6 +109,68 @@ class SimRig:
         })
         return out
 
+    # ------------------------------------------------ Rig: force servo
+    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5,
+              seed: int | None = None) -> dict:
+        """Hold the contact force with the arm's 1 kHz servo along the jaw normal.
+
+        The arm pushes with the target force plus ``gain`` times the force
+        error read by the wrist (:class:`sim2d.haptic.Servo`, an axis of 0.1 kg
+        and 5 N·s/m on the wrist's stiffness), for ``duration`` s, starting from
+        the present press. With ``guard`` a passivity observer/controller with
+        both low-velocity fixes sits on the correction's port
+        (:mod:`localizer._passivity`, "observed" booking). The hand ends where
+        the servo left it.
+
+        Parameters
+        ----------
+        target : float, V
+            Δv1 to hold (the paper's 0.4 V).
+        gain : float
+            Force-error gain (N/N). Above about 8 the bare loop rings; above
+            about 15 it loses the part every cycle.
+        guard : bool
+        duration : float, s
+
+        Returns
+        -------
+        dict
+            ``dv1`` (mean of the last half, V), ``dv1_std`` (V), ``contact_lost`` (samples of the
+            last half with no contact), ``min_energy`` (J), ``guard``.
+        """
+        from localizer import PassivityController
+
+        from .haptic import Axis, Servo, simulate_servo
+
+        if not (math.isfinite(target) and target > 0):
+            raise SimError(f"servo target={target!r} V must be positive")
+        hand = self.world.hand
+        if hand is None:
+            raise SimError("servo: the hand has not been placed; move it first")
+        c = self.world.contact()
+        if c.force <= 0:
+            raise SimError("servo: the jaw is not touching the part; press into contact first")
+        vpn = self.wrist.volts_per_newton
+        stiffness = float(getattr(self.world, "stiffness", 1.0))  # N/mm
+        start = c.force / stiffness * 1e-3                          # m of press
+        axis = Axis(damping=5.0)
+        spec = Servo(target=target / vpn, gain=gain, contact_stiffness=stiffness * 1e3, start=start,
+                     sensor_noise=self.noise.v1_noise / vpn, sensor_resolution=self.noise.adc_step / vpn,
+                     duration=duration)
+        pc = PassivityController(axis.dt, sign_fix=True, hold_fix=True, booking="observed") if guard else None
+        if seed is None:
+            seed = int(self.rng.integers(2 ** 31))
+        tr = simulate_servo(spec, pc, axis=axis, seed=seed)
+        moved = (tr.position[-1] - start) * 1e3                  # mm further along the normal
+        x, y, phi = hand
+        self.world.set_hand(x - moved * math.sin(phi), y + moved * math.cos(phi), phi)
+        self.time += duration
+        tail = tr.time >= duration / 2
+        force = tr.contact_force[tail]
+        return {"dv1": float(force.mean() * vpn), "dv1_std": float(force.std() * vpn),
+                "contact_lost": int((force == 0).sum()), "min_energy": float(tr.energy.min()),
+                "guard": bool(guard)}
+
     def truth(self) -> dict:
         """Ground truth of the present contact (simulation only)."""
         c = self.world.contact()
