@@ -5,7 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench march-report clean
+.PHONY: demo test bench march-report passivity-report clean
 
 $(STAMP): pyproject.toml
 	@test -x $(PY) || { command -v $(PYTHON) >/dev/null 2>&1 || { echo "$(PYTHON) not found; run: make PYTHON=/path/to/python3.11"; exit 1; }; $(PYTHON) -m venv $(VENV); }
@@ -24,6 +24,9 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m pytest bench --benchmark-only --benchmark-json=out/bench.json
+
+passivity-report: $(STAMP)
+	$(PY) -m bench.passivity --out docs/passivity
 
 march-report: $(STAMP)
 	$(PY) -m bench.march_study --out docs/march
