@@ -74,6 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk)")
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     sim.add_argument("--step", type=_positive, default=0.2, metavar="DEG", help="rolling step, degrees (default 0.2)")
+    _servo_arguments(sim)
     sim.add_argument("--out", required=True, metavar="TRACE.npz", help="trace file to write")
     sim.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
     sim.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -117,6 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--roll", type=float, action="append", metavar="DEG",
                      help="a roll's rotation in degrees; repeat (default 20 then 15)")
     run.add_argument("--step", type=_positive, default=0.2, metavar="DEG", help="rolling step (default 0.2°)")
+    _servo_arguments(run)
     run.add_argument("--log", metavar="FILE.jsonl", help="run log, JSON Lines, flushed per sample")
     run.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses and the estimate")
     run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
@@ -128,6 +130,23 @@ def _rig_arguments(p) -> None:
     p.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
     p.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
     p.add_argument("--timeout", type=_positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
+
+
+def _servo_arguments(p) -> None:
+    """--servo-gain and --no-guard: hold the force with the arm's servo after every press."""
+    p.add_argument("--servo-gain", type=_positive, metavar="G",
+                   help="after every press, hold Δv1 with the arm's 1 kHz force servo at this gain (N/N) "
+                        "for 0.3 s, refusing a loop that loses the part or rings above 0.05 V (docs/passivity.md); default: no servo")
+    p.add_argument("--no-guard", action="store_true",
+                   help="run that servo without its passivity observer/controller")
+
+
+def _servo_option(args) -> dict:
+    if args.servo_gain is None:
+        if args.no_guard:
+            raise RigError("--no-guard needs --servo-gain: without the servo there is nothing to guard")
+        return {}
+    return {"servo": {"gain": args.servo_gain, "guard": not args.no_guard, "duration": 0.3, "max_std": 0.05}}
 
 
 def _run_summary(part, trace, loc) -> dict:
@@ -198,7 +217,8 @@ def _simulate(args) -> int:
     rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine)
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
     run = localize_by_rolling(rig, part, rolls, calibration=calibration, step=math.radians(args.step),
-                              approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0))
+                              approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0),
+                              **_servo_option(args))
     first = run.rolls[0].truth[0][0]
     if math.isfinite(first) and abs(float(part.arc_offset(first, args.start))) > 1.0:
         raise RigError(f"--start {args.start} mm is not on the part's convex hull: a straight jaw laid there "
@@ -354,7 +374,8 @@ def _run(args) -> int:
     try:
         with SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
             run, calibration = run_from_here(rig, part, [math.radians(r) for r in rolls], calibration=calibration,
-                                             step=math.radians(args.step), observer=observer)
+                                             step=math.radians(args.step), observer=observer,
+                                             **_servo_option(args))
         sys.stderr.write("\n")
     except BaseException as exc:
         sys.stderr.write("\n")

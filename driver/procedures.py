@@ -75,7 +75,7 @@ def _delta(rig: Rig, baseline, n: int):
 
 def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0.01, n: int = 32,
           slope: float = 0.4, search_step: float = 0.25, max_travel: float = 15.0,
-          overload: float = 2.0, max_steps: int = 60) -> tuple:
+          overload: float = 2.0, max_steps: int = 60, servo: dict | None = None) -> tuple:
     """Translate along the jaw normal until Δv1 = ``target`` ± ``tol`` V (the paper's feedback).
 
     Parameters
@@ -88,6 +88,9 @@ def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0
         Give up (RigError) after pressing this far without contact.
     overload : float, V
         Δv1 above this backs the jaw off and stops the run (wrist protection).
+    servo : dict or None
+        When given, the arm's own force servo then holds the target:
+        ``hold_force(rig, target=target, **servo)``, e.g. ``{"gain": 20, "guard": True}``.
 
     Returns
     -------
@@ -109,6 +112,9 @@ def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0
             hand.press_by(-max_travel)
             raise RigError(f"Δv1 = {dv1:.3f} V exceeds the overload limit {overload} V: backed off")
         if abs(dv1 - target) <= tol:
+            if servo is not None:
+                hold_force(rig, target=target, **servo)
+                dv1, dv2 = _delta(rig, baseline, n)
             return dv1, dv2
         if prev is not None and abs(dv1 - prev[1]) > 4 * tol and prev[0] != 0:
             slope = max((dv1 - prev[1]) / prev[0], 0.05 * slope)

@@ -1,5 +1,6 @@
 """The arm's force servo with and without the passivity guard, on the simulated and the serial rig."""
 
+import json
 from pathlib import Path
 
 import pytest
@@ -83,3 +84,15 @@ def test_serial_servo_rejects_bad_arguments():
                 serial_rig.servo(0.4, -1.0)
     finally:
         emu.close()
+
+
+def test_simulate_with_an_aggressive_servo_needs_the_guard(tmp_path, capsys):
+    from driver.cli import main
+
+    args = ["simulate", str(ROOT / "parts" / "trefoil.json"), "--start", "120", "--roll", "20", "--roll", "15",
+            "--engine", "kinematic", "--servo-gain", "20", "--out", str(tmp_path / "t.npz"), "--json"]
+    assert main(args + ["--no-guard"]) == 2
+    assert "lost the part" in capsys.readouterr().err
+    assert main(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["error_mm"] < 0.3
