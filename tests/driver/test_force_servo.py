@@ -96,3 +96,26 @@ def test_simulate_with_an_aggressive_servo_needs_the_guard(tmp_path, capsys):
     assert main(args) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["error_mm"] < 0.3
+
+
+def test_a_serial_run_holds_every_press_with_the_guarded_servo(tmp_path):
+    import math
+
+    from driver.procedures import run_from_here
+    from driver.runlog import RunLog
+
+    rig = SimRig(PART, noise="paper", seed=3)
+    emu = Emulator(rig, start_pose=rig.approach_pose(120.0, jaw_position=0.0, standoff=1.0))
+    arm, daq = emu.serve_tcp(0)
+    log = RunLog(tmp_path / "run.jsonl", {})
+    try:
+        with SerialRig(arm, daq, log=log) as serial_rig:
+            run, _ = run_from_here(serial_rig, PART, [math.radians(10)], observer=log,
+                                   servo={"gain": 20.0, "guard": True, "duration": 0.3, "max_std": 0.05})
+    finally:
+        emu.close()
+        log.close()
+    events = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
+    servos = [e for e in events if e.get("event") == "servo"]
+    assert len(servos) > 50 and all(e["contact_lost"] == 0 and e["guard"] for e in servos)
+    assert run.localization.best is not None
