@@ -1,0 +1,195 @@
+"""Reactive localization: roll step by step, update the belief at every step, stop when sure.
+
+Jia (2005, §V) names "reactive localization which conducts sensing and movement
+simultaneously" as the way forward. :func:`localize_reactively` does it with
+:class:`localizer.ContactFilter`:
+
+1. establish contact and measure the wrist's give (the edge offset);
+2. rotate one step, press back to the force, read the contact's location on the
+   jaw; turn the step's jaw travel into signed arc (second-order inversion)
+   and give the filter the cumulative arc and the arm's measured net rotation;
+3. every ``check_every`` steps: stop when the probability within the success
+   radius reaches ``confidence``; otherwise pick the rolling direction whose
+   next ``lookahead`` of rotation spreads the hypotheses' predicted arc the most
+   (for two modes: whose curvature difference between them is larger);
+4. a step that jumps along the jaw has bridged a concavity: it is undone (the
+   jaw rolls back one step), its reading is dropped, and the direction flips;
+5. stop at ``max_rotation`` of total rolling, sure or not.
+
+Works on any :class:`driver.rig.Rig` (simulated or serial).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from localizer import Belief, ContactFilter, Part, arc_from_jaw_positions
+
+from .procedures import Calibration, _location, edge_offset, establish_contact, press
+from .rig import Rig, RigError
+
+__all__ = ["ReactiveRun", "localize_reactively", "spread_by_direction"]
+
+
+@dataclass(frozen=True)
+class ReactiveRun:
+    """Result of :func:`localize_reactively`.
+
+    Attributes
+    ----------
+    belief : Belief
+        The final belief over the present contact.
+    rotation : float, rad
+        Total rotation rolled (both directions counted).
+    steps : int
+        Rolling steps that updated the filter.
+    stopped : str
+        "confident", "max_rotation".
+    reversals : int
+        Direction changes (chosen or forced by a bridge).
+    history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
+        The belief at every check, with the truth where the rig knows it.
+    arcs, turns : tuple of float
+        The cumulative signed arc (mm) and net rotation (rad) given to the filter.
+    true_arcs : tuple of float
+        The true contact (mm) at the same readings (NaN on a real rig).
+    """
+
+    belief: Belief
+    rotation: float
+    steps: int
+    stopped: str
+    reversals: int
+    history: tuple = field(repr=False, default=())
+    arcs: tuple = field(repr=False, default=())
+    turns: tuple = field(repr=False, default=())
+    true_arcs: tuple = field(repr=False, default=())
+
+    @property
+    def estimate_arc(self) -> float:
+        return self.belief.map_arc
+
+
+def spread_by_direction(flt: ContactFilter, lookahead: float, samples: int = 64) -> tuple:
+    """(spread ccw, spread cw) in mm: how far apart the probable hypotheses' predicted arcs move
+    over the next ``lookahead`` rad of rotation each way (weighted standard deviation).
+
+    Hypotheses that would have to bridge a concavity that way count as not moving apart.
+    """
+    w = flt.posterior()
+    top = np.argsort(w)[-samples:]
+    wt = w[top] / w[top].sum()
+    out = []
+    for sign in (1.0, -1.0):
+        ahead, ok = flt.tracks.advance(top, flt.turn + sign * lookahead)
+        moved = np.where(ok, ahead - flt.current[top], 0.0)
+        mean = np.sum(wt * moved)
+        out.append(float(np.sqrt(np.sum(wt * (moved - mean) ** 2))))
+    return tuple(out)
+
+
+def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, approach_pose,
+                        filter: ContactFilter | None = None, step: float = math.radians(0.2), n: int = 32,
+                        confidence: float = 0.95, max_rotation: float = math.radians(90.0),
+                        direction: int = 1, check_every: int = 5, lookahead: float = math.radians(10.0),
+                        bridge_jump: float = 3.0, end_margin: float = 5.0, observer=None,
+                        **press_options) -> ReactiveRun:
+    """Roll until the contact is known within the filter's radius with ``confidence`` (module notes).
+
+    Parameters
+    ----------
+    filter : ContactFilter, optional
+        The belief to update (reset first); default: ``ContactFilter(part)``.
+    step : float, rad
+        Rolling step (paper: 0.2°).
+    confidence : float
+        Probability within the success radius that stops the rolling.
+    max_rotation : float, rad
+        Total rotation budget, both directions counted.
+    direction : {1, -1}
+        First rolling direction (counter-clockwise is 1).
+    check_every : int
+        Steps between checks of the stopping and direction rules.
+    lookahead : float, rad
+        Rotation over which the direction rule compares the two ways.
+    bridge_jump : float, mm
+        A step whose contact moves more than this on the jaw has bridged a concavity.
+    end_margin : float, mm
+        The contact is kept this far inside the calibrated span of the jaw.
+    observer : callable, optional
+        Called with ``{"event": "belief", ...}`` at every check.
+    """
+    if not (math.isfinite(step) and step > 0):
+        raise RigError(f"step={step!r} rad must be positive")
+    if not (math.isfinite(max_rotation) and max_rotation > 0):
+        raise RigError(f"max_rotation={max_rotation!r} rad must be positive")
+    if direction not in (1, -1):
+        raise RigError(f"direction={direction!r}: use 1 (counter-clockwise) or -1")
+    if not 0 < confidence < 1:
+        raise RigError(f"confidence={confidence!r} must be in (0, 1)")
+    flt = filter if filter is not None else ContactFilter(part)
+    flt.reset()
+    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
+    offset = edge_offset(rig, hand, baseline)
+    jaw_limit = float(np.max(np.abs(calibration.positions))) - end_margin
+    readings, truth = [], []
+    d_prev = _location(rig, baseline, calibration, n, readings, truth, hand)
+    phi0 = rig.pose()[2]
+    z, rotation, steps, reversals = 0.0, 0.0, 0, 0
+    arcs, turns, history = [0.0], [0.0], []
+    true_arcs = [truth[-1][0] if truth else math.nan]
+    stopped = "max_rotation"
+    belief = None
+    while rotation < max_rotation - 1e-12:
+        s = direction * step
+        hand.rotate_by(s)
+        press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+        rotation += step
+        try:
+            d = _location(rig, baseline, calibration, n, readings, truth, hand)
+        except RigError:
+            d = math.inf  # left the calibrated span
+        if abs(d - d_prev) > bridge_jump or abs(d) > jaw_limit:
+            # bridged a concavity, or the contact reached the end of the jaw's calibrated span
+            # (where it would stop on the jaw's corner): roll back, re-read, go the other way
+            hand.rotate_by(-s)
+            press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+            rotation += step
+            d_prev = _location(rig, baseline, calibration, n, readings, truth, hand)
+            direction = -direction
+            reversals += 1
+            continue
+        phi = rig.pose()[2]
+        z += direction * arc_from_jaw_positions([d_prev, d], s, offset)
+        turn = phi - phi0
+        flt.update(z, turn)
+        arcs.append(z)
+        turns.append(turn)
+        true_arcs.append(truth[-1][0] if truth else math.nan)
+        d_prev = d
+        steps += 1
+        if steps % check_every == 0:
+            belief = flt.belief()
+            true_arc = truth[-1][0] if truth else math.nan
+            history.append((rotation, belief.map_arc, belief.mass, true_arc))
+            if observer is not None:
+                observer({"event": "belief", "rotation": rotation, "map_arc": belief.map_arc, "mass": belief.mass,
+                          "modes": [(m.arc, m.mass) for m in belief.modes[:4]], "true_arc": true_arc})
+            if belief.mass >= confidence:
+                stopped = "confident"
+                break
+            ccw, cw = spread_by_direction(flt, lookahead)
+            best = 1 if ccw >= cw else -1
+            mine, other = (ccw, cw) if direction == 1 else (cw, ccw)
+            if best != direction and other > 1.2 * mine:
+                direction = best
+                reversals += 1
+    if belief is None or belief.steps != flt.steps:
+        belief = flt.belief()
+        history.append((rotation, belief.map_arc, belief.mass, truth[-1][0] if truth else math.nan))
+    return ReactiveRun(belief=belief, rotation=rotation, steps=steps, stopped=stopped, reversals=reversals,
+                       history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
+                       true_arcs=tuple(true_arcs))
