@@ -9,12 +9,17 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    jaw; turn the step's jaw travel into signed arc (second-order inversion)
    and give the filter the cumulative arc and the arm's measured net rotation;
 3. every ``check_every`` steps: stop when the probability within the success
-   radius reaches ``confidence``; otherwise pick the rolling direction whose
-   next ``lookahead`` of rotation spreads the hypotheses' predicted arc the most
-   (for two modes: whose curvature difference between them is larger);
-4. a step that jumps along the jaw has bridged a concavity: it is undone (the
+   radius reaches ``confidence``;
+4. the first direction is the one whose next ``lookahead`` of rotation spreads
+   the probable hypotheses' predicted arcs the most (for two modes: whose
+   curvature difference between them is larger); rolling goes on that way,
+   into curvature not yet measured, until it is blocked;
+5. a step that jumps along the jaw has bridged a concavity: it is undone (the
    jaw rolls back one step), its reading is dropped, and the direction flips;
-5. stop at ``max_rotation`` of total rolling, sure or not.
+6. at the end of the jaw's calibrated span the jaw is lifted, slid along
+   itself and put back on the same point (a regrasp; the filter starts a new
+   segment with its own offset), and rolling goes on the same way;
+7. stop at ``max_rotation`` of rolled rotation, sure or not.
 
 Works on any :class:`driver.rig.Rig` (simulated or serial).
 """
@@ -47,9 +52,11 @@ class ReactiveRun:
     steps : int
         Rolling steps that updated the filter.
     stopped : str
-        "confident", "max_rotation".
+        "confident", "max_rotation", or "blocked" (concavities both ways).
     reversals : int
-        Direction changes (chosen or forced by a bridge).
+        Direction changes (forced by a bridge across a concavity).
+    regrasps : int
+        Times the jaw was lifted and slid along itself at the end of its span.
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
         The belief at every check, with the truth where the rig knows it.
     arcs, turns : tuple of float
@@ -63,6 +70,7 @@ class ReactiveRun:
     steps: int
     stopped: str
     reversals: int
+    regrasps: int = 0
     history: tuple = field(repr=False, default=())
     arcs: tuple = field(repr=False, default=())
     turns: tuple = field(repr=False, default=())
@@ -73,19 +81,24 @@ class ReactiveRun:
         return self.belief.map_arc
 
 
-def spread_by_direction(flt: ContactFilter, lookahead: float, samples: int = 64) -> tuple:
+def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = (0.0, 0.0),
+                        samples: int = 64) -> tuple:
     """(spread ccw, spread cw) in mm: how far apart the probable hypotheses' predicted arcs move
-    over the next ``lookahead`` rad of rotation each way (weighted standard deviation).
+    over the next ``lookahead`` rad of *unexplored* rotation each way (weighted standard deviation).
 
-    Hypotheses that would have to bridge a concavity that way count as not moving apart.
+    ``explored`` is the (lowest, highest) net rotation rolled so far: rolling back over it
+    measures the same curvature again, so each way's window starts where the rolled range
+    ends. For two modes this is the difference of their radii of curvature over the window,
+    integrated. Hypotheses that would have to bridge a concavity count as not moving apart.
     """
     w = flt.posterior()
     top = np.argsort(w)[-samples:]
     wt = w[top] / w[top].sum()
     out = []
-    for sign in (1.0, -1.0):
-        ahead, ok = flt.tracks.advance(top, flt.turn + sign * lookahead)
-        moved = np.where(ok, ahead - flt.current[top], 0.0)
+    for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
+        a, ok_a = flt.tracks.advance(top, edge)
+        b, ok_b = flt.tracks.advance(top, edge + sign * lookahead)
+        moved = np.where(ok_a & ok_b, b - a, 0.0)
         mean = np.sum(wt * moved)
         out.append(float(np.sqrt(np.sum(wt * (moved - mean) ** 2))))
     return tuple(out)
@@ -93,9 +106,9 @@ def spread_by_direction(flt: ContactFilter, lookahead: float, samples: int = 64)
 
 def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, approach_pose,
                         filter: ContactFilter | None = None, step: float = math.radians(0.2), n: int = 32,
-                        confidence: float = 0.95, max_rotation: float = math.radians(90.0),
-                        direction: int = 1, check_every: int = 5, lookahead: float = math.radians(10.0),
-                        bridge_jump: float = 3.0, end_margin: float = 5.0, observer=None,
+                        confidence: float = 0.95, max_rotation: float = math.radians(120.0),
+                        direction: int | None = None, check_every: int = 5, lookahead: float = math.radians(15.0),
+                        bridge_jump: float = 3.0, end_margin: float = 5.0, backoff: float = 2.0, observer=None,
                         **press_options) -> ReactiveRun:
     """Roll until the contact is known within the filter's radius with ``confidence`` (module notes).
 
@@ -108,17 +121,18 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
     confidence : float
         Probability within the success radius that stops the rolling.
     max_rotation : float, rad
-        Total rotation budget, both directions counted.
-    direction : {1, -1}
-        First rolling direction (counter-clockwise is 1).
+        Budget of rolled rotation, both directions counted.
+    direction : {1, -1, None}
+        First rolling direction (counter-clockwise is 1); None lets the direction rule choose.
     check_every : int
-        Steps between checks of the stopping and direction rules.
+        Steps between checks of the stopping rule.
     lookahead : float, rad
         Rotation over which the direction rule compares the two ways.
     bridge_jump : float, mm
         A step whose contact moves more than this on the jaw has bridged a concavity.
     end_margin : float, mm
-        The contact is kept this far inside the calibrated span of the jaw.
+        The contact is kept this far inside the calibrated span of the jaw; there the jaw
+        is lifted by ``backoff`` mm, slid along itself and put back (a regrasp).
     observer : callable, optional
         Called with ``{"event": "belief", ...}`` at every check.
     """
@@ -126,8 +140,8 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         raise RigError(f"step={step!r} rad must be positive")
     if not (math.isfinite(max_rotation) and max_rotation > 0):
         raise RigError(f"max_rotation={max_rotation!r} rad must be positive")
-    if direction not in (1, -1):
-        raise RigError(f"direction={direction!r}: use 1 (counter-clockwise) or -1")
+    if direction not in (1, -1, None):
+        raise RigError(f"direction={direction!r}: use 1 (counter-clockwise), -1 or None")
     if not 0 < confidence < 1:
         raise RigError(f"confidence={confidence!r} must be in (0, 1)")
     flt = filter if filter is not None else ContactFilter(part)
@@ -136,11 +150,20 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
     offset = edge_offset(rig, hand, baseline)
     jaw_limit = float(np.max(np.abs(calibration.positions))) - end_margin
     readings, truth = [], []
-    d_prev = _location(rig, baseline, calibration, n, readings, truth, hand)
+
+    def read():
+        return _location(rig, baseline, calibration, n, readings, truth, hand)
+
+    d_prev = read()
     phi0 = rig.pose()[2]
-    z, rotation, steps, reversals = 0.0, 0.0, 0, 0
+    z, rotation, steps, reversals, regrasps = 0.0, 0.0, 0, 0, 0
+    explored = [0.0, 0.0]
+    blocked = {1: False, -1: False}
     arcs, turns, history = [0.0], [0.0], []
     true_arcs = [truth[-1][0] if truth else math.nan]
+    if direction is None:
+        ccw, cw = spread_by_direction(flt, lookahead)
+        direction = 1 if ccw >= cw else -1
     stopped = "max_rotation"
     belief = None
     while rotation < max_rotation - 1e-12:
@@ -149,23 +172,38 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
         rotation += step
         try:
-            d = _location(rig, baseline, calibration, n, readings, truth, hand)
+            d = read()
         except RigError:
             d = math.inf  # left the calibrated span
-        if abs(d - d_prev) > bridge_jump or abs(d) > jaw_limit:
-            # bridged a concavity, or the contact reached the end of the jaw's calibrated span
-            # (where it would stop on the jaw's corner): roll back, re-read, go the other way
+        if abs(d) > jaw_limit and abs(d - d_prev) <= bridge_jump:
+            # the contact reached the end of the jaw's span: lift, slide the jaw along itself so
+            # that the contact comes back near the other end, put it back; same part point
+            hand.press_by(-backoff)
+            target_d = -math.copysign(jaw_limit - 2 * end_margin, d)
+            hand.slide_by(d - target_d)
+            press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+            d = read()
+            turn = rig.pose()[2] - phi0
+            flt.regrasp(z, turn)
+            regrasps += 1
+        elif abs(d - d_prev) > bridge_jump or not math.isfinite(d):
+            # bridged a concavity: roll back, re-read, and go the other way
             hand.rotate_by(-s)
             press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
             rotation += step
-            d_prev = _location(rig, baseline, calibration, n, readings, truth, hand)
+            d_prev = read()
+            blocked[direction] = True
+            if blocked[-direction]:
+                stopped = "blocked"
+                break
             direction = -direction
             reversals += 1
             continue
-        phi = rig.pose()[2]
-        z += direction * arc_from_jaw_positions([d_prev, d], s, offset)
-        turn = phi - phi0
-        flt.update(z, turn)
+        else:
+            turn = rig.pose()[2] - phi0
+            z += direction * arc_from_jaw_positions([d_prev, d], s, offset)
+            flt.update(z, turn)
+        explored = [min(explored[0], turn), max(explored[1], turn)]
         arcs.append(z)
         turns.append(turn)
         true_arcs.append(truth[-1][0] if truth else math.nan)
@@ -177,19 +215,14 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             history.append((rotation, belief.map_arc, belief.mass, true_arc))
             if observer is not None:
                 observer({"event": "belief", "rotation": rotation, "map_arc": belief.map_arc, "mass": belief.mass,
-                          "modes": [(m.arc, m.mass) for m in belief.modes[:4]], "true_arc": true_arc})
+                          "modes": [(m.arc, m.mass) for m in belief.modes[:4]], "true_arc": true_arc,
+                          "direction": direction})
             if belief.mass >= confidence:
                 stopped = "confident"
                 break
-            ccw, cw = spread_by_direction(flt, lookahead)
-            best = 1 if ccw >= cw else -1
-            mine, other = (ccw, cw) if direction == 1 else (cw, ccw)
-            if best != direction and other > 1.2 * mine:
-                direction = best
-                reversals += 1
     if belief is None or belief.steps != flt.steps:
         belief = flt.belief()
         history.append((rotation, belief.map_arc, belief.mass, truth[-1][0] if truth else math.nan))
     return ReactiveRun(belief=belief, rotation=rotation, steps=steps, stopped=stopped, reversals=reversals,
-                       history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
+                       regrasps=regrasps, history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
                        true_arcs=tuple(true_arcs))

@@ -13,12 +13,22 @@ of ``spacing`` mm over the whole boundary. After k steps, the measured
 cumulative signed arcs z_0 = 0, z_1, …, z_k and the predicted ones
 p_j(σ₀) = σ(θ(σ₀) + Ω_j) − σ₀ are related by
 
-    z_j = c + b·p_j(σ₀) + e_j,   e_j ~ N(0, sd_position²) independent,
+    z_j = c + b·p_j(σ₀) + ρ̂_j·η(z_j) + e_j,   e_j ~ N(0, sd_position²) independent,
 
-where c absorbs the noise of the first reading (flat prior) and b is the
-calibration's scale (b ~ N(1, sd_scale²)). Both are integrated out in closed
-form, so the log-likelihood of each hypothesis is a function of six running
-sums, and one step costs a few vector operations on the grid. The rotations
+where c absorbs the noise of the first reading (flat prior), b is the
+calibration's scale (b ~ N(1, sd_scale²)), and ρ̂·η is the machining error's
+effect: a slope error η of the real boundary against its model (rad) moves the
+contact for a given jaw angle by ρ·η, ρ the radius of curvature there. η is a
+smooth random function along the path, cubic B-splines in z with knots every
+``shape_spacing`` mm and coefficients ~ N(0, sd_slope²), and ρ̂_j is the radius
+the readings themselves show (arc over rotation over the last few steps), the
+same for every hypothesis. This error repeats when the jaw rolls over the same
+stretch again, so more rolling does not average it away; near an inflection,
+where ρ grows without bound, it makes the readings say little, as they should.
+c, b and η are integrated out in closed form (Woodbury): each hypothesis keeps
+running sums (pᵀp, pᵀz and the basis projections Uᵀp, of which a reading
+touches five), so one step costs a few vector operations on the grid, and the
+belief a small dense solve. The rotations
 are taken as exact; the encoder's 0.03° moves a contact by ρ·5e-4 rad, a few
 µm at the parts' radii. A hypothesis that would have to cross an inflection
 (where a straight jaw bridges a concavity, which the rolling procedure refuses)
@@ -42,11 +52,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from ._errors import QueryError
 from ._part import Part
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks"]
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope"]
 
 
 @dataclass(frozen=True)
@@ -99,10 +110,19 @@ class Belief:
     steps: int
 
 
+def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
+    """RMS slope error (rad) of a boundary deviation of ``rms`` mm made of harmonics of the
+    perimeter with 1/k amplitudes down to ``wavelength`` mm (the simulator's machining model)."""
+    if rms <= 0:
+        return 0.0
+    k = np.arange(1, max(1, int(perimeter / wavelength)) + 1)
+    return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k ** 2)))
+
+
 class ModeTracks:
     """Where each of a set of hypotheses' contacts goes under further rotation (for planning)."""
 
-    def __init__(self, part: Part, spacing: float):
+    def __init__(self, part: Part, spacing: float, hull_tolerance: float = 0.1):
         self.part = part
         p = part.perimeter
         n = max(64, int(math.ceil(p / spacing)))
@@ -138,7 +158,17 @@ class ModeTracks:
         self._span = span
         run_of_cell = np.repeat(np.arange(a.size), b - a)
         self._run = run_of_cell[np.arange(n) + n]
-        self.convex = rising[a][self._run] & (kappa > 0)
+        # a straight jaw touches only the convex hull: keep the boundary within hull_tolerance
+        # of the hull of its dense sample (a tolerance, so that a start the real, machined part
+        # lets the jaw reach is not ruled out near where the hull leaves the boundary)
+        pts = np.asarray(part.point_at_arc(sigma))
+        eq = ConvexHull(pts).equations                      # n·x + d ≤ 0 inside
+        depth = np.full(n, -np.inf)
+        for chunk in range(0, len(eq), 256):
+            e = eq[chunk:chunk + 256]
+            depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
+        self.hull = depth > -hull_tolerance
+        self.convex = rising[a][self._run] & (kappa > 0) & self.hull
 
     def advance(self, index: np.ndarray, turn: float) -> tuple:
         """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``.
@@ -155,6 +185,9 @@ class ModeTracks:
         b0, b1 = self._banded[j - 1], self._banded[j]
         w = (target - b0) / np.where(b1 > b0, b1 - b0, 1.0)
         arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
+        # the contact must still be on the hull where it lands (else the jaw bridges)
+        land = np.mod(np.rint(arc / self.h).astype(np.int64), self.sigma.size)
+        ok &= self.hull[land]
         return np.where(ok, arc, np.nan), ok
 
 
@@ -170,6 +203,12 @@ class ContactFilter:
         Standard deviation of one contact-location reading, as arc.
     sd_scale : float
         Standard deviation of the calibration's relative scale error (0: none).
+    sd_slope : float, rad
+        Standard deviation of the B-spline coefficients of the part's slope error
+        against its model (0: a perfect part). :func:`machining_slope` gives it for
+        the simulator's machining model.
+    shape_spacing : float, mm
+        Knot spacing of that B-spline basis, in cumulative arc.
     radius : float, mm
         Success radius of :meth:`belief`.
     mode_floor : float
@@ -188,19 +227,30 @@ class ContactFilter:
     False
     """
 
-    def __init__(self, part: Part, *, spacing: float = 0.02, sd_position: float = 0.05, sd_scale: float = 0.02,
-                 radius: float = 0.3, mode_floor: float = 0.05, confidence: float = 0.95):
+    def __init__(self, part: Part, *, spacing: float = 0.02, sd_position: float = 0.035, sd_scale: float = 0.003,
+                 sd_slope: float = 0.001, shape_spacing: float = 5.0, radius: float = 0.3, mode_floor: float = 0.05,
+                 confidence: float = 0.95, prune: float = 40.0):
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")
-        if not (math.isfinite(sd_scale) and sd_scale >= 0):
-            raise QueryError(f"sd_scale={sd_scale!r} must be ≥ 0")
+        for name, value in (("sd_scale", sd_scale), ("sd_slope", sd_slope)):
+            if not (math.isfinite(value) and value >= 0):
+                raise QueryError(f"{name}={value!r} must be ≥ 0")
+        if not (math.isfinite(shape_spacing) and shape_spacing > 0):
+            raise QueryError(f"shape_spacing={shape_spacing!r} mm must be positive")
         if not 0 < confidence < 1:
             raise QueryError(f"confidence={confidence!r} must be in (0, 1)")
         self.part = part
         self.tracks = ModeTracks(part, spacing)
         self.sd_position = float(sd_position)
         self.sd_scale = float(sd_scale)
+        self.sd_slope = float(sd_slope)
+        self.shape_spacing = float(shape_spacing)
+        self.prune = float(prune)
+        # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
+        self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
+        self._segments = 16                   # offsets: one per contact segment (see regrasp)
+        self._m = self._segments + (2 * self._k0 + 4 if sd_slope > 0 else 0)
         self.radius = float(radius)
         self.mode_floor = float(mode_floor)
         self.confidence = float(confidence)
@@ -217,11 +267,19 @@ class ContactFilter:
         n = self.grid.size
         self.current = self.grid.copy()      # present contact of each hypothesis, mm (unwrapped)
         self.feasible = self.tracks.convex.copy()
-        self._sp = np.zeros(n)
+        m = self._m
+        self._up = np.zeros((m, n))           # Uᵀp per hypothesis (row 0: Σp)
         self._spp = np.zeros(n)
         self._szp = np.zeros(n)
-        self._sz = self._szz = 0.0
-        self._n = 1                           # the first reading: z_0 = 0, p_0 = 0
+        self._uz = np.zeros(m)                # Uᵀz
+        self._uu = np.zeros((m, m))           # UᵀU
+        self._szz = 0.0
+        self._touched = {0}
+        self._segment = 0
+        self._recent = [(0.0, 0.0)]           # (z, turn) of the last readings of this segment
+        self._live = self.feasible.copy()     # hypotheses still worth evaluating
+        self._recent = []
+        self._add_row(0.0, np.zeros(n))       # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
         self.arc = 0.0
@@ -242,30 +300,87 @@ class ContactFilter:
             raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
         current, ok = self.tracks.advance(self.index, turn)
         self.feasible &= ok
+        self._live &= ok
         p = np.where(ok, current - self.grid, 0.0)
         self.current = np.where(ok, current, self.current)
         z = float(arc)
-        self._sp += p
-        self._spp += p * p
-        self._szp += z * p
-        self._sz += z
-        self._szz += z * z
-        self._n += 1
+        self._add_row(z, p, float(turn))
         self.steps += 1
         self.turn, self.arc = float(turn), z
 
+    def regrasp(self, arc: float, turn: float) -> None:
+        """The jaw was lifted and put back (e.g. slid along itself at the end of its span).
+
+        The contact is where the net rotation ``turn`` (rad) puts it, but the next
+        reading starts a new segment with its own unknown offset (the arc across the
+        lift is not measured). ``arc`` (mm) is the cumulative arc the caller will
+        continue from; any value works, the new offset absorbs it.
+        """
+        if self._segment + 1 >= self._segments:
+            raise QueryError(f"more than {self._segments - 1} regrasps in one localization")
+        self._segment += 1
+        self._recent = []
+        self.update(arc, turn)
+
+    def _basis(self, z: float) -> tuple:
+        """(columns, values) of the basis at cumulative arc z: the segment's offset and four cubic B-splines."""
+        seg = np.array([self._segment])
+        if self.sd_slope <= 0:
+            return seg, np.array([1.0])
+        x = z / self.shape_spacing
+        i = math.floor(x)
+        u = x - i
+        vals = np.array([(1 - u) ** 3, 3 * u ** 3 - 6 * u ** 2 + 4, -3 * u ** 3 + 3 * u ** 2 + 3 * u + 1, u ** 3]) / 6
+        cols = self._segments + self._k0 + i + np.arange(4)
+        if cols[0] < self._segments or cols[-1] >= self._m:
+            raise QueryError(f"arc={z!r} mm is more than a perimeter from the first reading")
+        return np.concatenate([seg, cols]), np.concatenate([[1.0], vals * self._radius_here(z)])
+
+    def _radius_here(self, z: float) -> float:
+        """ρ̂, mm: arc over rotation across the last few readings of the segment (5 to 500 mm)."""
+        if len(self._recent) < 2:
+            return 50.0
+        (z0, t0), (z1, t1) = self._recent[0], self._recent[-1]
+        dt = abs(t1 - t0)
+        return float(np.clip(abs(z1 - z0) / dt, 5.0, 500.0)) if dt > 0 else 500.0
+
+    def _add_row(self, z: float, p: np.ndarray, turn: float = 0.0) -> None:
+        self._recent = (self._recent + [(z, turn)])[-6:]
+        cols, vals = self._basis(z)
+        for c, v in zip(cols, vals):
+            self._up[c] += v * p
+        self._touched.update(int(c) for c in cols)
+        self._spp += p * p
+        self._szp += z * p
+        self._uz[cols] += vals * z
+        self._uu[np.ix_(cols, cols)] += np.outer(vals, vals)
+        self._szz += z * z
+
     def log_likelihood(self) -> np.ndarray:
-        """Log-likelihood of each start (−inf where infeasible), up to a constant."""
-        n = self._n
-        spp = self._spp - self._sp ** 2 / n
-        szp = self._szp - self._sz * self._sp / n
-        szz = self._szz - self._sz ** 2 / n
-        srr = szz - 2 * szp + spp
-        srp = szp - spp
-        s2, t2 = self.sd_position ** 2, self.sd_scale ** 2
-        quad = (srr - t2 * srp ** 2 / (s2 + t2 * spp)) / s2
-        ll = -0.5 * (quad + np.log1p(t2 * spp / s2))
-        return np.where(self.feasible, ll, -np.inf)
+        """Log-likelihood of each start (−inf where infeasible or pruned), up to a constant."""
+        cols = np.array(sorted(self._touched))
+        s2 = self.sd_position ** 2
+        prior = np.full(cols.size, self.sd_slope ** 2)
+        prior[cols < self._segments] = 1e6              # the segments' offsets: flat
+        g = self._uu[np.ix_(cols, cols)] + np.diag(s2 / prior)
+        live = np.flatnonzero(self._live)
+        v = self._up[np.ix_(cols, live)]                # (m, n_live)
+        gi_v = np.linalg.solve(g, v)
+        wz = self._uz[cols]
+        gi_wz = np.linalg.solve(g, wz)
+        qpp = (self._spp[live] - np.einsum("ij,ij->j", v, gi_v)) / s2
+        qpz = (self._szp[live] - gi_wz @ v) / s2
+        qzz = (self._szz - wz @ gi_wz) / s2
+        qrr = qzz - 2 * qpz + qpp
+        t2 = self.sd_scale ** 2
+        qpr = qpz - qpp
+        ll_live = -0.5 * (qrr - t2 * qpr ** 2 / (1 + t2 * qpp) + np.log1p(t2 * qpp))
+        ll = np.full(self.grid.size, -np.inf)
+        ll[live] = ll_live
+        if self.prune > 0 and live.size:
+            # hypotheses this far below the best are dropped from later evaluations
+            self._live[live[ll_live < ll_live.max() - self.prune]] = False
+        return ll
 
     def posterior(self) -> np.ndarray:
         """Posterior probability of each start (sums to 1)."""
