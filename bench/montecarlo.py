@@ -46,8 +46,9 @@ def read_trials(path) -> list:
         lines = lines[:-1]
     rows = []
     reader = csv.DictReader(lines)
+    width = len(reader.fieldnames or ())
     for r in reader:
-        if r is None or None in r.values() or len(r) != len(TRIAL_COLUMNS):
+        if r is None or None in r.values() or len(r) != width or width < len(TRIAL_COLUMNS):
             continue
         rows.append(r)
     return rows
@@ -83,13 +84,13 @@ def run_study(study: Study, out, *, workers: int | None = None, scheduler: str |
         done = {(int(r["level"]), int(r["trial"])) for r in rows}
         # rewrite without a truncated tail so that appending continues a clean file
         with open(table, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=TRIAL_COLUMNS)
+            w = csv.DictWriter(f, fieldnames=study.columns)
             w.writeheader()
             for r in rows:
                 w.writerow(r)
     else:
         with open(table, "w", newline="") as f:
-            csv.DictWriter(f, fieldnames=TRIAL_COLUMNS).writeheader()
+            csv.DictWriter(f, fieldnames=study.columns).writeheader()
     specs = [TrialSpec(study, level, trial) for level in range(study.levels) for trial in range(study.trials)
              if (level, trial) not in done]
     total = study.levels * study.trials
@@ -99,7 +100,7 @@ def run_study(study: Study, out, *, workers: int | None = None, scheduler: str |
 
     def record(row, f, writer):
         nonlocal finished, successes
-        writer.writerow({k: _fmt(row.get(k)) for k in TRIAL_COLUMNS})
+        writer.writerow({k: _fmt(row.get(k)) for k in study.columns})
         f.flush()
         finished += 1
         successes += int(row["success"])
@@ -111,7 +112,7 @@ def run_study(study: Study, out, *, workers: int | None = None, scheduler: str |
             sys.stderr.flush()
 
     with open(table, "a", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=TRIAL_COLUMNS)
+        writer = csv.DictWriter(f, fieldnames=study.columns)
         if not specs:
             pass
         elif scheduler:
@@ -158,8 +159,42 @@ def summarize(study: Study, rows) -> dict:
             "broken": sum(bool(r["failure"]) for r in sel),
             "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,
         })
-    return {"study": study.name, "method": study.method, "engine": study.engine, "noise": study.noise,
-            "success_radius": study.success_radius, "levels": levels}
+    out = {"study": study.name, "method": study.method, "engine": study.engine, "noise": study.noise,
+           "success_radius": study.success_radius, "levels": levels}
+    if study.methods:
+        out.update(summarize_methods(study, rows))
+    return out
+
+
+def summarize_methods(study: Study, rows) -> dict:
+    """``methods`` {name: success rate} over all trials, with details and success against rotation."""
+    from .methods import MARK_DEG, parse_curve
+
+    rates, details, curves = {}, {}, {}
+    n = len(rows)
+    for m in study.methods:
+        ok = sum(int(r[f"{m}_success"]) for r in rows)
+        rot = np.array([float(r[f"{m}_rotation_deg"]) for r in rows], dtype=float)
+        err = np.array([float(r[f"{m}_error_mm"]) for r in rows], dtype=float)
+        rates[m] = ok / n if n else None
+        details[m] = {"success": ok, "trials": n, "ci95": list(wilson(ok, n)),
+                      "mean_rotation_deg": float(np.nanmean(rot)) if n else None,
+                      "median_rotation_deg": float(np.nanmedian(rot)) if n else None,
+                      "error_median_mm": float(np.median(err)) if n else None}
+        per_mark: dict = {}
+        for r in rows:
+            pairs = parse_curve(r[f"{m}_curve"])
+            last = pairs[-1][1] if pairs else math.inf
+            marks = {round(k, 6): e for k, e in pairs}
+            # a method that rolled no further than its last mark keeps its last answer
+            top = max(marks) if marks else 0.0
+            k = MARK_DEG
+            while k <= max(study.reactive.max_rotation_deg, sum(abs(a) for a in study.rolls_deg)) + 1e-9:
+                e = marks.get(round(k, 6), last if k > top else math.inf)
+                per_mark.setdefault(k, []).append(e < study.success_radius)
+                k += MARK_DEG
+        curves[m] = {f"{k:g}": float(np.mean(v)) for k, v in sorted(per_mark.items())}
+    return {"methods": rates, "method_details": details, "success_by_rotation_deg": curves}
 
 
 def plot_study(study: Study, rows, out: Path) -> None:
@@ -171,7 +206,10 @@ def plot_study(study: Study, rows, out: Path) -> None:
 
     from localizer import load_part
 
-    summ = summarize(study, rows)["levels"]
+    full = summarize(study, rows)
+    summ = full["levels"]
+    if study.methods and rows:
+        _plot_methods(study, full, out)
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     x = [lv["value"] if lv["value"] is not None else k for k, lv in enumerate(summ)]
     rate = np.array([lv["success_rate"] if lv["success_rate"] is not None else np.nan for lv in summ])
@@ -229,6 +267,31 @@ def plot_study(study: Study, rows, out: Path) -> None:
         plt.close(fig)
 
 
+def _plot_methods(study: Study, summary: dict, out: Path) -> None:
+    """methods.png: success rate against rotation rolled for each method."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.4))
+    for m in study.methods:
+        curve = summary["success_by_rotation_deg"][m]
+        x = [float(k) for k in curve]
+        d = summary["method_details"][m]
+        label = (f"{m}: {summary['methods'][m]:.1%} at the end, mean rotation {d['mean_rotation_deg']:.0f}°")
+        ax.plot(x, list(curve.values()), "o-", ms=3, label=label)
+    ax.axhline(0.45, color="tab:red", lw=1, ls="--", label="the paper's rig: about 45%")
+    ax.axvline(sum(abs(a) for a in study.rolls_deg), color="0.5", lw=1, ls=":",
+               label=f"the fixed rolls: {sum(abs(a) for a in study.rolls_deg):g}°")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel("rotation rolled (degrees)")
+    ax.set_ylabel(f"success rate (error < {study.success_radius} mm)")
+    ax.set_title(f"{study.name}: {len(study.methods)} methods on the same trials", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    fig.savefig(out / "methods.png", dpi=110)
+    plt.close(fig)
+
+
 def print_summary(summary: dict) -> None:
     print(f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
           f"noise {Path(str(summary['noise'])).name}")
@@ -238,3 +301,8 @@ def print_summary(summary: dict) -> None:
         print(f"  {v}{lv['success']}/{lv['trials']} within {summary['success_radius']} mm = "
               f"{rate:.1%} (95% CI {lv['ci95'][0]:.1%}–{lv['ci95'][1]:.1%}), median error "
               f"{lv['error_median_mm']:.3f} mm" if rate is not None else f"  {v}no trials")
+    for m, rate in summary.get("methods", {}).items():
+        d = summary["method_details"][m]
+        if rate is not None:
+            print(f"  {m:10s} {d['success']}/{d['trials']} = {rate:.1%} (95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), "
+                  f"mean rotation {d['mean_rotation_deg']:.1f}°, median error {d['error_median_mm']:.3f} mm")

@@ -21,6 +21,26 @@ A study file::
     sd_length = 0.3                      # likelihood rule (mm, degrees)
     sd_turn_deg = 0.03
 
+Several methods on the same trials (instead of ``method``)::
+
+    methods = ["paper", "particle", "reactive"]   # first one fills success/error_mm
+
+    [reactive]                           # the sequential filter (driver.reactive)
+    confidence = 0.95
+    max_rotation_deg = 180.0
+    sd_position = 0.04                   # mm, one contact-location reading
+    sd_scale = 0.003                     # calibration scale
+    sd_slope = 0.003                     # rad, the part's slope error ("auto": from the noise model)
+
+    [particle]                           # the peer baseline, over the fixed rolls' readings
+    particles = 2000
+    sd_step = 0.06                       # mm, one step's arc increment
+    process = 0.005                      # mm per step
+
+The paper and likelihood methods and the particle filter use the readings of
+the fixed rolls (``rolls_deg``); the reactive method rolls on its own, from the
+same start on a rig with the same seed.
+
 Every trial is reproducible from (seed, level, trial): its generator is
 ``numpy.random.SeedSequence([seed, level, trial])``.
 """
@@ -42,8 +62,33 @@ TRIAL_COLUMNS = ("level", "trial", "parameter", "value", "part", "start_arc", "t
                  "error_mm", "success", "candidates", "probability", "ambiguous", "lengths", "turns",
                  "restarts", "time_s", "failure")
 
-_KEYS = {"name", "parts", "rolls_deg", "step_deg", "method", "engine", "trials", "seed", "success_radius",
-         "noise", "sweep", "likelihood"}
+_KEYS = {"name", "parts", "rolls_deg", "step_deg", "method", "methods", "engine", "trials", "seed",
+         "success_radius", "noise", "sweep", "likelihood", "reactive", "particle"}
+METHODS = ("paper", "likelihood", "particle", "reactive")
+#: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
+METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve")
+
+
+@dataclass(frozen=True)
+class ReactiveOptions:
+    """[reactive] of a study file (see :func:`driver.reactive.localize_reactively`)."""
+
+    confidence: float = 0.95
+    max_rotation_deg: float = 180.0
+    check_every: int = 5
+    sd_position: float = 0.04
+    sd_scale: float = 0.003
+    sd_slope: float | None = None   # None: "auto"
+    switch_ratio: float = 3.0
+
+
+@dataclass(frozen=True)
+class ParticleOptions:
+    """[particle] of a study file (see :class:`localizer.ParticleFilter`)."""
+
+    particles: int = 2000
+    sd_step: float = 0.06
+    process: float = 0.005
 
 
 class StudyError(ValueError):
@@ -69,6 +114,15 @@ class Study:
     sd_length: float = 0.3
     sd_turn_deg: float = 0.03
     source: str = ""
+    methods: tuple = ()
+    reactive: ReactiveOptions = ReactiveOptions()
+    particle: ParticleOptions = ParticleOptions()
+
+    @property
+    def columns(self) -> tuple:
+        """The columns of this study's trials.csv."""
+        extra = tuple(f"{m}_{c}" for m in self.methods for c in METHOD_COLUMNS) if self.methods else ()
+        return TRIAL_COLUMNS + extra
 
     @property
     def levels(self) -> int:
@@ -132,6 +186,16 @@ def load_study(path) -> Study:
     method = data.get("method", "paper")
     if method not in ("paper", "likelihood"):
         raise StudyError(f"study {path}: method {method!r}; use 'paper' or 'likelihood'")
+    methods = data.get("methods", [])
+    if (not isinstance(methods, list) or not all(m in METHODS for m in methods)
+            or len(set(methods)) != len(methods)):
+        raise StudyError(f"study {path}: methods {methods!r} must be a list of distinct names from {list(METHODS)}")
+    if methods and "method" in data:
+        raise StudyError(f"study {path}: give 'method' or 'methods', not both")
+    if methods:
+        method = methods[0]
+    reactive = _options(path, data.get("reactive", {}), ReactiveOptions, "reactive")
+    particle = _options(path, data.get("particle", {}), ParticleOptions, "particle")
     engine = data.get("engine", "kinematic")
     if engine not in ("kinematic", "pymunk"):
         raise StudyError(f"study {path}: engine {engine!r}; use 'kinematic' or 'pymunk'")
@@ -178,7 +242,31 @@ def load_study(path) -> Study:
                  trials=int(data.get("trials", 100)), seed=int(data.get("seed", 0)),
                  success_radius=float(data.get("success_radius", 0.3)), noise=str(noise), parameter=parameter,
                  values=values, sd_length=float(lk.get("sd_length", 0.3)),
-                 sd_turn_deg=float(lk.get("sd_turn_deg", 0.03)), source=str(path))
+                 sd_turn_deg=float(lk.get("sd_turn_deg", 0.03)), source=str(path), methods=tuple(methods),
+                 reactive=reactive, particle=particle)
+
+
+def _options(path, table, cls, name):
+    """A [reactive] or [particle] table as its options dataclass, checked."""
+    if not isinstance(table, dict):
+        raise StudyError(f"study {path}: [{name}] must be a table")
+    known = set(cls.__dataclass_fields__)
+    unknown = sorted(set(table) - known)
+    if unknown:
+        raise StudyError(f"study {path}: [{name}] unknown key(s) {unknown}; valid: {sorted(known)}")
+    values = {}
+    for key, value in table.items():
+        if key == "sd_slope" and value == "auto":
+            values[key] = None
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):
+            raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a positive number")
+        values[key] = int(value) if key in ("particles", "check_every") else float(value)
+    if values.get("confidence", 0.5) >= 1:
+        raise StudyError(f"study {path}: [{name}] confidence={values['confidence']!r} must be below 1")
+    if values.get("particles", 2) < 2:
+        raise StudyError(f"study {path}: [{name}] particles={values['particles']!r} must be at least 2")
+    return cls(**values)
 
 
 # ------------------------------------------------------------------ trial
@@ -208,7 +296,8 @@ def run_trial(spec: TrialSpec) -> dict:
 
     The start is drawn uniformly over the perimeter; a start where the pipeline
     refuses to roll (not on the convex hull, or a roll would bridge a
-    concavity) is redrawn, up to 20 times (``restarts``).
+    concavity) is redrawn, up to 20 times (``restarts``). With ``methods``, every
+    method is scored on that same trial (module notes).
     """
     import math as _m
 
@@ -228,6 +317,7 @@ def run_trial(spec: TrialSpec) -> dict:
     row = {"level": spec.level, "trial": spec.trial, "parameter": s.parameter or "", "value": value,
            "part": Path(part_file).name}
     rolls = [_m.radians(r) for r in s.rolls_deg]
+    rule = s.method if s.method in ("paper", "likelihood") else "paper"
     try:
         t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
         cal_arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
@@ -236,10 +326,11 @@ def run_trial(spec: TrialSpec) -> dict:
         run = None
         for restarts in range(20):
             start = float(rng.uniform(0, part.perimeter))
-            rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=s.engine)
+            rig_seed = int(rng.integers(1 << 31))
+            rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine)
             try:
                 run = localize_by_rolling(
-                    rig, part, rolls, calibration=cal, step=_m.radians(s.step_deg), rule=s.method,
+                    rig, part, rolls, calibration=cal, step=_m.radians(s.step_deg), rule=rule,
                     sd_length=s.sd_length, sd_turn=_m.radians(s.sd_turn_deg),
                     approach_pose=rig.approach_pose(start, jaw_position=-40.0 if rolls[0] > 0 else 40.0,
                                                     standoff=1.0))
@@ -263,9 +354,19 @@ def run_trial(spec: TrialSpec) -> dict:
                     "lengths": " ".join(f"{L:.6f}" for L, _ in run.estimates),
                     "turns": " ".join(f"{w:.8f}" for _, w in run.estimates),
                     "restarts": restarts, "failure": ""})
+        if s.methods:
+            from .methods import score_methods
+
+            row.update(score_methods(s, part, noise, cal, run, start, rig_seed, true_arc))
+            first_method = s.methods[0]
+            for key in ("success", "error_mm", "estimate_arc"):
+                row[key] = row[f"{first_method}_{key}"]
     except Exception as exc:  # a trial that breaks is a recorded failure, not a lost study
         row.update({"start_arc": math.nan, "true_arc": math.nan, "estimate_arc": math.nan, "error_mm": math.inf,
                     "success": 0, "candidates": 0, "probability": 0.0, "ambiguous": 0, "lengths": "",
                     "turns": "", "restarts": 0, "failure": f"{type(exc).__name__}: {exc}"[:200]})
+        for m in s.methods:
+            row.update({f"{m}_success": 0, f"{m}_error_mm": math.inf, f"{m}_estimate_arc": math.nan,
+                        f"{m}_rotation_deg": math.nan, f"{m}_curve": ""})
     row["time_s"] = time.perf_counter() - t0
     return row

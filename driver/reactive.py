@@ -10,10 +10,11 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    and give the filter the cumulative arc and the arm's measured net rotation;
 3. every ``check_every`` steps: stop when the probability within the success
    radius reaches ``confidence``;
-4. the first direction is the one whose next ``lookahead`` of rotation spreads
-   the probable hypotheses' predicted arcs the most (for two modes: whose
-   curvature difference between them is larger); rolling goes on that way,
-   into curvature not yet measured, until it is blocked;
+4. the direction rule: at each check, compare how much the next ``lookahead``
+   of *unexplored* rotation each way spreads the probable hypotheses'
+   predicted arcs (for two modes: how much their radii of curvature differ
+   over it, integrated); turn round when the other way is ``switch_ratio``
+   times better (rolling back over the explored range on the way);
 5. a step that jumps along the jaw has bridged a concavity: it is undone (the
    jaw rolls back one step), its reading is dropped, and the direction flips;
 6. at the end of the jaw's calibrated span the jaw is lifted, slid along
@@ -52,7 +53,8 @@ class ReactiveRun:
     steps : int
         Rolling steps that updated the filter.
     stopped : str
-        "confident", "max_rotation", or "blocked" (concavities both ways).
+        "confident", "max_rotation", "blocked" (concavities both ways) or "lost" (the contact
+        could not be read back after a bridge).
     reversals : int
         Direction changes (forced by a bridge across a concavity).
     regrasps : int
@@ -63,6 +65,8 @@ class ReactiveRun:
         The cumulative signed arc (mm) and net rotation (rad) given to the filter.
     true_arcs : tuple of float
         The true contact (mm) at the same readings (NaN on a real rig).
+    segments : tuple of int
+        The contact segment of each reading (a regrasp or a bridge starts a new one).
     """
 
     belief: Belief
@@ -75,6 +79,7 @@ class ReactiveRun:
     arcs: tuple = field(repr=False, default=())
     turns: tuple = field(repr=False, default=())
     true_arcs: tuple = field(repr=False, default=())
+    segments: tuple = field(repr=False, default=())
 
     @property
     def estimate_arc(self) -> float:
@@ -108,8 +113,8 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
                         filter: ContactFilter | None = None, step: float = math.radians(0.2), n: int = 32,
                         confidence: float = 0.95, max_rotation: float = math.radians(120.0),
                         direction: int | None = None, check_every: int = 5, lookahead: float = math.radians(15.0),
-                        bridge_jump: float = 3.0, end_margin: float = 5.0, backoff: float = 2.0, observer=None,
-                        **press_options) -> ReactiveRun:
+                        bridge_jump: float = 3.0, end_margin: float = 5.0, backoff: float = 2.0,
+                        switch_ratio: float = 3.0, observer=None, **press_options) -> ReactiveRun:
     """Roll until the contact is known within the filter's radius with ``confidence`` (module notes).
 
     Parameters
@@ -123,11 +128,14 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
     max_rotation : float, rad
         Budget of rolled rotation, both directions counted.
     direction : {1, -1, None}
-        First rolling direction (counter-clockwise is 1); None lets the direction rule choose.
+        First rolling direction (counter-clockwise is 1; None: 1).
     check_every : int
-        Steps between checks of the stopping rule.
+        Steps between checks of the stopping and direction rules.
     lookahead : float, rad
         Rotation over which the direction rule compares the two ways.
+    switch_ratio : float
+        The direction rule turns round when the other way's unexplored window spreads the
+        hypotheses this many times more than the window ahead.
     bridge_jump : float, mm
         A step whose contact moves more than this on the jaw has bridged a concavity.
     end_margin : float, mm
@@ -161,9 +169,9 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
     blocked = {1: False, -1: False}
     arcs, turns, history = [0.0], [0.0], []
     true_arcs = [truth[-1][0] if truth else math.nan]
+    segments = [0]
     if direction is None:
-        ccw, cw = spread_by_direction(flt, lookahead)
-        direction = 1 if ccw >= cw else -1
+        direction = 1  # nothing is known yet: counter-clockwise, like the paper
     stopped = "max_rotation"
     belief = None
     while rotation < max_rotation - 1e-12:
@@ -175,23 +183,45 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             d = read()
         except RigError:
             d = math.inf  # left the calibrated span
-        if abs(d) > jaw_limit and abs(d - d_prev) <= bridge_jump:
+        bridged = abs(d - d_prev) > bridge_jump or not math.isfinite(d)
+        regrasped = False
+        if not bridged and abs(d) > jaw_limit:
             # the contact reached the end of the jaw's span: lift, slide the jaw along itself so
-            # that the contact comes back near the other end, put it back; same part point
-            hand.press_by(-backoff)
+            # that the contact comes back near the other end, put it back on the same point
             target_d = -math.copysign(jaw_limit - 2 * end_margin, d)
-            hand.slide_by(d - target_d)
+            slide = d - target_d
+            hand.press_by(-backoff)
+            hand.slide_by(slide)
             press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
-            d = read()
-            turn = rig.pose()[2] - phi0
-            flt.regrasp(z, turn)
-            regrasps += 1
-        elif abs(d - d_prev) > bridge_jump or not math.isfinite(d):
+            try:
+                d_new = read()
+            except RigError:
+                d_new = math.inf
+            if abs(d_new - target_d) <= bridge_jump:
+                d = d_new
+                turn = rig.pose()[2] - phi0
+                flt.regrasp(z, turn)
+                regrasps += 1
+                regrasped = True
+            else:
+                # the longer reach of the slid jaw found another point: the stretch ends here
+                # on the hull; put the jaw back and treat it as a bridge
+                hand.press_by(-backoff)
+                hand.slide_by(-slide)
+                press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+                bridged = True
+        if bridged:
             # bridged a concavity: roll back, re-read, and go the other way
             hand.rotate_by(-s)
             press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
             rotation += step
-            d_prev = read()
+            try:
+                d_prev = read()
+            except RigError:
+                stopped = "lost"
+                break
+            # the re-read is a new base for the increments: a new segment with its own offset
+            flt.regrasp(z, rig.pose()[2] - phi0)
             blocked[direction] = True
             if blocked[-direction]:
                 stopped = "blocked"
@@ -199,7 +229,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             direction = -direction
             reversals += 1
             continue
-        else:
+        if not regrasped:
             turn = rig.pose()[2] - phi0
             z += direction * arc_from_jaw_positions([d_prev, d], s, offset)
             flt.update(z, turn)
@@ -207,6 +237,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         arcs.append(z)
         turns.append(turn)
         true_arcs.append(truth[-1][0] if truth else math.nan)
+        segments.append(flt.segment)
         d_prev = d
         steps += 1
         if steps % check_every == 0:
@@ -220,9 +251,16 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             if belief.mass >= confidence:
                 stopped = "confident"
                 break
+            # the direction rule: turn round when the unexplored curvature the other way
+            # separates the probable hypotheses much better than what lies ahead
+            ccw, cw = spread_by_direction(flt, lookahead, tuple(explored))
+            ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
+            if behind > switch_ratio * ahead and not blocked[-direction]:
+                direction = -direction
+                reversals += 1
     if belief is None or belief.steps != flt.steps:
         belief = flt.belief()
         history.append((rotation, belief.map_arc, belief.mass, truth[-1][0] if truth else math.nan))
     return ReactiveRun(belief=belief, rotation=rotation, steps=steps, stopped=stopped, reversals=reversals,
                        regrasps=regrasps, history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
-                       true_arcs=tuple(true_arcs))
+                       true_arcs=tuple(true_arcs), segments=tuple(segments))

@@ -122,7 +122,7 @@ def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
 class ModeTracks:
     """Where each of a set of hypotheses' contacts goes under further rotation (for planning)."""
 
-    def __init__(self, part: Part, spacing: float, hull_tolerance: float = 0.1):
+    def __init__(self, part: Part, spacing: float, hull_tolerance: float = 1.0):
         self.part = part
         p = part.perimeter
         n = max(64, int(math.ceil(p / spacing)))
@@ -159,8 +159,9 @@ class ModeTracks:
         run_of_cell = np.repeat(np.arange(a.size), b - a)
         self._run = run_of_cell[np.arange(n) + n]
         # a straight jaw touches only the convex hull: keep the boundary within hull_tolerance
-        # of the hull of its dense sample (a tolerance, so that a start the real, machined part
-        # lets the jaw reach is not ruled out near where the hull leaves the boundary)
+        # of the hull of its dense sample. The tolerance is generous (1 mm) because a jaw of
+        # finite length reaches a little past where the hull leaves the boundary when the
+        # obstructing bump is beyond its end, and the machined part differs from the model.
         pts = np.asarray(part.point_at_arc(sigma))
         eq = ConvexHull(pts).equations                      # n·x + d ≤ 0 inside
         depth = np.full(n, -np.inf)
@@ -256,6 +257,11 @@ class ContactFilter:
         self.confidence = float(confidence)
         self.index = np.arange(self.tracks.sigma.size)
         self.reset()
+
+    @property
+    def segment(self) -> int:
+        """Index of the present contact segment (0, then one more per :meth:`regrasp`)."""
+        return self._segment
 
     @property
     def grid(self) -> np.ndarray:
