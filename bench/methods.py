@@ -100,7 +100,7 @@ def score_particle(study, part, seq, seed: int) -> dict:
     from localizer import ParticleFilter
 
     o = study.particle
-    pf = ParticleFilter(part, particles=o.particles, sd_step=o.sd_step, process=o.process,
+    pf = ParticleFilter(part, particles=o.particles, sd_position=o.sd_position, process=o.process,
                         radius=study.success_radius, seed=seed)
     marks = dict((k, m) for m, k in _marks(seq["turn"]))
     curve = []
@@ -138,7 +138,7 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict
                               approach_pose=rig.approach_pose(start, jaw_position=-40.0, standoff=1.0),
                               step=math.radians(study.step_deg), confidence=o.confidence,
                               max_rotation=math.radians(o.max_rotation_deg), check_every=o.check_every,
-                              switch_ratio=o.switch_ratio)
+                              min_spread=o.min_spread)
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)
     rot = math.degrees(res.rotation)

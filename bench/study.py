@@ -34,7 +34,7 @@ Several methods on the same trials (instead of ``method``)::
 
     [particle]                           # the peer baseline, over the fixed rolls' readings
     particles = 2000
-    sd_step = 0.06                       # mm, one step's arc increment
+    sd_position = 0.04                   # mm, one reading
     process = 0.005                      # mm per step
 
 The paper and likelihood methods and the particle filter use the readings of
@@ -79,7 +79,7 @@ class ReactiveOptions:
     sd_position: float = 0.04
     sd_scale: float = 0.003
     sd_slope: float | None = None   # None: "auto"
-    switch_ratio: float = 3.0
+    min_spread: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,7 @@ class ParticleOptions:
     """[particle] of a study file (see :class:`localizer.ParticleFilter`)."""
 
     particles: int = 2000
-    sd_step: float = 0.06
+    sd_position: float = 0.04
     process: float = 0.005
 
 

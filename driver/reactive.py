@@ -10,12 +10,15 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    and give the filter the cumulative arc and the arm's measured net rotation;
 3. every ``check_every`` steps: stop when the probability within the success
    radius reaches ``confidence``;
-4. the direction rule: at each check, compare how much the next ``lookahead``
-   of *unexplored* rotation each way spreads the probable hypotheses'
-   predicted arcs (for two modes: how much their radii of curvature differ
-   over it, integrated); turn round when the other way is ``switch_ratio``
-   times better (rolling back over the explored range on the way);
-5. a step that jumps along the jaw has bridged a concavity: it is undone (the
+4. the direction rule: while the belief has two or more modes, compare how much
+   the next ``lookahead`` of *unexplored* rotation each way separates the two
+   leading ones (how much their radii of curvature differ over it,
+   integrated); when the way ahead cannot separate them (below ``min_spread``)
+   and the other way clearly can (above three times that), turn round (rolling
+   back over the explored range);
+5. when most of the belief says the contact will leave its convex stretch
+   within ``lookahead``, turn round before the jaw bridges the concavity; a
+   step that jumps along the jaw all the same has bridged it: it is undone (the
    jaw rolls back one step), its reading is dropped, and the direction flips;
 6. at the end of the jaw's calibrated span the jaw is lifted, slid along
    itself and put back on the same point (a regrasp; the filter starts a new
@@ -56,7 +59,7 @@ class ReactiveRun:
         "confident", "max_rotation", "blocked" (concavities both ways) or "lost" (the contact
         could not be read back after a bridge).
     reversals : int
-        Direction changes (forced by a bridge across a concavity).
+        Direction changes (a concavity ahead or bridged, or the direction rule).
     regrasps : int
         Times the jaw was lifted and slid along itself at the end of its span.
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
@@ -87,26 +90,38 @@ class ReactiveRun:
 
 
 def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = (0.0, 0.0),
-                        samples: int = 64) -> tuple:
-    """(spread ccw, spread cw) in mm: how far apart the probable hypotheses' predicted arcs move
-    over the next ``lookahead`` rad of *unexplored* rotation each way (weighted standard deviation).
+                        starts=None) -> tuple:
+    """(spread ccw, spread cw) in mm: how far apart hypotheses' predicted arcs move over the next
+    ``lookahead`` rad of *unexplored* rotation each way.
 
-    ``explored`` is the (lowest, highest) net rotation rolled so far: rolling back over it
-    measures the same curvature again, so each way's window starts where the rolled range
-    ends. For two modes this is the difference of their radii of curvature over the window,
-    integrated. Hypotheses that would have to bridge a concavity count as not moving apart.
+    ``starts`` are the hypotheses (start arcs, mm), equally weighted; default: the two
+    most probable modes of the belief. For two modes the spread is half the difference
+    of their predicted travel: their radii of curvature's difference over the window,
+    integrated. ``explored`` is the (lowest, highest) net rotation rolled so far: rolling
+    back over it measures the same curvature again, so each way's window starts where
+    the rolled range ends. A hypothesis that would have to bridge a concavity that way
+    counts as not moving.
     """
+    if starts is None:
+        starts = [m.start_arc for m in flt.belief().modes[:2]]
+    idx = np.mod(np.rint(np.asarray(starts, dtype=float) / flt.tracks.h).astype(int), flt.grid.size)
+    out = []
+    for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
+        a, ok_a = flt.tracks.advance(idx, edge)
+        b, ok_b = flt.tracks.advance(idx, edge + sign * lookahead)
+        moved = np.where(ok_a & ok_b, b - a, 0.0)
+        out.append(float(np.std(moved)))
+    return tuple(out)
+
+
+def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, samples: int = 64) -> float:
+    """Probability that the jaw can roll ``lookahead`` rad further ``direction``-wise without the
+    contact leaving its convex stretch (over the most probable hypotheses)."""
     w = flt.posterior()
     top = np.argsort(w)[-samples:]
     wt = w[top] / w[top].sum()
-    out = []
-    for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
-        a, ok_a = flt.tracks.advance(top, edge)
-        b, ok_b = flt.tracks.advance(top, edge + sign * lookahead)
-        moved = np.where(ok_a & ok_b, b - a, 0.0)
-        mean = np.sum(wt * moved)
-        out.append(float(np.sqrt(np.sum(wt * (moved - mean) ** 2))))
-    return tuple(out)
+    _, ok = flt.tracks.advance(top, flt.turn + direction * lookahead)
+    return float(np.sum(wt[ok]))
 
 
 def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, approach_pose,
@@ -114,7 +129,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
                         confidence: float = 0.95, max_rotation: float = math.radians(120.0),
                         direction: int | None = None, check_every: int = 5, lookahead: float = math.radians(15.0),
                         bridge_jump: float = 3.0, end_margin: float = 5.0, backoff: float = 2.0,
-                        switch_ratio: float = 3.0, observer=None, **press_options) -> ReactiveRun:
+                        min_spread: float = 0.05, observer=None, **press_options) -> ReactiveRun:
     """Roll until the contact is known within the filter's radius with ``confidence`` (module notes).
 
     Parameters
@@ -133,9 +148,10 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         Steps between checks of the stopping and direction rules.
     lookahead : float, rad
         Rotation over which the direction rule compares the two ways.
-    switch_ratio : float
-        The direction rule turns round when the other way's unexplored window spreads the
-        hypotheses this many times more than the window ahead.
+    min_spread : float, mm
+        The direction rule turns round when the window ahead separates the two leading
+        modes' predicted arcs by less than this and the other way's window by more than
+        three times this (0: never turn round by choice).
     bridge_jump : float, mm
         A step whose contact moves more than this on the jaw has bridged a concavity.
     end_margin : float, mm
@@ -251,11 +267,19 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             if belief.mass >= confidence:
                 stopped = "confident"
                 break
-            # the direction rule: turn round when the unexplored curvature the other way
-            # separates the probable hypotheses much better than what lies ahead
-            ccw, cw = spread_by_direction(flt, lookahead, tuple(explored))
+            # a concavity ahead for most of the belief: turn round before bridging it
+            if not blocked[-direction] and clear_ahead(flt, direction, lookahead) < 0.5:
+                direction = -direction
+                reversals += 1
+                continue
+            # the direction rule: when rolling on cannot separate the two leading modes, turn
+            # round if the unexplored curvature the other way separates them better
+            strong = [m for m in belief.modes if m.mass >= flt.mode_floor]
+            if len(strong) < 2 or blocked[-direction]:
+                continue
+            ccw, cw = spread_by_direction(flt, lookahead, tuple(explored), [m.start_arc for m in strong[:2]])
             ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
-            if behind > switch_ratio * ahead and not blocked[-direction]:
+            if ahead < min_spread and behind > 3 * min_spread:
                 direction = -direction
                 reversals += 1
     if belief is None or belief.steps != flt.steps:
