@@ -319,8 +319,10 @@ class ContactFilter:
 
         The contact is where the net rotation ``turn`` (rad) puts it, but the next
         reading starts a new segment with its own unknown offset (the arc across the
-        lift is not measured). ``arc`` (mm) is the cumulative arc the caller will
-        continue from; any value works, the new offset absorbs it.
+        lift is not measured). ``arc`` (mm) is the cumulative arc to continue from:
+        pass the last reading's, since the contact has not moved along the part. The
+        new offset absorbs any error in it; it also places the reading on the slope
+        error's basis, so it should be right to a few mm.
         """
         if self._segment + 1 >= self._segments:
             raise QueryError(f"more than {self._segments - 1} regrasps in one localization")

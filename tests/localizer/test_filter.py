@@ -1,0 +1,157 @@
+"""The sequential filters: the grid filter's posterior against known answers, the particle filter
+against the grid filter."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from localizer import ContactFilter, ParticleFilter, QueryError, load_part, machining_slope, part_from_points
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+STEP = math.radians(0.2)
+
+
+@pytest.fixture(scope="module")
+def cam():
+    return load_part(PARTS / "cam.json")
+
+
+def readings(flt, start_arc, turns, rng=None, sd=0.0):
+    """Cumulative arcs a true start would give (from the filter's own tracks), plus noise."""
+    i = int(round(start_arc / flt.tracks.h)) % flt.grid.size
+    arcs, ok = flt.tracks.advance(np.full(len(turns), i), np.asarray(turns))
+    assert ok.all()
+    z = arcs - flt.grid[i]
+    if rng is not None:
+        e = sd * rng.standard_normal(len(z) + 1)
+        z = z + e[1:] - e[0]
+    return z, arcs
+
+
+def feed(flt, z, turns):
+    for a, t in zip(z, turns):
+        flt.update(float(a), float(t))
+
+
+def test_noise_free_posterior_concentrates_at_the_truth(cam):
+    flt = ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0)
+    turns = STEP * np.arange(1, 176)                      # 35°, the paper's total
+    z, arcs = readings(flt, 57.3, turns)
+    feed(flt, z, turns)
+    b = flt.belief()
+    assert abs(cam.arc_offset(b.map_arc, arcs[-1])) < 0.03
+    assert b.mass > 0.99 and b.informative and not b.ambiguous
+    assert len(b.modes) >= 1 and abs(cam.arc_offset(b.modes[0].start_arc, 57.3)) < 0.03
+
+
+def test_noisy_posterior_covers_the_truth_and_sharpens_with_rotation(cam):
+    rng = np.random.default_rng(4)
+    flt = ContactFilter(cam, sd_position=0.035, sd_scale=0.0, sd_slope=0.0)
+    turns = STEP * np.arange(1, 451)                      # 90°
+    z, arcs = readings(flt, 140.0, turns, rng, 0.035)
+    masses = []
+    for k, (a, t) in enumerate(zip(z, turns)):
+        flt.update(float(a), float(t))
+        if (k + 1) % 150 == 0:
+            masses.append(flt.belief().mass)
+    b = flt.belief()
+    assert abs(cam.arc_offset(b.map_arc, arcs[-1])) < 0.3
+    assert masses[0] < masses[-1]
+
+
+def test_on_a_circle_the_belief_stays_flat_and_says_so():
+    a = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    circle = part_from_points(np.c_[25 * np.cos(a), 25 * np.sin(a)], name="circle")
+    flt = ContactFilter(circle, sd_position=0.02)
+    turns = STEP * np.arange(1, 101)
+    z = 25.0 * turns                                      # what any start gives on a circle
+    feed(flt, z, turns)
+    b = flt.belief()
+    assert not b.informative and not b.ambiguous
+    w = flt.posterior()
+    assert w.max() / w[w > 0].min() < 1.05                # uniform
+    assert b.mass < 0.01
+
+
+def test_on_an_ellipse_it_reports_the_two_symmetric_modes():
+    part = load_part(PARTS / "ellipse.json")
+    flt = ContactFilter(part, sd_position=0.04, sd_scale=0.0, sd_slope=0.0)   # wider than the grid step
+    turns = STEP * np.arange(1, 151)
+    start = 0.3 * part.perimeter
+    z, arcs = readings(flt, start, turns)
+    feed(flt, z, turns)
+    b = flt.belief()
+    assert b.ambiguous and b.informative
+    m1, m2 = b.modes[:2]
+    assert m1.mass == pytest.approx(0.5, abs=0.05) and m2.mass == pytest.approx(0.5, abs=0.05)
+    half = abs(part.arc_offset(m1.arc, m2.arc))
+    assert half == pytest.approx(part.perimeter / 2, abs=0.2)
+    assert min(abs(part.arc_offset(m.arc, arcs[-1])) for m in (m1, m2)) < 0.1
+
+
+def test_a_regrasp_offset_is_absorbed(cam):
+    # without the slope nuisance (whose basis is placed by z) the new segment's offset absorbs any jump
+    turns = STEP * np.arange(1, 101)
+    lls = []
+    for jump in (0.0, 7.5):
+        flt = ContactFilter(cam, sd_position=0.02, sd_slope=0.0)
+        z, _ = readings(flt, 90.0, turns)
+        feed(flt, z[:50], turns[:50])
+        flt.regrasp(z[49] + jump, turns[49])              # the arc across a lift is unknown
+        feed(flt, z[50:] + jump, turns[50:])
+        lls.append(flt.log_likelihood())
+    fin = np.isfinite(lls[0])
+    assert np.array_equal(fin, np.isfinite(lls[1]))
+    assert np.allclose(lls[0][fin], lls[1][fin], atol=1e-3)   # the offsets' prior is flat to 1e6 mm²
+
+
+def test_a_start_off_the_hull_is_not_a_hypothesis():
+    kidney = load_part(PARTS / "kidney.csv")
+    flt = ContactFilter(kidney)
+    # the deepest point of the concavity is far inside the hull
+    s = np.arange(0, kidney.perimeter, 0.5)
+    k = np.asarray(kidney.curvature_at_arc(s))
+    deepest = s[np.argmin(k)]
+    i = int(round(deepest / flt.tracks.h))
+    assert not flt.feasible[i]
+    assert flt.feasible.mean() < 1.0 and flt.feasible.mean() > 0.5
+
+
+def test_many_particles_agree_with_the_grid_filter(cam):
+    rng = np.random.default_rng(11)
+    grid = ContactFilter(cam, sd_position=0.04, sd_scale=0.0, sd_slope=0.0)
+    pf = ParticleFilter(cam, particles=60000, sd_position=0.04, process=0.0005, seed=3)
+    turns = STEP * np.arange(1, 176)
+    z, arcs = readings(grid, 200.0, turns, rng, 0.04)
+    for a, t in zip(z, turns):
+        grid.update(float(a), float(t))
+        pf.update(float(a), float(t))
+    b = grid.belief()
+    est, mass = pf.estimate()
+    assert abs(cam.arc_offset(est, b.map_arc)) < 0.15
+    assert mass == pytest.approx(b.mass, abs=0.2)
+
+
+def test_machining_slope_of_one_harmonic():
+    # one harmonic: amplitude √2·rms, slope amplitude √2·rms·2π/P, slope RMS rms·2π/P
+    assert machining_slope(0.01, 100.0, 100.0) == pytest.approx(0.01 * 2 * math.pi / 100.0)
+    assert machining_slope(0.0, 20.0, 300.0) == 0.0
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"spacing": 0}, "spacing=0"), ({"sd_position": -1}, "sd_position=-1"),
+    ({"sd_slope": float("nan")}, "sd_slope=nan"), ({"confidence": 1.0}, "confidence=1.0"),
+])
+def test_bad_filter_parameters(cam, kwargs, match):
+    with pytest.raises(QueryError, match=match):
+        ContactFilter(cam, **kwargs)
+
+
+def test_bad_readings(cam):
+    flt = ContactFilter(cam)
+    with pytest.raises(QueryError, match="arc=nan"):
+        flt.update(float("nan"), 0.0)
+    with pytest.raises(QueryError, match="particles=1"):
+        ParticleFilter(cam, particles=1)
