@@ -1,0 +1,103 @@
+"""Reactive localization on the simulated and the serial rig."""
+
+import math
+from pathlib import Path
+
+import pytest
+
+from driver.emulator import Emulator
+from driver.procedures import calibrate
+from driver.reactive import clear_ahead, localize_reactively, spread_by_direction
+from driver.rig import RigError
+from driver.serial_rig import SerialRig
+from localizer import ContactFilter, load_part
+from sim2d import SimRig
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+
+
+def calibration(part, noise="none"):
+    import numpy as np
+
+    t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
+    arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+    rig = SimRig(part, noise=noise, seed=99)
+    return calibrate(rig, rig.approach_pose(arc, jaw_position=0.0, standoff=1.0))
+
+
+@pytest.fixture(scope="module")
+def trefoil():
+    part = load_part(PARTS / "trefoil.json")
+    return part, calibration(part)
+
+
+def test_it_stops_when_sure_and_is_right(trefoil):
+    part, cal = trefoil
+    rig = SimRig(part, noise="none", seed=1)
+    flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
+    run = localize_reactively(rig, part, calibration=cal, filter=flt, confidence=0.95,
+                              approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
+    assert run.stopped == "confident" and run.belief.mass >= 0.95
+    assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
+    assert run.rotation < math.radians(120)
+    assert len(run.arcs) == len(run.turns) == len(run.true_arcs) == len(run.segments) == run.steps + 1
+
+
+def test_the_rotation_budget_stops_it(trefoil):
+    part, cal = trefoil
+    rig = SimRig(part, noise="none", seed=1)
+    run = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(2.0),
+                              approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
+    assert run.stopped == "max_rotation" and run.rotation == pytest.approx(math.radians(2.0), abs=1e-9)
+    assert run.steps == 10
+
+
+def test_on_an_ellipse_it_stays_ambiguous_and_says_so():
+    part = load_part(PARTS / "ellipse.json")
+    cal = calibration(part)
+    rig = SimRig(part, noise="none", seed=2)
+    flt = ContactFilter(part, sd_position=0.02, sd_scale=0.0, sd_slope=0.0)
+    run = localize_reactively(rig, part, calibration=cal, filter=flt, max_rotation=math.radians(30.0),
+                              approach_pose=rig.approach_pose(40.0, jaw_position=-40.0, standoff=1.0))
+    assert run.stopped == "max_rotation"
+    assert run.belief.ambiguous and len(run.belief.modes) >= 2
+    m1, m2 = run.belief.modes[:2]
+    assert abs(part.arc_offset(m1.arc, m2.arc)) == pytest.approx(part.perimeter / 2, abs=0.5)
+
+
+def test_direction_helpers_on_a_symmetric_belief():
+    part = load_part(PARTS / "ellipse.json")
+    flt = ContactFilter(part)
+    a = part.perimeter / 4
+    ccw, cw = spread_by_direction(flt, math.radians(15), starts=[a, a + part.perimeter / 2])
+    assert ccw < 0.005 and cw < 0.005                     # symmetric modes: grid rounding only
+    ccw, cw = spread_by_direction(flt, math.radians(15), starts=[a, a + 10.0])
+    assert ccw > 0.1 and cw > 0.1
+    assert clear_ahead(flt, 1, math.radians(15)) == pytest.approx(1.0)                 # convex all round
+
+
+def test_bad_arguments(trefoil):
+    part, cal = trefoil
+    rig = SimRig(part, seed=0)
+    pose = rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0)
+    for kwargs, match in (({"max_rotation": 0}, "max_rotation=0"), ({"direction": 2}, "direction=2"),
+                          ({"confidence": 1.0}, "confidence=1.0"), ({"step": -1}, "step=-1")):
+        with pytest.raises(RigError, match=match):
+            localize_reactively(rig, part, calibration=cal, approach_pose=pose, **kwargs)
+
+
+def test_the_serial_rig_gives_the_simulated_run(trefoil):
+    part, cal = trefoil
+    direct_rig = SimRig(part, noise="paper", seed=5)
+    pose = direct_rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0)
+    direct = localize_reactively(direct_rig, part, calibration=cal, max_rotation=math.radians(6.0), approach_pose=pose)
+    emu = Emulator(SimRig(part, noise="paper", seed=5))
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq) as rig:
+            serial = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(6.0), approach_pose=pose)
+    finally:
+        emu.close()
+    assert serial.steps == direct.steps
+    assert serial.arcs == pytest.approx(direct.arcs, abs=1e-9)
+    assert serial.estimate_arc == pytest.approx(direct.estimate_arc, abs=1e-9)
