@@ -284,6 +284,7 @@ class ContactFilter:
         self._segment = 0
         self._recent = [(0.0, 0.0)]           # (z, turn) of the last readings of this segment
         self._live = self.feasible.copy()     # hypotheses still worth evaluating
+        self._live_idx = np.flatnonzero(self._live)
         self._recent = []
         self._add_row(0.0, np.zeros(n))       # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
@@ -304,13 +305,19 @@ class ContactFilter:
         """
         if not (math.isfinite(arc) and math.isfinite(turn)):
             raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
-        current, ok = self.tracks.advance(self.index, turn)
-        self.feasible &= ok
-        self._live &= ok
-        p = np.where(ok, current - self.grid, 0.0)
-        self.current = np.where(ok, current, self.current)
+        # only the hypotheses still in the running are moved and summed (the pruned ones are
+        # never evaluated again)
+        idx = self._live_idx
+        current, ok = self.tracks.advance(idx, turn)
+        if not ok.all():
+            out = idx[~ok]
+            self.feasible[out] = False
+            self._live[out] = False
+            self._live_idx = np.flatnonzero(self._live)
+        p = np.where(ok, current - self.grid[idx], 0.0)
+        self.current[idx] = np.where(ok, current, self.current[idx])
         z = float(arc)
-        self._add_row(z, p, float(turn))
+        self._add_row(z, p, float(turn), idx)
         self.steps += 1
         self.turn, self.arc = float(turn), z
 
@@ -352,14 +359,16 @@ class ContactFilter:
         dt = abs(t1 - t0)
         return float(np.clip(abs(z1 - z0) / dt, 5.0, 500.0)) if dt > 0 else 500.0
 
-    def _add_row(self, z: float, p: np.ndarray, turn: float = 0.0) -> None:
+    def _add_row(self, z: float, p: np.ndarray, turn: float = 0.0, idx=None) -> None:
+        """Add a reading z with the predictions p of the hypotheses ``idx`` (default: all)."""
         self._recent = (self._recent + [(z, turn)])[-6:]
         cols, vals = self._basis(z)
+        sel = slice(None) if idx is None else idx
         for c, v in zip(cols, vals):
-            self._up[c] += v * p
+            self._up[c, sel] += v * p
         self._touched.update(int(c) for c in cols)
-        self._spp += p * p
-        self._szp += z * p
+        self._spp[sel] += p * p
+        self._szp[sel] += z * p
         self._uz[cols] += vals * z
         self._uu[np.ix_(cols, cols)] += np.outer(vals, vals)
         self._szz += z * z
@@ -387,7 +396,10 @@ class ContactFilter:
         ll[live] = ll_live
         if self.prune > 0 and live.size:
             # hypotheses this far below the best are dropped from later evaluations
-            self._live[live[ll_live < ll_live.max() - self.prune]] = False
+            drop = live[ll_live < ll_live.max() - self.prune]
+            if drop.size:
+                self._live[drop] = False
+                self._live_idx = np.flatnonzero(self._live)
         return ll
 
     def posterior(self) -> np.ndarray:

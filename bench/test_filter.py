@@ -1,0 +1,59 @@
+"""The sequential filters' cost per rolling step (target: well under 1 ms on a 100-knot part).
+
+Run: ``pytest bench/test_filter.py --benchmark-only``. Each benchmark feeds a filter a
+25° roll first (checking the belief every 5 steps, as the reactive procedure does, which
+prunes hypotheses 40 nats below the best), so that it is timed in the state it has
+mid-localization.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from localizer import ContactFilter, ParticleFilter, part_from_points
+
+STEP = math.radians(0.2)
+
+
+@pytest.fixture(scope="module")
+def part100():
+    """A smooth convex 100-knot part (an egg with a few lobes), about 240 mm round."""
+    a = np.linspace(0, 2 * np.pi, 100, endpoint=False)
+    r = 38 + 4 * np.cos(a) + 2.0 * np.cos(3 * a + 0.4) + 0.8 * np.sin(5 * a)
+    return part_from_points(np.c_[r * np.cos(a), r * np.sin(a)], name="egg100")
+
+
+def _roll(flt, part, start=40.0, steps=125):
+    i = int(round(start / flt.tracks.h))
+    turns = STEP * np.arange(1, steps + 1)
+    arcs, ok = flt.tracks.advance(np.full(steps, i), turns)
+    assert ok.all()
+    for k, (a, t) in enumerate(zip(arcs - flt.grid[i], turns)):
+        flt.update(float(a), float(t))
+        if isinstance(flt, ContactFilter) and k % 5 == 4:
+            flt.belief()          # as the reactive procedure checks every 5 steps (and prunes)
+    return float(arcs[-1] - flt.grid[i]), float(turns[-1])
+
+
+def test_grid_filter_update(benchmark, part100):
+    flt = ContactFilter(part100)
+    z, turn = _roll(flt, part100)
+    benchmark.extra_info.update({"part": "egg100 (100 knots)", "hypotheses": int(flt.grid.size)})
+    benchmark(flt.update, z, turn)
+
+
+def test_grid_filter_belief(benchmark, part100):
+    flt = ContactFilter(part100)
+    _roll(flt, part100)
+    b = benchmark(flt.belief)
+    assert abs(part100.arc_offset(b.map_arc, flt.current[int(round(40.0 / flt.tracks.h))])) < 0.05
+
+
+@pytest.mark.parametrize("particles", [2000, 20000])
+def test_particle_filter_update(benchmark, part100, particles):
+    pf = ParticleFilter(part100, particles=particles, seed=1)
+    grid = ContactFilter(part100)
+    z, turn = _roll(grid, part100)
+    benchmark.extra_info.update({"particles": particles})
+    benchmark(pf.update, z, turn)
