@@ -105,6 +105,11 @@ def test_dask_local_cluster_gives_the_same_table(reference):
     ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v2_noise"\nvalues = [-1.0]', "must be >= 0"),
     ('parts = ["{cam}"]\nrolls_deg = [20.0]\nnoise = "lab"', "noise"),
     ('parts = [', "not valid TOML"),
+    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["paper", "oracle"]', "methods .* distinct names"),
+    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "paper"\nmethods = ["paper"]', "not both"),
+    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\nconfidence = 1.5',
+     "confidence=1.5 must be below 1"),
+    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2', r"unknown key\(s\) \['speed'\]"),
 ])
 def test_bad_study_files(tmp_path, text, match):
     f = tmp_path / "bad.toml"
@@ -127,8 +132,24 @@ def test_wilson_interval():
 
 
 def test_shipped_studies_load():
-    for name in ("paper", "arc_length", "rotation", "machining"):
+    for name in ("paper", "arc_length", "rotation", "machining", "reactive"):
         s = load_study(ROOT / "bench" / "studies" / f"{name}.toml")
         assert s.trials > 0
     paper = load_study(ROOT / "bench" / "studies" / "paper.toml")
     assert paper.method == "paper" and paper.noise == "paper" and paper.rolls_deg == (20.0, 15.0)
+
+
+def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
+    from bench.cli import main
+
+    out = tmp_path / "r"
+    assert main(["montecarlo", str(ROOT / "bench" / "studies" / "reactive.toml"), "--out", str(out),
+                 "--trials", "2", "--engine", "kinematic", "--workers", "1"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary["methods"]) == {"paper", "particle", "reactive"}
+    assert all(0.0 <= r <= 1.0 for r in summary["methods"].values())
+    rows = read_trials(out / "trials.csv")
+    assert len(rows) == 2 and all(f"{m}_curve" in rows[0] for m in summary["methods"])
+    for r in rows:  # the paper method's row is the study's own result
+        assert r["success"] == r["paper_success"] and float(r["reactive_rotation_deg"]) > 0
+    assert (out / "methods.png").exists()
