@@ -66,8 +66,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("part", help="part file")
     sim.add_argument("--start", type=float, required=True, metavar="MM",
                      help="arc position of the first contact, mm counter-clockwise from the part's first point")
-    sim.add_argument("--roll", type=float, action="append", required=True, metavar="DEG",
-                     help="a roll's rotation, degrees (positive: counter-clockwise); repeat for more rolls")
+    sim.add_argument("--roll", type=float, action="append", metavar="DEG",
+                     help="a roll's rotation, degrees (positive: counter-clockwise); repeat for more rolls "
+                          "(required unless --reactive)")
     sim.add_argument("--noise", default="paper", metavar="none|paper|FILE.toml",
                      help="noise model: a preset or a TOML file (default paper)")
     sim.add_argument("--engine", choices=("pymunk", "kinematic"), default="pymunk",
@@ -75,6 +76,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     sim.add_argument("--step", type=_positive, default=0.2, metavar="DEG", help="rolling step, degrees (default 0.2)")
     _servo_arguments(sim)
+    _reactive_arguments(sim)
     sim.add_argument("--out", required=True, metavar="TRACE.npz", help="trace file to write")
     sim.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
     sim.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -119,6 +121,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="a roll's rotation in degrees; repeat (default 20 then 15)")
     run.add_argument("--step", type=_positive, default=0.2, metavar="DEG", help="rolling step (default 0.2°)")
     _servo_arguments(run)
+    _reactive_arguments(run)
     run.add_argument("--log", metavar="FILE.jsonl", help="run log, JSON Lines, flushed per sample")
     run.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses and the estimate")
     run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
@@ -139,6 +142,53 @@ def _servo_arguments(p) -> None:
                         "for 0.3 s, refusing a loop that loses the part or rings above 0.05 V (docs/passivity.md); default: no servo")
     p.add_argument("--no-guard", action="store_true",
                    help="run that servo without its passivity observer/controller")
+
+
+def _reactive_arguments(p) -> None:
+    """--reactive and its options: roll until the belief is sure (driver.reactive)."""
+    p.add_argument("--reactive", action="store_true",
+                   help="instead of fixed rolls, roll step by step until the contact is known within 0.3 mm "
+                        "with --confidence, or --max-rotation is rolled (docs/robustness.md)")
+    p.add_argument("--confidence", type=_positive, default=0.95, metavar="P",
+                   help="reactive: probability within 0.3 mm that stops the rolling (default 0.95)")
+    p.add_argument("--max-rotation", type=_positive, default=240.0, metavar="DEG",
+                   help="reactive: rotation budget, both directions counted (default 240°)")
+
+
+def _reactive(args, rig, part, calibration, approach_pose, observer=None) -> dict:
+    """Run the reactive localization on ``rig``; the JSON object of 'simulate|run --reactive'."""
+    from driver.reactive import localize_reactively
+    from localizer import ContactFilter
+
+    if not 0 < args.confidence < 1:
+        raise RigError(f"--confidence {args.confidence} must be between 0 and 1")
+    res = localize_reactively(rig, part, calibration=calibration, filter=ContactFilter(part),
+                              approach_pose=approach_pose, step=math.radians(args.step),
+                              confidence=args.confidence, max_rotation=math.radians(args.max_rotation),
+                              observer=observer, **_servo_option(args))
+    b = res.belief
+    doc = {"part": part.name, "method": "reactive", "estimate_arc": b.map_arc, "mass": b.mass,
+           "ambiguous": b.ambiguous, "informative": b.informative, "stopped": res.stopped,
+           "rotation_deg": math.degrees(res.rotation), "steps": res.steps, "reversals": res.reversals,
+           "regrasps": res.regrasps, "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]]}
+    truth = getattr(rig, "truth", None)
+    if truth is not None:
+        true_arc = truth()["contact_arc"]
+        doc["true_arc"] = true_arc
+        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
+    return doc, res
+
+
+def _print_reactive(doc) -> None:
+    verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
+    print(f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
+          f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)")
+    print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within 0.3 mm")
+    for m in doc["modes"][1:3]:
+        print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")
+    if doc.get("error_mm") is not None:
+        err = doc["error_mm"]
+        print(f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)")
 
 
 def _servo_option(args) -> dict:
@@ -206,7 +256,9 @@ def _simulate(args) -> int:
 
     part = load_part(args.part)
     noise = load_noise(args.noise)
-    rolls = [math.radians(r) for r in args.roll]
+    if not args.roll and not args.reactive:
+        raise RigError("give the rolls (--roll DEG, repeated) or --reactive")
+    rolls = [math.radians(r) for r in (args.roll or [20.0])]
     if not 0 <= args.start < part.perimeter:
         raise LocalizerError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
     # calibrate on the part's most curved point (on the hull), with its own rig instance
@@ -216,6 +268,19 @@ def _simulate(args) -> int:
     calibration = calibrate(cal_rig, cal_rig.approach_pose(cal_arc, jaw_position=0.0, standoff=1.0))
     rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine)
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
+    if args.reactive:
+        doc, res = _reactive(args, rig, part, calibration,
+                             rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0))
+        np.savez(args.out, arcs=np.array(res.arcs), turns=np.array(res.turns), true_arcs=np.array(res.true_arcs),
+                 segments=np.array(res.segments), history=np.array(res.history, dtype=float).reshape(-1, 4),
+                 metadata=np.array(json.dumps({**doc, "noise": str(args.noise), "seed": args.seed,
+                                               "engine": args.engine, "start_arc": args.start})))
+        doc["trace"] = str(args.out)
+        print(json.dumps(doc, indent=2) if args.json else "", end="\n" if args.json else "")
+        if not args.json:
+            _print_reactive(doc)
+            print(f"readings written to {args.out}")
+        return 0
     run = localize_by_rolling(rig, part, rolls, calibration=calibration, step=math.radians(args.step),
                               approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0),
                               **_servo_option(args))
@@ -371,6 +436,8 @@ def _run(args) -> int:
             log(event)
         _progress(event)
 
+    if args.reactive:
+        return _run_reactive(args, part, calibration, log, observer)
     try:
         with SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
             run, calibration = run_from_here(rig, part, [math.radians(r) for r in rolls], calibration=calibration,
@@ -390,6 +457,44 @@ def _run(args) -> int:
         log({"event": "result", **doc})
         log.close()
     _emit_run(args, doc, part, trace, run.localization)
+    return 0
+
+
+def _run_reactive(args, part, calibration, log, observer) -> int:
+    """'run --reactive': from the present pose, calibrate if needed, slide 40 mm, roll until sure."""
+    from driver.procedures import Hand, calibrate
+    from driver.serial_rig import SerialRig
+
+    def progress(event):
+        observer(event)
+        if event.get("event") == "belief":
+            sys.stderr.write(f"\rrolled {math.degrees(event['rotation']):6.1f}°  best {event['map_arc']:8.2f} mm  "
+                             f"{event['mass']:6.1%} within 0.3 mm ")
+            sys.stderr.flush()
+
+    try:
+        with SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+            here = tuple(rig.pose())
+            if calibration is None:
+                calibration = calibrate(rig, here)
+                Hand(rig, here)
+            x, y, phi = here
+            start = (x + 40.0 * math.cos(phi), y + 40.0 * math.sin(phi), phi)  # as run_from_here: contact at -40 mm
+            doc, _ = _reactive(args, rig, part, calibration, start, observer=progress)
+        sys.stderr.write("\n")
+    except BaseException as exc:
+        sys.stderr.write("\n")
+        if log is not None:
+            log({"event": "error", "message": str(exc) or type(exc).__name__})
+            log.close()
+        raise
+    if log is not None:
+        log({"event": "result", **doc})
+        log.close()
+    if args.json:
+        print(json.dumps(doc, indent=2))
+    else:
+        _print_reactive(doc)
     return 0
 
 

@@ -101,3 +101,32 @@ def test_the_serial_rig_gives_the_simulated_run(trefoil):
     assert serial.steps == direct.steps
     assert serial.arcs == pytest.approx(direct.arcs, abs=1e-9)
     assert serial.estimate_arc == pytest.approx(direct.estimate_arc, abs=1e-9)
+
+
+def test_cli_simulate_and_run_reactive(tmp_path, capsys):
+    import json
+
+    from driver.cli import main
+
+    part_file = str(PARTS / "trefoil.json")
+    assert main(["simulate", part_file, "--start", "211.1", "--reactive", "--engine", "kinematic",
+                 "--out", str(tmp_path / "r.npz"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    for key in ("estimate_arc", "mass", "stopped", "rotation_deg", "modes", "true_arc", "error_mm"):
+        assert key in doc
+    assert doc["error_mm"] < 0.3
+    part = load_part(part_file)
+    rig = SimRig(part, noise="paper", seed=3)
+    # the operator's jog: the jaw's centre facing the start point, 1 mm off (run_from_here then slides)
+    emu = Emulator(rig, start_pose=rig.approach_pose(211.1, jaw_position=0.0, standoff=1.0))
+    arm, daq = emu.serve_tcp(0)
+    try:
+        rc = main(["run", part_file, "--arm", arm, "--daq", daq, "--reactive", "--max-rotation", "3",
+                   "--log", str(tmp_path / "run.jsonl"), "--json"])
+    finally:
+        emu.close()
+    assert rc == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["stopped"] in ("max_rotation", "confident") and doc["rotation_deg"] <= 3.0 + 1e-9
+    events = [json.loads(x) for x in (tmp_path / "run.jsonl").read_text().splitlines()]
+    assert any(e.get("event") == "belief" for e in events) and events[-1]["event"] == "result"
