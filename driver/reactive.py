@@ -178,6 +178,14 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
     def read():
         return _location(rig, baseline, calibration, n, readings, truth, hand)
 
+    def pressed() -> bool:
+        """Press back to the force; False when the press was refused (overload, no contact)."""
+        try:
+            press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+            return True
+        except RigError:
+            return False
+
     d_prev = read()
     phi0 = rig.pose()[2]
     z, rotation, steps, reversals, regrasps = 0.0, 0.0, 0, 0, 0
@@ -193,12 +201,11 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
     while rotation < max_rotation - 1e-12:
         s = direction * step
         hand.rotate_by(s)
-        press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
         rotation += step
         try:
-            d = read()
+            d = read() if pressed() else math.inf
         except RigError:
-            d = math.inf  # left the calibrated span
+            d = math.inf  # left the calibrated span, or the press was refused: treated as a bridge
         bridged = abs(d - d_prev) > bridge_jump or not math.isfinite(d)
         regrasped = False
         if not bridged and abs(d) > jaw_limit:
@@ -208,9 +215,8 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             slide = d - target_d
             hand.press_by(-backoff)
             hand.slide_by(slide)
-            press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
             try:
-                d_new = read()
+                d_new = read() if pressed() else math.inf
             except RigError:
                 d_new = math.inf
             if abs(d_new - target_d) <= bridge_jump:
@@ -224,14 +230,15 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
                 # on the hull; put the jaw back and treat it as a bridge
                 hand.press_by(-backoff)
                 hand.slide_by(-slide)
-                press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+                pressed()
                 bridged = True
         if bridged:
             # bridged a concavity: roll back, re-read, and go the other way
             hand.rotate_by(-s)
-            press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
             rotation += step
             try:
+                if not pressed():
+                    raise RigError("the press back was refused")
                 d_prev = read()
             except RigError:
                 stopped = "lost"
