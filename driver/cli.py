@@ -7,6 +7,7 @@ at this edge; lengths are in mm.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import sys
@@ -438,18 +439,10 @@ def _run(args) -> int:
 
     if args.reactive:
         return _run_reactive(args, part, calibration, log, observer)
-    try:
-        with SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
-            run, calibration = run_from_here(rig, part, [math.radians(r) for r in rolls], calibration=calibration,
-                                             step=math.radians(args.step), observer=observer,
-                                             **_servo_option(args))
-        sys.stderr.write("\n")
-    except BaseException as exc:
-        sys.stderr.write("\n")
-        if log is not None:
-            log({"event": "error", "message": str(exc) or type(exc).__name__})
-            log.close()
-        raise
+    with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+        run, calibration = run_from_here(rig, part, [math.radians(r) for r in rolls], calibration=calibration,
+                                         step=math.radians(args.step), observer=observer,
+                                         **_servo_option(args))
     trace = Trace.from_run(run, calibration, part=header["part"], arm=args.arm, daq=args.daq,
                            rolls_deg=rolls, step_deg=args.step, engine="serial")
     doc = _run_summary(part, trace, run.localization)
@@ -458,6 +451,20 @@ def _run(args) -> int:
         log.close()
     _emit_run(args, doc, part, trace, run.localization)
     return 0
+
+
+@contextlib.contextmanager
+def _ending_progress_line(log):
+    """End the progress line on stderr; on any failure log it and close the run log, then re-raise."""
+    try:
+        yield
+        sys.stderr.write("\n")
+    except BaseException as exc:
+        sys.stderr.write("\n")
+        if log is not None:
+            log({"event": "error", "message": str(exc) or type(exc).__name__})
+            log.close()
+        raise
 
 
 def _run_reactive(args, part, calibration, log, observer) -> int:
@@ -472,22 +479,14 @@ def _run_reactive(args, part, calibration, log, observer) -> int:
                              f"{event['mass']:6.1%} within 0.3 mm ")
             sys.stderr.flush()
 
-    try:
-        with SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
-            here = tuple(rig.pose())
-            if calibration is None:
-                calibration = calibrate(rig, here)
-                Hand(rig, here)
-            x, y, phi = here
-            start = (x + 40.0 * math.cos(phi), y + 40.0 * math.sin(phi), phi)  # as run_from_here: contact at -40 mm
-            doc, _ = _reactive(args, rig, part, calibration, start, observer=progress)
-        sys.stderr.write("\n")
-    except BaseException as exc:
-        sys.stderr.write("\n")
-        if log is not None:
-            log({"event": "error", "message": str(exc) or type(exc).__name__})
-            log.close()
-        raise
+    with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+        here = tuple(rig.pose())
+        if calibration is None:
+            calibration = calibrate(rig, here)
+            Hand(rig, here)
+        x, y, phi = here
+        start = (x + 40.0 * math.cos(phi), y + 40.0 * math.sin(phi), phi)  # as run_from_here: contact at -40 mm
+        doc, _ = _reactive(args, rig, part, calibration, start, observer=progress)
     if log is not None:
         log({"event": "result", **doc})
         log.close()
