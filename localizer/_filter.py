@@ -119,6 +119,25 @@ def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
     return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k ** 2)))
 
 
+_TRACKS: dict = {}
+
+
+def tracks_for(part: Part, spacing: float) -> "ModeTracks":
+    """The part's :class:`ModeTracks` at ``spacing`` mm, built once per part and spacing.
+
+    Building them takes most of a second (the dense sample, its convex hull, the banded
+    tangent-angle table); a Monte Carlo trial makes a grid filter and a particle filter on
+    the same part. The tables are read-only, so the filters can share them.
+    """
+    key = (part.points.tobytes(), part.cells_per_piece, float(spacing))
+    tracks = _TRACKS.get(key)
+    if tracks is None:
+        if len(_TRACKS) >= 8:
+            _TRACKS.pop(next(iter(_TRACKS)))
+        tracks = _TRACKS[key] = ModeTracks(part, spacing)
+    return tracks
+
+
 class ModeTracks:
     """Where each of a set of hypotheses' contacts goes under further rotation (for planning)."""
 
@@ -172,6 +191,9 @@ class ModeTracks:
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
         self.hull = depth > -hull_tolerance
         self.convex = rising[a][self._run] & (kappa > 0) & self.hull
+        for arr in (self.sigma, self.theta, self.kappa, self.hull, self.convex, self._s, self._banded,
+                    self._first, self._last, self._run):
+            arr.setflags(write=False)
 
     def advance(self, index: np.ndarray, turn: float) -> tuple:
         """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``.
@@ -244,7 +266,7 @@ class ContactFilter:
         if not 0 < confidence < 1:
             raise QueryError(f"confidence={confidence!r} must be in (0, 1)")
         self.part = part
-        self.tracks = ModeTracks(part, spacing)
+        self.tracks = tracks_for(part, spacing)
         self.sd_position = float(sd_position)
         self.sd_scale = float(sd_scale)
         self.sd_slope = float(sd_slope)
@@ -505,7 +527,7 @@ class ParticleFilter:
         if not (math.isfinite(process) and process >= 0):
             raise QueryError(f"process={process!r} mm must be ≥ 0")
         self.part = part
-        self.tracks = ModeTracks(part, spacing)
+        self.tracks = tracks_for(part, spacing)
         self.n = int(particles)
         self.sd_position = float(sd_position)
         self.process = float(process)
