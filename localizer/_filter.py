@@ -20,11 +20,19 @@ calibration's scale (b ~ N(1, sd_scale²)), and ρ̂·η is the machining error'
 effect: a slope error η of the real boundary against its model (rad) moves the
 contact for a given jaw angle by ρ·η, ρ the radius of curvature there. η is a
 smooth random function along the path, cubic B-splines in z with knots every
-``shape_spacing`` mm and coefficients ~ N(0, sd_slope²), and ρ̂_j is the radius
-the readings themselves show (arc over rotation over the last few steps), the
-same for every hypothesis. This error repeats when the jaw rolls over the same
+``shape_spacing`` mm and coefficients ~ N(0, sd_slope²), and ρ̂_j is the model's
+radius of curvature at the present contact of a reference hypothesis, the most
+probable one (re-chosen every ``refresh`` readings; the part's median radius
+before the first), the same for every hypothesis. ρ̂ must not be measured from
+the readings themselves (arc over rotation over the last few steps, as the first
+version did): that puts the reading noise into the basis, and the slope term
+then fitted the noise and moved the start, by up to 0.5 mm at a stated 99%
+(docs/robustness.md). This error repeats when the jaw rolls over the same
 stretch again, so more rolling does not average it away; near an inflection,
 where ρ grows without bound, it makes the readings say little, as they should.
+The same term at the last reading is how far the real present contact is from
+where the model puts it (:meth:`ContactFilter.shift`); the belief includes it
+and its spread.
 c, b and η are integrated out in closed form (Woodbury): each hypothesis keeps
 running sums (pᵀp, pᵀz and the basis projections Uᵀp, of which a reading
 touches five), so one step costs a few vector operations on the grid, and the
@@ -53,6 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import ConvexHull
+from scipy.special import ndtr
 
 from ._errors import QueryError
 from ._part import Part
@@ -238,6 +247,13 @@ class ContactFilter:
         Success radius of :meth:`belief`.
     mode_floor : float
         Probability a mode needs to count in ``ambiguous``.
+    confidence : float
+        Probability the leading mode needs for the belief not to be ``ambiguous``.
+    prune : float
+        Hypotheses this many nats below the best are no longer evaluated.
+    refresh : int
+        Readings between choices of the reference hypothesis whose radius of
+        curvature scales the slope-error term (each choice evaluates the likelihood).
 
     Examples
     --------
@@ -254,7 +270,7 @@ class ContactFilter:
 
     def __init__(self, part: Part, *, spacing: float = 0.02, sd_position: float = 0.035, sd_scale: float = 0.003,
                  sd_slope: float = 0.001, shape_spacing: float = 5.0, radius: float = 0.3, mode_floor: float = 0.05,
-                 confidence: float = 0.95, prune: float = 40.0):
+                 confidence: float = 0.95, prune: float = 40.0, refresh: int = 5):
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")
@@ -265,6 +281,8 @@ class ContactFilter:
             raise QueryError(f"shape_spacing={shape_spacing!r} mm must be positive")
         if not 0 < confidence < 1:
             raise QueryError(f"confidence={confidence!r} must be in (0, 1)")
+        if isinstance(refresh, bool) or not isinstance(refresh, (int, np.integer)) or refresh < 1:
+            raise QueryError(f"refresh={refresh!r} must be a whole number of readings ≥ 1")
         self.part = part
         self.tracks = tracks_for(part, spacing)
         self.sd_position = float(sd_position)
@@ -272,6 +290,10 @@ class ContactFilter:
         self.sd_slope = float(sd_slope)
         self.shape_spacing = float(shape_spacing)
         self.prune = float(prune)
+        self.refresh = int(refresh)
+        # before the first reference hypothesis: the median radius over the stretches a jaw touches
+        convex = self.tracks.kappa[self.tracks.convex]
+        self._rho_prior = float(np.clip(np.median(1.0 / convex), 5.0, 500.0)) if convex.size else 50.0
         # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
         self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
         self._segments = 16                   # offsets: one per contact segment (see regrasp)
@@ -306,10 +328,12 @@ class ContactFilter:
         self._szz = 0.0
         self._touched = {0}
         self._segment = 0
-        self._recent = [(0.0, 0.0)]           # (z, turn) of the last readings of this segment
         self._live = self.feasible.copy()     # hypotheses still worth evaluating
         self._live_idx = np.flatnonzero(self._live)
-        self._recent = []
+        self._ref = None                      # the hypothesis whose radius scales the slope term
+        self._version = 0                     # readings added (the log-likelihood cache's key)
+        self._cached = None
+        self._last_row = None
         self._add_row(0.0, np.zeros(n))       # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
@@ -341,9 +365,11 @@ class ContactFilter:
         p = np.where(ok, current - self.grid[idx], 0.0)
         self.current[idx] = np.where(ok, current, self.current[idx])
         z = float(arc)
-        self._add_row(z, p, float(turn), idx)
+        self._add_row(z, p, idx)
         self.steps += 1
         self.turn, self.arc = float(turn), z
+        if self.steps % self.refresh == 0:
+            self._ref = int(np.argmax(self.log_likelihood()))
 
     def regrasp(self, arc: float, turn: float) -> None:
         """The jaw was lifted and put back (e.g. slid along itself at the end of its span).
@@ -358,7 +384,6 @@ class ContactFilter:
         if self._segment + 1 >= self._segments:
             raise QueryError(f"more than {self._segments - 1} regrasps in one localization")
         self._segment += 1
-        self._recent = []
         self.update(arc, turn)
 
     def _basis(self, z: float) -> tuple:
@@ -373,20 +398,22 @@ class ContactFilter:
         cols = self._segments + self._k0 + i + np.arange(4)
         if cols[0] < self._segments or cols[-1] >= self._m:
             raise QueryError(f"arc={z!r} mm is more than a perimeter from the first reading")
-        return np.concatenate([seg, cols]), np.concatenate([[1.0], vals * self._radius_here(z)])
+        return np.concatenate([seg, cols]), np.concatenate([[1.0], vals * self._radius_here()])
 
-    def _radius_here(self, z: float) -> float:
-        """ρ̂, mm: arc over rotation across the last few readings of the segment (5 to 500 mm)."""
-        if len(self._recent) < 2:
-            return 50.0
-        (z0, t0), (z1, t1) = self._recent[0], self._recent[-1]
-        dt = abs(t1 - t0)
-        return float(np.clip(abs(z1 - z0) / dt, 5.0, 500.0)) if dt > 0 else 500.0
+    def _radius_here(self) -> float:
+        """ρ̂, mm: the model's radius of curvature at the reference hypothesis' present contact
+        (5 to 500 mm; the median convex radius before there is a reference)."""
+        if self._ref is None:
+            return self._rho_prior
+        t = self.tracks
+        k = t.kappa[int(np.rint(self.current[self._ref] / t.h)) % t.sigma.size]
+        return float(np.clip(1.0 / k, 5.0, 500.0)) if k > 0 else 500.0
 
-    def _add_row(self, z: float, p: np.ndarray, turn: float = 0.0, idx=None) -> None:
+    def _add_row(self, z: float, p: np.ndarray, idx=None) -> None:
         """Add a reading z with the predictions p of the hypotheses ``idx`` (default: all)."""
-        self._recent = (self._recent + [(z, turn)])[-6:]
+        self._version += 1
         cols, vals = self._basis(z)
+        self._last_row = (cols, vals)
         sel = slice(None) if idx is None else idx
         for c, v in zip(cols, vals):
             self._up[c, sel] += v * p
@@ -397,8 +424,18 @@ class ContactFilter:
         self._uu[np.ix_(cols, cols)] += np.outer(vals, vals)
         self._szz += z * z
 
-    def log_likelihood(self) -> np.ndarray:
-        """Log-likelihood of each start (−inf where infeasible or pruned), up to a constant."""
+    def _solved(self) -> dict:
+        """The marginalisation over the live hypotheses and their log-likelihoods, once per reading
+        (cached: the reference refresh, :meth:`belief` and :meth:`shift` share it)."""
+        if self._cached is None or self._cached["version"] != self._version:
+            s = self._solve()
+            s["version"] = self._version
+            s["ll"] = self._log_likelihood(s)
+            self._cached = s
+        return self._cached
+
+    def _solve(self) -> dict:
+        """The closed-form marginalisation over the live hypotheses (see the module notes)."""
         cols = np.array(sorted(self._touched))
         s2 = self.sd_position ** 2
         prior = np.full(cols.size, self.sd_slope ** 2)
@@ -412,7 +449,13 @@ class ContactFilter:
         qpp = (self._spp[live] - np.einsum("ij,ij->j", v, gi_v)) / s2
         qpz = (self._szp[live] - gi_wz @ v) / s2
         qzz = (self._szz - wz @ gi_wz) / s2
-        qrr = qzz - 2 * qpz + qpp
+        return {"cols": cols, "g": g, "live": live, "gi_v": gi_v, "gi_wz": gi_wz, "qpp": qpp, "qpz": qpz,
+                "qzz": qzz}
+
+    def _log_likelihood(self, s: dict) -> np.ndarray:
+        """Log-likelihood of each start from a :meth:`_solve`; prunes the hopeless ones."""
+        live, qpp, qpz = s["live"], s["qpp"], s["qpz"]
+        qrr = s["qzz"] - 2 * qpz + qpp
         t2 = self.sd_scale ** 2
         qpr = qpz - qpp
         ll_live = -0.5 * (qrr - t2 * qpr ** 2 / (1 + t2 * qpp) + np.log1p(t2 * qpp))
@@ -425,6 +468,43 @@ class ContactFilter:
                 self._live[drop] = False
                 self._live_idx = np.flatnonzero(self._live)
         return ll
+
+    def log_likelihood(self) -> np.ndarray:
+        """Log-likelihood of each start (−inf where infeasible or pruned), up to a constant."""
+        return self._solved()["ll"].copy()
+
+    def shift(self) -> tuple:
+        """How far the real present contact is from each hypothesis' nominal one, mm.
+
+        The slope error η moves the contact for a given jaw angle by ρ·η along the part
+        (module notes), so the readings' term ρ̂·η(z) at the last reading is also the
+        present contact's offset from where the model puts it. Given the start it is
+        Gaussian; with sd_slope = 0 it is zero.
+
+        Returns
+        -------
+        mean, sd : ndarray, mm
+            Over the grid (0 where infeasible or pruned).
+        """
+        s = self._solved()
+        n = self.grid.size
+        mean, sd = np.zeros(n), np.zeros(n)
+        if self.sd_slope <= 0:
+            return mean, sd
+        cols, live = s["cols"], s["live"]
+        a = np.zeros(cols.size)
+        row_cols, row_vals = self._last_row
+        a[np.searchsorted(cols, row_cols)] = row_vals
+        a[cols < self._segments] = 0.0                  # the offset is the reading's, not the contact's
+        t2 = self.sd_scale ** 2
+        qpr = s["qpz"] - s["qpp"]
+        d_mean = t2 * qpr / (1 + t2 * s["qpp"])         # the scale's posterior, b = 1 + δ
+        d_var = t2 / (1 + t2 * s["qpp"])
+        a_v = a @ s["gi_v"]
+        mean[live] = a @ s["gi_wz"] - (1 + d_mean) * a_v
+        var0 = self.sd_position ** 2 * float(a @ np.linalg.solve(s["g"], a))
+        sd[live] = np.sqrt(var0 + d_var * a_v ** 2)
+        return mean, sd
 
     def posterior(self) -> np.ndarray:
         """Posterior probability of each start (sums to 1)."""
@@ -440,10 +520,17 @@ class ContactFilter:
         radius = self.radius if radius is None else float(radius)
         part = self.part
         w = self.posterior()
-        present = part.wrap_arc(self.current)
+        mean, sd = self.shift()
+        present = part.wrap_arc(self.current + mean)
         i = int(np.argmax(w))
         map_arc = float(present[i])
-        mass = float(w[np.abs(part.arc_offset(present, map_arc)) <= radius].sum())
+        # each start's present contact is N(nominal + shift, sd²): the mass within ±radius of the MAP
+        sel = np.flatnonzero(w > 1e-12 * w[i])
+        off, s = np.asarray(part.arc_offset(present[sel], map_arc)), sd[sel]
+        spread = np.where(s > 0, s, 1.0)
+        inside = np.where(s > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread),
+                          np.abs(off) <= radius)
+        mass = float(np.sum(w[sel] * inside))
         modes = self._modes(w, present, radius)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
         prior /= prior.sum()
