@@ -19,7 +19,12 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
 5. when most of the belief says the contact will leave its convex stretch
    within ``lookahead``, turn round before the jaw bridges the concavity; a
    step that jumps along the jaw all the same has bridged it: it is undone (the
-   jaw rolls back one step), its reading is dropped, and the direction flips;
+   jaw rolls back one step), its reading is dropped, and the direction flips.
+   Rules 4 and 5 turn round only towards a way that is clear for ``lookahead``
+   beyond what has been rolled there; otherwise the jaw rolls on (a bridge is
+   safe: it is detected and undone). Without this the two rules can turn the
+   jaw back and forth every check, rolling in place (measured: 110 reversals
+   in one trial);
 6. at the end of the jaw's calibrated span the jaw is lifted, slid along
    itself and put back on the same point (a regrasp; the filter starts a new
    segment with its own offset), and rolling goes on the same way;
@@ -114,14 +119,16 @@ def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = 
     return tuple(out)
 
 
-def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, samples: int = 64) -> float:
+def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, at: float | None = None) -> float:
     """Probability that the jaw can roll ``lookahead`` rad further ``direction``-wise without the
-    contact leaving its convex stretch (over the most probable hypotheses)."""
+    contact leaving its convex stretch (over every hypothesis with weight).
+
+    ``at`` is the net rotation (rad) to roll on from (default: the present one).
+    """
     w = flt.posterior()
-    top = np.argsort(w)[-samples:]
-    wt = w[top] / w[top].sum()
-    _, ok = flt.tracks.advance(top, flt.turn + direction * lookahead)
-    return float(np.sum(wt[ok]))
+    top = np.flatnonzero(w > 1e-9 * w.max())
+    _, ok = flt.tracks.advance(top, (flt.turn if at is None else at) + direction * lookahead)
+    return float(np.sum(w[top][ok]) / np.sum(w[top]))
 
 
 def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, approach_pose,
@@ -274,19 +281,26 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             if belief.mass >= confidence:
                 stopped = "confident"
                 break
-            # a concavity ahead for most of the belief: turn round before bridging it
-            if not blocked[-direction] and clear_ahead(flt, direction, lookahead) < 0.5:
+            # a concavity ahead for most of the belief: turn round before bridging it, if the
+            # other way is clear beyond what has been rolled there (else roll on: a bridge is
+            # detected and undone all the same, and turning round towards a way that is no better
+            # only rocks the jaw in place)
+            beyond = explored[0] if direction == 1 else explored[1]
+            if (not blocked[-direction] and clear_ahead(flt, direction, lookahead) < 0.5
+                    and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5):
                 direction = -direction
                 reversals += 1
                 continue
             # the direction rule: when rolling on cannot separate the two leading modes, turn
-            # round if the unexplored curvature the other way separates them better
+            # round if the unexplored curvature the other way separates them better, and if that
+            # way is clear (else the rule above turns it straight back, and the jaw rocks)
             strong = [m for m in belief.modes if m.mass >= flt.mode_floor]
             if len(strong) < 2 or blocked[-direction]:
                 continue
             ccw, cw = spread_by_direction(flt, lookahead, tuple(explored), [m.start_arc for m in strong[:2]])
             ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
-            if ahead < min_spread and behind > 3 * min_spread:
+            if (ahead < min_spread and behind > 3 * min_spread
+                    and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5):
                 direction = -direction
                 reversals += 1
     if belief is None or belief.steps != flt.steps:
