@@ -190,3 +190,24 @@ def test_the_slope_term_does_not_fit_the_reading_noise(kidney):
         misses += err > 0.3
         overconfident += err > 0.3 and b.mass > 0.95
     assert misses <= 1 and overconfident == 0
+
+
+def test_the_shift_recovers_a_known_slope_error(cam):
+    # Readings from a part whose slope differs from the model by η(z) = 2e-3·sin(2πz/30 mm): the
+    # contact sits ρ·η from where the model puts it, and the readings carry that (module notes).
+    # The posterior of that term at the last reading must find it, within its stated spread.
+    flt = ContactFilter(cam, sd_position=0.01, sd_scale=0.0, sd_slope=0.002)
+    turns = STEP * np.arange(1, 451)                      # 90°
+    z_model, arcs = readings(flt, 57.3, turns)
+    rho = 1.0 / np.asarray(cam.curvature_at_arc(cam.wrap_arc(arcs)))
+    true_shift = rho * 0.002 * np.sin(2 * np.pi * z_model / 30.0)
+    feed(flt, z_model + true_shift, turns)
+    mean, sd = flt.shift()
+    i = int(np.argmax(flt.posterior()))
+    assert abs(cam.arc_offset(flt.grid[i], 57.3)) < 0.05
+    assert abs(mean[i] - true_shift[-1]) < 3 * sd[i] + 0.005
+    assert 0 < sd[i] < rho[-1] * 0.002
+    assert abs(true_shift[-1]) > 0.02                     # the test would see a shift ignored
+    nothing = ContactFilter(cam, sd_slope=0.0)
+    feed(nothing, z_model[:10], turns[:10])
+    assert not np.any(nothing.shift()[0]) and not np.any(nothing.shift()[1])
