@@ -2,6 +2,8 @@
 
 - ``paper`` / ``likelihood``: the fixed rolls' (L, Ω) and the localizer's rule.
 - ``particle``: :class:`localizer.ParticleFilter` over the fixed rolls' step-by-step readings.
+- ``grid``: :class:`localizer.ContactFilter` (the reactive method's filter) over the same readings:
+  what the filter alone does with the paper's 35°, without the reactive rolling.
 - ``reactive``: :func:`driver.reactive.localize_reactively` on a fresh rig with the same seed (the
   same machined part and noise) from the same start.
 
@@ -95,6 +97,19 @@ def score_paper(study, part, run, seq, rule: str) -> dict:
             "curve": curve}
 
 
+def _score_sequential(study, part, seq, update, estimate) -> dict:
+    """A filter fed the fixed rolls' readings one by one, its estimate at every 5° and at the end."""
+    marks = dict((k, m) for m, k in _marks(seq["turn"]))
+    curve = []
+    for j in range(1, len(seq["z"])):
+        update(float(seq["z"][j]), float(seq["turn"][j]))
+        if j in marks:
+            curve.append((marks[j], _err(part, estimate(), seq["truth"][j])))
+    est = estimate()
+    return {"estimate_arc": est, "error_mm": _err(part, est, seq["truth"][-1]),
+            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve}
+
+
 def score_particle(study, part, seq, seed: int) -> dict:
     """The particle filter over the fixed rolls' readings."""
     from localizer import ParticleFilter
@@ -102,15 +117,13 @@ def score_particle(study, part, seq, seed: int) -> dict:
     o = study.particle
     pf = ParticleFilter(part, particles=o.particles, sd_position=o.sd_position, process=o.process,
                         radius=study.success_radius, seed=seed)
-    marks = dict((k, m) for m, k in _marks(seq["turn"]))
-    curve = []
-    for j in range(1, len(seq["z"])):
-        pf.update(float(seq["z"][j]), float(seq["turn"][j]))
-        if j in marks:
-            curve.append((marks[j], _err(part, pf.estimate()[0], seq["truth"][j])))
-    est = pf.estimate()[0]
-    return {"estimate_arc": est, "error_mm": _err(part, est, seq["truth"][-1]),
-            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve}
+    return _score_sequential(study, part, seq, pf.update, lambda: pf.estimate()[0])
+
+
+def score_grid(study, part, noise, seq) -> dict:
+    """The reactive method's grid filter over the fixed rolls' readings (no reactive rolling)."""
+    flt = reactive_filter(study, part, noise)
+    return _score_sequential(study, part, seq, flt.update, lambda: flt.belief().map_arc)
 
 
 def reactive_filter(study, part, noise):
@@ -167,6 +180,8 @@ def score_methods(study, part, noise, cal, run, start: float, rig_seed: int, tru
                 r = score_paper(study, part, run, seq, m)
             elif m == "particle":
                 r = score_particle(study, part, seq, seed=rig_seed)
+            elif m == "grid":
+                r = score_grid(study, part, noise, seq)
             else:
                 r = score_reactive(study, part, noise, cal, start, rig_seed)
         except Exception:  # this method failed on this trial: a miss, the others still count

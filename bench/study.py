@@ -37,9 +37,11 @@ Several methods on the same trials (instead of ``method``)::
     sd_position = 0.04                   # mm, one reading
     process = 0.005                      # mm per step
 
-The paper and likelihood methods and the particle filter use the readings of
-the fixed rolls (``rolls_deg``); the reactive method rolls on its own, from the
-same start on a rig with the same seed.
+The paper and likelihood methods, the particle filter and ``grid`` (the reactive
+method's filter, :class:`localizer.ContactFilter` with the ``[reactive]`` settings,
+without the reactive rolling) use the readings of the fixed rolls
+(``rolls_deg``); the reactive method rolls on its own, from the same start on a
+rig with the same seed.
 
 Every trial is reproducible from (seed, level, trial): its generator is
 ``numpy.random.SeedSequence([seed, level, trial])``.
@@ -64,7 +66,7 @@ TRIAL_COLUMNS = ("level", "trial", "parameter", "value", "part", "start_arc", "t
 
 _KEYS = {"name", "parts", "rolls_deg", "step_deg", "method", "methods", "engine", "trials", "seed",
          "success_radius", "noise", "sweep", "likelihood", "reactive", "particle"}
-METHODS = ("paper", "likelihood", "particle", "reactive")
+METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
 METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve")
 

@@ -1,6 +1,7 @@
 """The Monte Carlo runner: reproducibility, resume, Dask, bad study files."""
 
 import json
+import math
 import signal
 import subprocess
 import sys
@@ -132,7 +133,7 @@ def test_wilson_interval():
 
 
 def test_shipped_studies_load():
-    for name in ("paper", "arc_length", "rotation", "machining", "reactive"):
+    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters"):
         s = load_study(ROOT / "bench" / "studies" / f"{name}.toml")
         assert s.trials > 0
     paper = load_study(ROOT / "bench" / "studies" / "paper.toml")
@@ -153,3 +154,22 @@ def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
     for r in rows:  # the paper method's row is the study's own result
         assert r["success"] == r["paper_success"] and float(r["reactive_rotation_deg"]) > 0
     assert (out / "methods.png").exists()
+
+
+def test_grid_method_scores_the_filter_on_the_fixed_readings(tmp_path):
+    from bench.cli import main
+
+    text = (ROOT / "bench" / "studies" / "filters.toml").read_text()
+    text = text.replace("../../parts/", str(ROOT / "parts") + "/").replace("particles = 200000", "particles = 500")
+    (tmp_path / "f.toml").write_text(text)
+    out = tmp_path / "f"
+    assert main(["montecarlo", str(tmp_path / "f.toml"), "--out", str(out), "--trials", "3", "--workers", "1"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary["methods"]) == {"paper", "particle", "grid"}
+    rows = read_trials(out / "trials.csv")
+    for r in rows:
+        assert float(r["grid_rotation_deg"]) == pytest.approx(35.0)
+        assert len(r["grid_curve"].split()) == 7                       # every 5° of the 35°
+        # the filter was fed the same readings as the paper's rule: it lands where the truth is
+        # or fails like a method, never as a broken trial
+        assert r["failure"] == "" and math.isfinite(float(r["grid_error_mm"]))
