@@ -50,7 +50,7 @@ def test_grid_filter_belief(benchmark, part100):
     assert abs(part100.arc_offset(b.map_arc, flt.current[int(round(40.0 / flt.tracks.h))])) < 0.05
 
 
-@pytest.mark.parametrize("particles", [2000, 20000])
+@pytest.mark.parametrize("particles", [2000, 20000, 200000])
 def test_particle_filter_update(benchmark, part100, particles):
     pf = ParticleFilter(part100, particles=particles, seed=1)
     grid = ContactFilter(part100)
