@@ -507,13 +507,19 @@ class ContactFilter:
         return mean, sd
 
     def posterior(self) -> np.ndarray:
-        """Posterior probability of each start (sums to 1)."""
-        ll = self.log_likelihood()
-        top = ll.max()
-        if not np.isfinite(top):
-            raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
-        w = np.exp(ll - top)
-        return w / w.sum()
+        """Posterior probability of each start (sums to 1).
+
+        Computed once per reading (a check asks for it several times: the belief and the
+        rolling procedure's look-ahead rules)."""
+        s = self._solved()
+        if "w" not in s:
+            ll = s["ll"]
+            top = ll.max()
+            if not np.isfinite(top):
+                raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
+            w = np.exp(ll - top)
+            s["w"] = w / w.sum()
+        return s["w"].copy()
 
     def belief(self, radius: float | None = None) -> Belief:
         """The belief over the present contact (see :class:`Belief`)."""
