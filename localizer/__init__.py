@@ -3,13 +3,15 @@
 from ._errors import LocalizerError, PartError, QueryError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
 from ._passivity import PassivityController, PassivityStep
-from ._filter import Belief, ContactFilter, Mode, ModeTracks, ParticleFilter, machining_slope
+from ._filter import NOISE_SCALES, Belief, ContactFilter, Mode, ModeTracks, ParticleFilter, machining_slope, tracks_for
+from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._march import MarchGrid, MarchResult, march, march_grid
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._solver import DIRECTIONS, METHODS, Segment, feasible_segments
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for",
+           "NOISE_SCALES", "StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
            "Segment", "feasible_segments", "METHODS", "DIRECTIONS",
            "Candidate", "Localization", "localize", "RULES",
            "march", "march_grid", "MarchResult", "MarchGrid", "arc_from_jaw_positions",

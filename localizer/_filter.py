@@ -60,13 +60,32 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull
 from scipy.special import ndtr
 
+from ._cache import per_part
 from ._errors import QueryError
 from ._part import Part
+from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope"]
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "NOISE_SCALES"]
+
+#: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
+#: log-uniform prior in steps of 2^(1/4) from a quarter to sixteen times what it was told. The
+#: steps are fine because with hundreds of readings the scale's posterior is sharp (a few per cent):
+#: a coarse grid would round it, and an underestimated scale overstates the evidence.
+NOISE_SCALES = tuple(float(2.0 ** (k / 4)) for k in range(-8, 17))
+#: Probability that one reading puts the contact where the jaw cannot touch under the true start
+#: (a jaw position misread by more than ``jaw_margin``, a model error in the part's reach).
+CONTRADICTION = 1e-3
+#: Probability that the rig reports a bridge where the jaw surely clears (a press refused for
+#: another reason).
+BRIDGE_MISS = 0.05
+#: Standard deviation of one reading of the arm's rotation, rad: its encoder's 0.03° step (the
+#: Adept Cobra 600, paper §IV), a uniform error.
+ENCODER_SD = math.radians(0.03) / math.sqrt(12.0)
+#: How far, rad, a rotation may run past the model's end of a convex stretch and keep the contact
+#: at that end (the machined part's slope differs from the model's by up to a few mrad).
+TURN_MARGIN = 0.01
 
 
 @dataclass(frozen=True)
@@ -128,30 +147,34 @@ def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
     return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k ** 2)))
 
 
-_TRACKS: dict = {}
+def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> "ModeTracks":
+    """The part's :class:`ModeTracks` at ``spacing`` mm for ``jaw``, built once per part, spacing and jaw.
 
-
-def tracks_for(part: Part, spacing: float) -> "ModeTracks":
-    """The part's :class:`ModeTracks` at ``spacing`` mm, built once per part and spacing.
-
-    Building them takes most of a second (the dense sample, its convex hull, the banded
+    Building them takes most of a second (the dense sample, the jaw's reach, the banded
     tangent-angle table); a Monte Carlo trial makes a grid filter and a particle filter on
     the same part. The tables are read-only, so the filters can share them.
     """
-    key = (part.points.tobytes(), part.cells_per_piece, float(spacing))
-    tracks = _TRACKS.get(key)
-    if tracks is None:
-        if len(_TRACKS) >= 8:
-            _TRACKS.pop(next(iter(_TRACKS)))
-        tracks = _TRACKS[key] = ModeTracks(part, spacing)
-    return tracks
+    return per_part("tracks", part, (float(spacing), jaw), lambda: ModeTracks(part, spacing, jaw))
 
 
 class ModeTracks:
-    """Where each of a set of hypotheses' contacts goes under further rotation (for planning)."""
+    """Where each of a set of hypotheses' contacts goes under further rotation, and where the jaw reaches.
 
-    def __init__(self, part: Part, spacing: float, hull_tolerance: float = 4.0):
+    Attributes
+    ----------
+    sigma, theta, kappa : ndarray, shape (n,)
+        The grid's arc positions (mm), unwrapped tangent angles (rad) and curvatures (1/mm).
+    lo, hi : ndarray, shape (n,), mm
+        The jaw positions at which the jaw can touch each grid point (:class:`localizer.Reach`).
+    touchable : ndarray of bool
+        The jaw touches the point at some place along it.
+    convex : ndarray of bool
+        Where a rolling can be: a convex stretch (θ rising, κ > 0) the jaw touches.
+    """
+
+    def __init__(self, part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW):
         self.part = part
+        self.jaw = jaw
         p = part.perimeter
         n = max(64, int(math.ceil(p / spacing)))
         self.h = p / n
@@ -186,43 +209,96 @@ class ModeTracks:
         self._span = span
         run_of_cell = np.repeat(np.arange(a.size), b - a)
         self._run = run_of_cell[np.arange(n) + n]
-        # a straight jaw touches only the convex hull: keep the boundary within hull_tolerance
-        # of the hull of its dense sample. The tolerance is generous (4 mm) because a jaw of
-        # finite length reaches well past where the hull leaves the boundary when the
-        # obstructing lobe is beyond its end (measured: starts 1.4 mm below the trefoil's hull
-        # were touched with the contact 40 mm from the jaw's centre), and the machined part
-        # differs from the model.
-        pts = np.asarray(part.point_at_arc(sigma))
-        eq = ConvexHull(pts).equations                      # n·x + d ≤ 0 inside
-        depth = np.full(n, -np.inf)
-        for chunk in range(0, len(eq), 256):
-            e = eq[chunk:chunk + 256]
-            depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
-        self.hull = depth > -hull_tolerance
-        self.convex = rising[a][self._run] & (kappa > 0) & self.hull
-        for arr in (self.sigma, self.theta, self.kappa, self.hull, self.convex, self._s, self._banded,
-                    self._first, self._last, self._run):
+        # where the jaw reaches, from its geometry (localizer._reach): no fixed tolerance below the hull
+        self.reach = reach_for(part, jaw)
+        self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
+        self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
+        self.convex = rising[a][self._run] & (kappa > 0) & self.touchable
+        for arr in (self.sigma, self.theta, self.kappa, self.lo, self.hi, self.touchable, self.convex, self._s,
+                    self._banded, self._first, self._last, self._run):
             arr.setflags(write=False)
 
-    def advance(self, index: np.ndarray, turn: float) -> tuple:
-        """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``.
+    def advance(self, index: np.ndarray, turn, *, turn_margin: float = 0.0) -> tuple:
+        """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``, along their
+        convex stretches (no check of where the jaw reaches: :meth:`touches`, :meth:`roll`).
 
-        Returns (arc mm, unwrapped, ``nan`` where the rotation leaves the point's
-        convex stretch), and a feasibility mask.
+        Parameters
+        ----------
+        index : array of int
+            Grid points the rotation starts from.
+        turn : float or array, rad
+            Net rotation from there (counter-clockwise positive).
+        turn_margin : float, rad
+            A rotation up to this far past the end of the point's convex stretch keeps the
+            contact at the end (the real part's slope differs from the model's near an
+            inflection) instead of ruling the point out.
+
+        Returns
+        -------
+        arc : ndarray, mm
+            Unwrapped; ``nan`` where the rotation leaves the point's convex stretch.
+        ok : ndarray of bool
         """
         idx = np.asarray(index)
         run = self._run[idx]
         target = self.theta[idx] + turn + run * self._span
         first, last = self._first[run], self._last[run]
-        ok = self.convex[idx] & (target >= self._banded[first]) & (target <= self._banded[last])
+        lo_b, hi_b = self._banded[first], self._banded[last]
+        ok = self.convex[idx] & (target >= lo_b - turn_margin) & (target <= hi_b + turn_margin)
+        target = np.clip(target, lo_b, hi_b)
         j = np.clip(np.searchsorted(self._banded, target, side="left"), first + 1, last)
         b0, b1 = self._banded[j - 1], self._banded[j]
         w = (target - b0) / np.where(b1 > b0, b1 - b0, 1.0)
         arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
-        # the contact must still be on the hull where it lands (else the jaw bridges)
-        land = np.mod(np.rint(arc / self.h).astype(np.int64), self.sigma.size)
-        ok &= self.hull[land]
         return np.where(ok, arc, np.nan), ok
+
+    def touches(self, arc, jaw=None, margin: float = 0.0) -> np.ndarray:
+        """Whether the jaw can touch at arc positions ``arc`` (mm, unwrapped; nan: no) with the contact
+        at jaw position(s) ``jaw`` (mm; None: at some place on the jaw), within ``margin`` mm."""
+        arc = np.asarray(arc, dtype=float)
+        finite = np.isfinite(arc)
+        land = np.mod(np.rint(np.where(finite, arc, 0.0) / self.h).astype(np.int64), self.sigma.size)
+        if jaw is None:
+            return finite & self.touchable[land]
+        d = np.asarray(jaw, dtype=float)
+        return finite & (self.lo[land] - margin < d) & (d < self.hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
+
+    def roll(self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0,
+             turn_margin: float = 0.0) -> tuple:
+        """:meth:`advance`, and the landing must be touchable.
+
+        ``jaw`` (mm) is the contact's place on the jaw at arc ``at`` (mm, default the grid
+        points): the landing's place is taken as that plus the arc rolled (the contact moves
+        as far along the jaw as along the part, to first order in the step), within
+        ``margin`` mm. Without ``jaw`` the landing must be touchable at some place on the jaw.
+        Returns (arc mm, nan where not; ok).
+        """
+        arc, ok = self.advance(index, turn, turn_margin=turn_margin)
+        if jaw is not None:
+            base = self.sigma[np.asarray(index)] if at is None else np.asarray(at, dtype=float)
+            jaw = np.asarray(jaw, dtype=float) + (arc - base)
+        ok = ok & self.touches(arc, jaw, margin)
+        return np.where(ok, arc, np.nan), ok
+
+
+    def rollable(self, turns, jaw: float, margin: float = 0.0) -> np.ndarray:
+        """Grid points from which the jaw, laid with the contact at ``jaw`` (mm on it), can roll through
+        every net rotation of ``turns`` (rad, in order, one sign) without bridging, with ``margin``
+        mm to spare on the jaw all along (boolean mask over the grid)."""
+        ok = self.convex & self.touches(self.sigma, jaw, -margin)
+        for t in np.atleast_1d(np.asarray(turns, dtype=float)):
+            idx = np.flatnonzero(ok)
+            arc, moved = self.advance(idx, float(t))
+            ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin)
+        return ok
+
+
+def _bspline(x: float) -> tuple:
+    """(indices, values) of the four uniform cubic B-splines that are nonzero at ``x`` (in knot steps)."""
+    i = math.floor(x)
+    u = x - i
+    vals = np.array([(1 - u) ** 3, 3 * u ** 3 - 6 * u ** 2 + 4, -3 * u ** 3 + 3 * u ** 2 + 3 * u + 1, u ** 3]) / 6
+    return i + np.arange(4), vals
 
 
 class ContactFilter:
@@ -254,6 +330,24 @@ class ContactFilter:
     refresh : int
         Readings between choices of the reference hypothesis whose radius of
         curvature scales the slope-error term (each choice evaluates the likelihood).
+    jaw : StraightJaw
+        The jaw, for where it can touch (:class:`localizer.Reach`).
+    jaw_margin : float, mm
+        How far a measured place on the jaw may be off when checking it against the reach.
+    sd_jaw : float, mm
+        Standard deviation of the B-spline coefficients of the calibration's error along the jaw
+        (a smooth function of the contact's place on the jaw, the same all run long; 0: none).
+        Measured on the simulated rig: about 0.45 of one reading's standard deviation.
+    jaw_spacing : float, mm
+        Knot spacing of that basis along the jaw.
+    sd_turn : float, rad
+        Standard deviation of one reading of the net rotation (default: the arm encoder's
+        0.03° step, uniform: 0.03°/√12). It moves the contact by ρ·e, which on a flat stretch
+        (ρ of hundreds of mm) is more than the reading's own error.
+    noise_scales : sequence of float
+        Common factors on ``sd_position``, ``sd_scale``, ``sd_slope`` and ``sd_jaw`` that the filter weighs
+        with equal prior probability (the real noise is rarely what the settings say; module
+        notes); ``(1.0,)`` trusts the settings.
 
     Examples
     --------
@@ -270,25 +364,39 @@ class ContactFilter:
 
     def __init__(self, part: Part, *, spacing: float = 0.02, sd_position: float = 0.035, sd_scale: float = 0.003,
                  sd_slope: float = 0.001, shape_spacing: float = 5.0, radius: float = 0.3, mode_floor: float = 0.05,
-                 confidence: float = 0.95, prune: float = 40.0, refresh: int = 5):
+                 confidence: float = 0.95, prune: float = 40.0, refresh: int = 5, jaw: StraightJaw = DEFAULT_JAW,
+                 jaw_margin: float = 2.0, noise_scales=NOISE_SCALES, sd_jaw: float = 0.015,
+                 jaw_spacing: float = 5.0, sd_turn: float = ENCODER_SD):
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")
-        for name, value in (("sd_scale", sd_scale), ("sd_slope", sd_slope)):
+        for name, value in (("sd_scale", sd_scale), ("sd_slope", sd_slope), ("sd_jaw", sd_jaw), ("sd_turn", sd_turn)):
             if not (math.isfinite(value) and value >= 0):
                 raise QueryError(f"{name}={value!r} must be ≥ 0")
-        if not (math.isfinite(shape_spacing) and shape_spacing > 0):
-            raise QueryError(f"shape_spacing={shape_spacing!r} mm must be positive")
+        for name, value in (("shape_spacing", shape_spacing), ("jaw_spacing", jaw_spacing)):
+            if not (math.isfinite(value) and value > 0):
+                raise QueryError(f"{name}={value!r} mm must be positive")
         if not 0 < confidence < 1:
             raise QueryError(f"confidence={confidence!r} must be in (0, 1)")
         if isinstance(refresh, bool) or not isinstance(refresh, (int, np.integer)) or refresh < 1:
             raise QueryError(f"refresh={refresh!r} must be a whole number of readings ≥ 1")
+        scales = np.asarray(noise_scales, dtype=float).ravel()
+        if scales.size == 0 or not np.all(np.isfinite(scales) & (scales > 0)):
+            raise QueryError(f"noise_scales={noise_scales!r} must be positive factors")
+        if not (math.isfinite(jaw_margin) and jaw_margin >= 0):
+            raise QueryError(f"jaw_margin={jaw_margin!r} mm must be ≥ 0")
         self.part = part
-        self.tracks = tracks_for(part, spacing)
+        self.jaw = jaw
+        self.jaw_margin = float(jaw_margin)
+        self.noise_scales = tuple(float(v) for v in scales)
+        self.tracks = tracks_for(part, spacing, jaw)
         self.sd_position = float(sd_position)
         self.sd_scale = float(sd_scale)
         self.sd_slope = float(sd_slope)
+        self.sd_jaw = float(sd_jaw)
+        self.sd_turn = float(sd_turn)
         self.shape_spacing = float(shape_spacing)
+        self.jaw_spacing = float(jaw_spacing)
         self.prune = float(prune)
         self.refresh = int(refresh)
         # before the first reference hypothesis: the median radius over the stretches a jaw touches
@@ -296,8 +404,12 @@ class ContactFilter:
         self._rho_prior = float(np.clip(np.median(1.0 / convex), 5.0, 500.0)) if convex.size else 50.0
         # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
         self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
-        self._segments = 16                   # offsets: one per contact segment (see regrasp)
-        self._m = self._segments + (2 * self._k0 + 4 if sd_slope > 0 else 0)
+        self._segments = 48                   # offsets: one per contact segment (see regrasp)
+        self._jaw0 = self._segments + (2 * self._k0 + 4 if sd_slope > 0 else 0)
+        # then the calibration error's B-splines over the jaw's span and the margin beyond it
+        self._jaw_lo = -(jaw.half + self.jaw_margin) - self.jaw_spacing
+        n_jaw = int(math.ceil(2 * (jaw.half + self.jaw_margin) / self.jaw_spacing)) + 5 if sd_jaw > 0 else 0
+        self._m = self._jaw0 + n_jaw
         self.radius = float(radius)
         self.mode_floor = float(mode_floor)
         self.confidence = float(confidence)
@@ -328,10 +440,15 @@ class ContactFilter:
         self._szz = 0.0
         self._touched = {0}
         self._segment = 0
+        self._penalty = np.zeros(n)           # log-probability of the reach evidence (touches, bridges)
+        self.jaw_position = math.nan          # the contact's last measured place on the jaw, mm
         self._live = self.feasible.copy()     # hypotheses still worth evaluating
         self._live_idx = np.flatnonzero(self._live)
-        self._ref = None                      # the hypothesis whose radius scales the slope term
-        self._version = 0                     # readings added (the log-likelihood cache's key)
+        self._ref = None                      # the hypothesis whose radii set the slope term's prior
+        self._slope_var = np.zeros(self._m)   # prior variance of each slope coefficient, mm²
+        self._hist = []                       # (z, turn) of every reading, for the reference's radii
+        self._version = 0                     # changes to the likelihood (its cache's key)
+        self._rows = 0                        # readings added
         self._cached = None
         self._last_row = None
         self._add_row(0.0, np.zeros(n))       # the first reading: z_0 = 0, p_0 = 0
@@ -339,7 +456,7 @@ class ContactFilter:
         self.turn = 0.0
         self.arc = 0.0
 
-    def update(self, arc: float, turn: float) -> None:
+    def update(self, arc: float, turn: float, jaw: float | None = None) -> None:
         """Take one reading.
 
         Parameters
@@ -350,13 +467,16 @@ class ContactFilter:
             its rotation's direction.
         turn : float, rad
             Net jaw rotation since the first reading (counter-clockwise positive).
+        jaw : float, mm, optional
+            The contact's measured place on the jaw: checked against where the jaw can touch
+            (:meth:`touch`).
         """
         if not (math.isfinite(arc) and math.isfinite(turn)):
             raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
         # only the hypotheses still in the running are moved and summed (the pruned ones are
         # never evaluated again)
         idx = self._live_idx
-        current, ok = self.tracks.advance(idx, turn)
+        current, ok = self.tracks.advance(idx, turn, turn_margin=TURN_MARGIN)
         if not ok.all():
             out = idx[~ok]
             self.feasible[out] = False
@@ -365,13 +485,76 @@ class ContactFilter:
         p = np.where(ok, current - self.grid[idx], 0.0)
         self.current[idx] = np.where(ok, current, self.current[idx])
         z = float(arc)
-        self._add_row(z, p, idx)
+        self._add_row(z, p, idx, jaw, float(turn))
         self.steps += 1
         self.turn, self.arc = float(turn), z
+        if jaw is not None:
+            self.touch(jaw)
         if self.steps % self.refresh == 0:
             self._ref = int(np.argmax(self.log_likelihood()))
+            self._slope_priors()
 
-    def regrasp(self, arc: float, turn: float) -> None:
+    def touch(self, jaw: float) -> None:
+        """The contact is now at place ``jaw`` (mm from the jaw's centre) on the jaw.
+
+        A hypothesis whose present contact the jaw cannot touch there (``jaw_margin`` given)
+        is made :data:`CONTRADICTION` times less likely: the first contact's place rules out
+        the starts the jaw could not have been laid on, each reading those it could not have
+        rolled to.
+        """
+        if not math.isfinite(jaw):
+            raise QueryError(f"jaw={jaw!r} mm must be finite")
+        self.jaw_position = float(jaw)
+        if self._rows == 1 and self.sd_jaw > 0:
+            # the first reading (z = 0, p = 0) is where the jaw was laid: it carries the calibration's
+            # error at that place too (only UᵀU changes, z and p being 0)
+            old_cols, old_vals = self._last_row
+            cols, vals = self._basis(0.0, jaw)
+            wt2 = self._row_weight ** 2
+            self._uu[np.ix_(old_cols, old_cols)] -= wt2 * np.outer(old_vals, old_vals)
+            self._uu[np.ix_(cols, cols)] += wt2 * np.outer(vals, vals)
+            self._touched.update(int(c) for c in cols)
+            self._last_row = (cols, vals)
+            self._version += 1
+        idx = self._live_idx
+        ok = self.tracks.touches(self.current[idx], float(jaw), self.jaw_margin)
+        if not ok.all():
+            self._penalty[idx[~ok]] += math.log(CONTRADICTION)
+            self._version += 1
+
+    def bridged(self, turn: float, jaw: float | None = None, jump: float = 3.0) -> None:
+        """The jaw, turned to net rotation ``turn`` (rad), touched the part somewhere else (a bridge).
+
+        The rig calls a step a bridge when the contact moves more than ``jump`` mm along the jaw
+        in it (or cannot be read). ``jaw`` (mm) is the contact's place on the jaw at the last
+        reading (default: the last one given). A hypothesis under which that turn, and
+        :data:`TURN_MARGIN` more, keep the contact on its convex stretch, the turn moving it by
+        less than half of ``jump``, with the jaw clear by ``jaw_margin`` there, did not expect it and is made :data:`BRIDGE_MISS` times
+        less likely; the others predicted it (a concavity, or a flat stretch where one step
+        moves the contact far) or cannot tell. No reading is added: call :meth:`regrasp` with
+        the next one.
+        """
+        if not (math.isfinite(turn) and math.isfinite(jump) and jump > 0):
+            raise QueryError(f"turn={turn!r} rad and jump={jump!r} mm must be finite, jump positive")
+        d0 = self.jaw_position if jaw is None else float(jaw)
+        if not math.isfinite(d0):
+            return
+        idx = self._live_idx
+        # surely clear: still so a little further on (the real part's convex stretch may end up to
+        # TURN_MARGIN before the model's)
+        further = turn + math.copysign(TURN_MARGIN, turn - self.turn)
+        clear = np.ones(idx.size, dtype=bool)
+        for t in (turn, further):
+            land, ok = self.tracks.advance(idx, t)
+            moved = land - self.current[idx]
+            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin)
+            if t == turn:
+                clear &= np.abs(moved) < 0.5 * jump
+        if clear.any():
+            self._penalty[idx[clear]] += math.log(BRIDGE_MISS)
+            self._version += 1
+
+    def regrasp(self, arc: float, turn: float, jaw: float | None = None) -> None:
         """The jaw was lifted and put back (e.g. slid along itself at the end of its span).
 
         The contact is where the net rotation ``turn`` (rad) puts it, but the next
@@ -379,26 +562,33 @@ class ContactFilter:
         lift is not measured). ``arc`` (mm) is the cumulative arc to continue from:
         pass the last reading's, since the contact has not moved along the part. The
         new offset absorbs any error in it; it also places the reading on the slope
-        error's basis, so it should be right to a few mm.
+        error's basis, so it should be right to a few mm. ``jaw`` (mm) is the contact's
+        new place on the jaw, as in :meth:`update`.
         """
         if self._segment + 1 >= self._segments:
             raise QueryError(f"more than {self._segments - 1} regrasps in one localization")
         self._segment += 1
-        self.update(arc, turn)
+        self.update(arc, turn, jaw)
 
-    def _basis(self, z: float) -> tuple:
-        """(columns, values) of the basis at cumulative arc z: the segment's offset and four cubic B-splines."""
-        seg = np.array([self._segment])
-        if self.sd_slope <= 0:
-            return seg, np.array([1.0])
-        x = z / self.shape_spacing
-        i = math.floor(x)
-        u = x - i
-        vals = np.array([(1 - u) ** 3, 3 * u ** 3 - 6 * u ** 2 + 4, -3 * u ** 3 + 3 * u ** 2 + 3 * u + 1, u ** 3]) / 6
-        cols = self._segments + self._k0 + i + np.arange(4)
-        if cols[0] < self._segments or cols[-1] >= self._m:
-            raise QueryError(f"arc={z!r} mm is more than a perimeter from the first reading")
-        return np.concatenate([seg, cols]), np.concatenate([[1.0], vals * self._radius_here()])
+    def _basis(self, z: float, jaw: float | None = None) -> tuple:
+        """(columns, values) of the basis for a reading at cumulative arc z (mm) and place ``jaw`` (mm)
+        on the jaw: the segment's offset, four cubic B-splines of the slope error in z (times ρ̂)
+        and four of the calibration's error in the place on the jaw."""
+        cols, vals = [np.array([self._segment])], [np.array([1.0])]
+        if self.sd_slope > 0:
+            c, v = _bspline(z / self.shape_spacing)
+            c = c + self._segments + self._k0
+            if c[0] < self._segments or c[-1] >= self._jaw0:
+                raise QueryError(f"arc={z!r} mm is more than a perimeter from the first reading")
+            cols.append(c)
+            vals.append(v)
+        if self.sd_jaw > 0 and jaw is not None:
+            # a place read a little beyond the basis' span takes its end's values
+            x = float(np.clip((float(jaw) - self._jaw_lo) / self.jaw_spacing, 0.0, self._m - self._jaw0 - 3 - 1e-9))
+            c, v = _bspline(x)
+            cols.append(c + self._jaw0)
+            vals.append(v)
+        return np.concatenate(cols), np.concatenate(vals)
 
     def _radius_here(self) -> float:
         """ρ̂, mm: the model's radius of curvature at the reference hypothesis' present contact
@@ -409,11 +599,45 @@ class ContactFilter:
         k = t.kappa[int(np.rint(self.current[self._ref] / t.h)) % t.sigma.size]
         return float(np.clip(1.0 / k, 5.0, 500.0)) if k > 0 else 500.0
 
-    def _add_row(self, z: float, p: np.ndarray, idx=None) -> None:
-        """Add a reading z with the predictions p of the hypotheses ``idx`` (default: all)."""
+    def _slope_priors(self) -> None:
+        """Each slope coefficient's prior from the reference hypothesis' radii where its B-spline is
+        nonzero: the contact's offset there is ρ·η, η ~ N(0, sd_slope²). Only the prior changes (the
+        sums do not depend on it), so the coefficients stay a smooth function of the arc: scaling the
+        basis' values by a radius that jumps when the reference changes would make the offset's
+        constant part look measured (it is the segments' offsets' to absorb)."""
+        if self.sd_slope <= 0 or self._ref is None or not self._hist:
+            return
+        z, turn = np.array(self._hist).T
+        arc, ok = self.tracks.advance(np.full(z.size, self._ref), turn, turn_margin=TURN_MARGIN)
+        land = np.mod(np.rint(np.where(ok, arc, self.grid[self._ref]) / self.tracks.h).astype(np.int64),
+                      self.grid.size)
+        kappa = self.tracks.kappa[land]
+        rho = np.where(kappa > 0, np.clip(1.0 / np.maximum(kappa, 1e-12), 5.0, 500.0), 500.0)
+        # column c (relative) is nonzero for z/spacing in [c - 3, c + 1): the largest radius there
+        first = np.floor(z / self.shape_spacing).astype(np.int64) + self._segments + self._k0
+        var = np.zeros(self._m)
+        for k in range(4):
+            np.maximum.at(var, first + k, (rho * self.sd_slope) ** 2)
+        touched = np.flatnonzero(var > 0)
+        self._slope_var[touched] = var[touched]
         self._version += 1
-        cols, vals = self._basis(z)
+
+    def _add_row(self, z: float, p: np.ndarray, idx=None, jaw: float | None = None, turn: float = 0.0) -> None:
+        """Add a reading z at net rotation ``turn`` and place ``jaw`` on the jaw with the predictions p of
+        the hypotheses ``idx`` (default: all)."""
+        self._version += 1
+        self._rows += 1
+        cols, vals = self._basis(z, jaw)
         self._last_row = (cols, vals)
+        self._hist.append((z, turn))
+        fresh = cols[(cols >= self._segments) & (cols < self._jaw0)]
+        fresh = fresh[self._slope_var[fresh] == 0]
+        self._slope_var[fresh] = (self._radius_here() * self.sd_slope) ** 2
+        # the rotation's error moves the contact by ρ·e: the reading's variance grows by (ρ̂·sd_turn)²
+        # (weighted least squares: the row times 1/relative sd)
+        wt = 1.0 / math.hypot(1.0, self._radius_here() * self.sd_turn / self.sd_position)
+        self._row_weight = wt
+        z, p, vals = z * wt, p * wt, vals * wt
         sel = slice(None) if idx is None else idx
         for c, v in zip(cols, vals):
             self._up[c, sel] += v * p
@@ -438,8 +662,9 @@ class ContactFilter:
         """The closed-form marginalisation over the live hypotheses (see the module notes)."""
         cols = np.array(sorted(self._touched))
         s2 = self.sd_position ** 2
-        prior = np.full(cols.size, self.sd_slope ** 2)
+        prior = self._slope_var[cols].copy()            # the contact's offset ρ·η: (ρ·sd_slope)²
         prior[cols < self._segments] = 1e6              # the segments' offsets: flat
+        prior[cols >= self._jaw0] = self.sd_jaw ** 2
         g = self._uu[np.ix_(cols, cols)] + np.diag(s2 / prior)
         live = np.flatnonzero(self._live)
         v = self._up[np.ix_(cols, live)]                # (m, n_live)
@@ -453,12 +678,23 @@ class ContactFilter:
                 "qzz": qzz}
 
     def _log_likelihood(self, s: dict) -> np.ndarray:
-        """Log-likelihood of each start from a :meth:`_solve`; prunes the hopeless ones."""
+        """Log-likelihood of each start from a :meth:`_solve`, the noise scale weighed out; prunes the
+        hopeless ones. Also leaves in ``s`` each live start's posterior mean of the squared scale."""
         live, qpp, qpz = s["live"], s["qpp"], s["qpz"]
         qrr = s["qzz"] - 2 * qpz + qpp
         t2 = self.sd_scale ** 2
         qpr = qpz - qpp
-        ll_live = -0.5 * (qrr - t2 * qpr ** 2 / (1 + t2 * qpp) + np.log1p(t2 * qpp))
+        quad = qrr - t2 * qpr ** 2 / (1 + t2 * qpp)
+        # every standard deviation times λ: the quadratic form scales by 1/λ², the determinant by
+        # λ^(2k) with k the readings not absorbed by a flat offset; t2·qpp does not change
+        k = max(self._rows - (self._segment + 1), 0)
+        lam = np.asarray(self.noise_scales)
+        terms = -0.5 * quad[None, :] / lam[:, None] ** 2 - k * np.log(lam)[:, None]
+        top = terms.max(axis=0)
+        post = np.exp(terms - top)
+        total = post.sum(axis=0)
+        s["lam2"] = (post * lam[:, None] ** 2).sum(axis=0) / total
+        ll_live = top + np.log(total / lam.size) - 0.5 * np.log1p(t2 * qpp) + self._penalty[live]
         ll = np.full(self.grid.size, -np.inf)
         ll[live] = ll_live
         if self.prune > 0 and live.size:
@@ -479,7 +715,8 @@ class ContactFilter:
         The slope error η moves the contact for a given jaw angle by ρ·η along the part
         (module notes), so the readings' term ρ̂·η(z) at the last reading is also the
         present contact's offset from where the model puts it. Given the start it is
-        Gaussian; with sd_slope = 0 it is zero.
+        Gaussian; with sd_slope = 0 it is zero. The spread also holds the last rotation
+        reading's error, which moves the present contact by ρ·e (``sd_turn``).
 
         Returns
         -------
@@ -489,13 +726,19 @@ class ContactFilter:
         s = self._solved()
         n = self.grid.size
         mean, sd = np.zeros(n), np.zeros(n)
+        live = s["live"]
+        # the last rotation reading's error moves the present contact by ρ·e
+        kappa = self.tracks.kappa[np.mod(np.rint(self.current[live] / self.tracks.h).astype(np.int64), n)]
+        var_turn = (self.sd_turn / np.maximum(kappa, 2e-4)) ** 2
         if self.sd_slope <= 0:
+            sd[live] = np.sqrt(var_turn)
             return mean, sd
-        cols, live = s["cols"], s["live"]
+        cols = s["cols"]
         a = np.zeros(cols.size)
         row_cols, row_vals = self._last_row
         a[np.searchsorted(cols, row_cols)] = row_vals
         a[cols < self._segments] = 0.0                  # the offset is the reading's, not the contact's
+        a[cols >= self._jaw0] = 0.0                     # so is the calibration's error
         t2 = self.sd_scale ** 2
         qpr = s["qpz"] - s["qpp"]
         d_mean = t2 * qpr / (1 + t2 * s["qpp"])         # the scale's posterior, b = 1 + δ
@@ -503,7 +746,7 @@ class ContactFilter:
         a_v = a @ s["gi_v"]
         mean[live] = a @ s["gi_wz"] - (1 + d_mean) * a_v
         var0 = self.sd_position ** 2 * float(a @ np.linalg.solve(s["g"], a))
-        sd[live] = np.sqrt(var0 + d_var * a_v ** 2)
+        sd[live] = np.sqrt(s["lam2"] * (var0 + d_var * a_v ** 2) + var_turn)
         return mean, sd
 
     def posterior(self) -> np.ndarray:
@@ -643,7 +886,7 @@ class ParticleFilter:
         """Move particles at arc x by a rotation ``turn`` along their convex stretch."""
         t = self.tracks
         i = np.minimum(np.rint(np.mod(x, self.part.perimeter) / t.h).astype(int), t.sigma.size - 1)
-        moved, ok = t.advance(i, turn)
+        moved, ok = t.roll(i, turn)
         return moved - t.sigma[i], ok
 
     def update(self, arc: float, turn: float) -> None:

@@ -77,7 +77,9 @@ def test_on_a_circle_the_belief_stays_flat_and_says_so():
 
 def test_on_an_ellipse_it_reports_the_two_symmetric_modes():
     part = load_part(PARTS / "ellipse.json")
-    flt = ContactFilter(part, sd_position=0.04, sd_scale=0.0, sd_slope=0.0)   # wider than the grid step
+    # told noise wider than the grid step, and held to it (noise-free readings would otherwise let the
+    # filter shrink it until the grid's offsets from the two symmetric truths tell the modes apart)
+    flt = ContactFilter(part, sd_position=0.04, sd_scale=0.0, sd_slope=0.0, noise_scales=(1.0,))
     turns = STEP * np.arange(1, 151)
     start = 0.3 * part.perimeter
     z, arcs = readings(flt, start, turns)
@@ -208,6 +210,14 @@ def test_the_shift_recovers_a_known_slope_error(cam):
     assert abs(mean[i] - true_shift[-1]) < 3 * sd[i] + 0.005
     assert 0 < sd[i] < rho[-1] * 0.002
     assert abs(true_shift[-1]) > 0.02                     # the test would see a shift ignored
-    nothing = ContactFilter(cam, sd_slope=0.0)
+    nothing = ContactFilter(cam, sd_slope=0.0, sd_turn=0.0)
     feed(nothing, z_model[:10], turns[:10])
     assert not np.any(nothing.shift()[0]) and not np.any(nothing.shift()[1])
+    # the rotation reading's error alone: no shift, a spread of ρ·sd_turn at the present contact
+    encoder = ContactFilter(cam, sd_slope=0.0)
+    feed(encoder, z_model[:10], turns[:10])
+    mean, sd = encoder.shift()
+    live = sd > 0
+    rho_now = 1.0 / np.asarray(cam.curvature_at_arc(cam.wrap_arc(encoder.current[live])))
+    assert not np.any(mean)
+    np.testing.assert_allclose(sd[live], rho_now * math.radians(0.03) / math.sqrt(12), rtol=0.02)

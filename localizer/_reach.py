@@ -1,0 +1,205 @@
+"""Where a straight jaw can touch a part: the reachable set of (boundary point, place on the jaw).
+
+A straight jaw of length 2h lies along the tangent of the part at its contact P,
+the part on the inner side of its edge. With the contact at jaw position d
+(measured along the jaw from its centre, the wrist's axis, in the direction of
+the part's counter-clockwise tangent), the edge covers w ∈ [−h − d, h − d] along
+the tangent from P. The jaw can touch at P with the contact at d when no other
+point Q of the part lies on the jaw's side of that edge, deeper than
+``clearance``, within that stretch: with w⁺ the nearest such obstruction ahead
+along the tangent and w⁻ the nearest behind,
+
+    h − d < w⁺  and  −h − d > w⁻,   i.e.   d ∈ (h − w⁺, −h − w⁻) = (lo, hi).
+
+Every boundary point thus has one open interval of jaw positions (empty where a
+straight jaw cannot touch it at all: on a concave stretch its own neighbours are
+in the way). Points on the convex hull have the whole jaw; points below it are
+reached only with the contact towards one end, when the concavity is wider than
+the rest of the jaw. Rolling moves the contact along the part and along the jaw
+together, so a roll stays touchable while (σ, d) stays inside the set.
+
+``clearance`` makes the set a little generous: a model point that cuts into the
+jaw by less than that does not block it. The real part differs from its model
+by the machining error (9 µm RMS at the ``paper`` preset, up to 0.1 mm in
+places at four times that), and a start wrongly ruled out can never be found
+again, while one wrongly kept only costs a little sharpness.
+
+This one computation serves the filter's prior and roll transitions, the
+reading-by-reading check of the contact's place on the jaw, the evidence of a
+bridge, the studies' start sampler and the choice of where to calibrate.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import ConvexHull
+
+from ._cache import per_part
+from ._errors import QueryError
+from ._part import Part
+
+__all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc"]
+
+
+@dataclass(frozen=True)
+class StraightJaw:
+    """A straight jaw (the paper's): an edge of ``length`` mm centred on the wrist's axis.
+
+    Attributes
+    ----------
+    length : float, mm
+        The edge's length (paper: 100 mm, calibrated over ±50 mm).
+    """
+
+    length: float = 100.0
+
+    def __post_init__(self):
+        if not (math.isfinite(self.length) and self.length > 0):
+            raise QueryError(f"jaw length={self.length!r} mm must be a positive number")
+
+    @property
+    def half(self) -> float:
+        """Half the length, mm: the contact's place on the jaw runs over ±half."""
+        return 0.5 * self.length
+
+    def __str__(self) -> str:
+        return f"straight:{self.length:g}"
+
+
+#: The paper's jaw: 100 mm, calibrated over ±50 mm.
+DEFAULT_JAW = StraightJaw()
+
+
+class Reach:
+    """The reachable set of a part for a straight jaw, on a grid of arc positions.
+
+    Parameters
+    ----------
+    part : Part
+    jaw : StraightJaw
+    spacing : float, mm
+        Grid step along the boundary (default 0.1 mm).
+    clearance : float, mm
+        A model point must cut into the jaw deeper than this to block it (module notes).
+
+    Attributes
+    ----------
+    sigma : ndarray, shape (n,), mm
+        Arc positions of the grid.
+    lo, hi : ndarray, shape (n,), mm
+        The open interval of jaw positions at which the jaw can touch there (lo ≥ hi: nowhere;
+        ±inf where nothing blocks that way).
+    hull_depth : ndarray, shape (n,), mm
+        Distance of each point below the part's convex hull (0 on it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from localizer import part_from_points
+    >>> a = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    >>> disc = part_from_points(np.c_[30 * np.cos(a), 30 * np.sin(a)])
+    >>> r = Reach(disc, StraightJaw(100.0))
+    >>> bool(r.touchable(10.0, jaw=45.0)), bool(r.full.all())   # convex: the whole jaw everywhere
+    (True, True)
+    """
+
+    def __init__(self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.1,
+                 clearance: float = 0.1):
+        if not (math.isfinite(spacing) and spacing > 0):
+            raise QueryError(f"spacing={spacing!r} mm must be a positive number")
+        if not (math.isfinite(clearance) and clearance >= 0):
+            raise QueryError(f"clearance={clearance!r} mm must be ≥ 0")
+        self.part, self.jaw = part, jaw
+        self.clearance = float(clearance)
+        p = part.perimeter
+        n = max(64, int(math.ceil(p / spacing)))
+        self.h = p / n
+        self.sigma = np.arange(n) * self.h
+        t = part.param_at_arc(self.sigma)
+        pts = np.asarray(part.point(t))
+        tan = np.asarray(part.tangent(t))
+        eq = ConvexHull(pts).equations                       # n·x + d ≤ 0 inside
+        depth = np.full(n, -np.inf)
+        for c in range(0, len(eq), 256):
+            e = eq[c:c + 256]
+            depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
+        self.hull_depth = np.maximum(-depth, 0.0)
+        lo = np.full(n, -np.inf)
+        hi = np.full(n, np.inf)
+        # only points below the hull can be blocked: the hull's tangent is a supporting line
+        below = np.flatnonzero(self.hull_depth > 1e-9 * max(1.0, float(np.ptp(pts))))
+        half = jaw.half
+        for c in range(0, below.size, 128):
+            i = below[c:c + 128]
+            rel = pts[None, :, :] - pts[i, None, :]                     # (b, n, 2): Q − P
+            e = tan[i, None, :]
+            w = np.einsum("bnk,bnk->bn", rel, e)                         # along the tangent
+            dep = rel[..., 0] * e[..., 1] - rel[..., 1] * e[..., 0]      # −(Q−P)·m, m the inner normal
+            block = dep > self.clearance
+            w_plus = np.where(block & (w > 0), w, np.inf).min(axis=1)
+            w_minus = np.where(block & (w < 0), w, -np.inf).max(axis=1)
+            blocked_here = (block & (w == 0)).any(axis=1)
+            lo[i] = np.where(blocked_here, np.inf, half - w_plus)
+            hi[i] = np.where(blocked_here, -np.inf, -half - w_minus)
+        self.lo, self.hi = lo, hi
+        for arr in (self.sigma, self.lo, self.hi, self.hull_depth):
+            arr.setflags(write=False)
+
+    def _index(self, arc) -> np.ndarray:
+        return np.mod(np.rint(np.asarray(arc, dtype=float) / self.h).astype(np.int64), self.sigma.size)
+
+    def interval(self, arc) -> tuple:
+        """(lo, hi) jaw positions, mm, at which the jaw can touch at arc position(s) ``arc`` (mm)."""
+        i = self._index(arc)
+        return self.lo[i], self.hi[i]
+
+    def touchable(self, arc, jaw=None, margin: float = 0.0) -> np.ndarray:
+        """Whether the jaw can touch at ``arc`` (mm) with the contact at jaw position ``jaw`` (mm).
+
+        ``jaw`` None: at some place on the jaw. ``margin`` (mm) widens the interval (a measured
+        jaw position carries an error).
+        """
+        lo, hi = self.interval(arc)
+        half = self.jaw.half
+        if jaw is None:
+            return np.maximum(lo, -half) - margin < np.minimum(hi, half) + margin
+        d = np.asarray(jaw, dtype=float)
+        return (lo - margin < d) & (d < hi + margin) & (np.abs(d) <= half + margin)
+
+    def clear(self, arc, jaw, margin: float) -> np.ndarray:
+        """Whether the jaw touches at ``arc`` (mm) with the contact at ``jaw`` (mm) with room to spare:
+        ``margin`` mm inside the interval on both sides (a roll there surely does not bridge)."""
+        lo, hi = self.interval(arc)
+        d = np.asarray(jaw, dtype=float)
+        return (lo + margin < d) & (d < hi - margin) & (np.abs(d) <= self.jaw.half - margin)
+
+    @property
+    def full(self) -> np.ndarray:
+        """Points the jaw touches at every place along it (as the calibration's taps need)."""
+        return (self.lo <= -self.jaw.half) & (self.hi >= self.jaw.half)
+
+
+def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.1, clearance: float = 0.1) -> Reach:
+    """The part's :class:`Reach` for ``jaw``, built once per part, jaw, spacing and clearance (shared, read-only)."""
+    return per_part("reach", part, (jaw, float(spacing), float(clearance)),
+                    lambda: Reach(part, jaw, spacing=spacing, clearance=clearance))
+
+
+def calibration_arc(part: Part, jaw: StraightJaw = DEFAULT_JAW) -> float:
+    """Where to calibrate on ``part``: the most curved point the jaw touches at every place along it, mm.
+
+    The calibration taps one object point with the contact at 11 places from one end of
+    the jaw to the other (paper §III-B), so the point must be touchable with the whole jaw;
+    the most curved such point pins the contact best. A part without one (every point
+    blocked somewhere along the jaw) raises :class:`QueryError`.
+    """
+    r = reach_for(part, jaw)
+    ok = np.flatnonzero(r.full)
+    if ok.size == 0:
+        raise QueryError(f"no point of {part.name} can be touched along the whole {jaw} jaw: "
+                         "calibrate on another object")
+    kappa = np.asarray(part.curvature_at_arc(r.sigma[ok]))
+    return float(r.sigma[ok[int(np.argmax(kappa))]])
