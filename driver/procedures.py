@@ -26,7 +26,7 @@ from localizer import Localization, Part, arc_from_jaw_positions, localize
 from .rig import Rig, RigError
 
 __all__ = ["hold_force", "Calibration", "Hand", "RollResult", "RollingRun", "zero", "press", "establish_contact",
-           "calibrate", "edge_offset", "roll", "localize_by_rolling"]
+           "calibrate", "edge_offset", "roll", "roll_sequence", "localize_by_rolling"]
 
 
 # ------------------------------------------------------------------ hand
@@ -452,15 +452,12 @@ class RollingRun:
                 "candidates": [c.as_dict() for c in self.localization.candidates]}
 
 
-def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration, approach_pose,
-                        step: float = math.radians(0.2), n: int = 32, bridge_jump: float = 3.0,
-                        rule: str = "likelihood", sd_length: float = 0.5,
-                        sd_turn: float = math.radians(0.03), observer=None, **press_options) -> RollingRun:
-    """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
+def roll_sequence(rig: Rig, rolls, *, calibration: Calibration, approach_pose, step: float = math.radians(0.2),
+                  n: int = 32, bridge_jump: float = 3.0, observer=None, **press_options) -> tuple:
+    """Establish contact and roll by each angle of ``rolls`` (rad), all the same way; no localization.
 
-    All rolls turn the same way. Rolls that bridge a concave stretch are
-    refused (:func:`roll`, ``bridge_jump``): the pipeline localizes on the part,
-    never on its convex hull.
+    Returns the tuple of :class:`RollResult`. A roll that bridges a concave stretch is
+    refused (:func:`roll`, ``bridge_jump``) with :class:`RigError` naming the roll.
     """
     rolls = [float(a) for a in rolls]
     if not rolls:
@@ -475,10 +472,25 @@ def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration
                                 bridge_jump=bridge_jump, observer=observer, index=k, **press_options))
         except RigError as exc:
             raise RigError(f"roll {k + 1}: {exc}") from None
+    return tuple(results)
+
+
+def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration, approach_pose,
+                        step: float = math.radians(0.2), n: int = 32, bridge_jump: float = 3.0,
+                        rule: str = "likelihood", sd_length: float = 0.5,
+                        sd_turn: float = math.radians(0.03), observer=None, **press_options) -> RollingRun:
+    """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
+
+    All rolls turn the same way. Rolls that bridge a concave stretch are
+    refused (:func:`roll`, ``bridge_jump``): the pipeline localizes on the part,
+    never on its convex hull.
+    """
+    results = roll_sequence(rig, rolls, calibration=calibration, approach_pose=approach_pose, step=step, n=n,
+                            bridge_jump=bridge_jump, observer=observer, **press_options)
     estimates = tuple((r.length, r.turn) for r in results)
-    direction = "ccw" if rolls[0] > 0 else "cw"
+    direction = "ccw" if results[0].step > 0 else "cw"
     loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)
-    return RollingRun(rolls=tuple(results), estimates=estimates, localization=loc,
+    return RollingRun(rolls=results, estimates=estimates, localization=loc,
                       samples=list(getattr(rig, "samples", [])))
 
 

@@ -67,6 +67,8 @@ class ReactiveRun:
         Direction changes (a concavity ahead or bridged, or the direction rule).
     regrasps : int
         Times the jaw was lifted and slid along itself at the end of its span.
+    bridges : int
+        Steps that bridged a concavity (or were refused) and were undone.
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
         The belief at every check, with the truth where the rig knows it.
     arcs, turns : tuple of float
@@ -83,6 +85,7 @@ class ReactiveRun:
     stopped: str
     reversals: int
     regrasps: int = 0
+    bridges: int = 0
     history: tuple = field(repr=False, default=())
     arcs: tuple = field(repr=False, default=())
     turns: tuple = field(repr=False, default=())
@@ -110,10 +113,11 @@ def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = 
     if starts is None:
         starts = [m.start_arc for m in flt.belief().modes[:2]]
     idx = np.mod(np.rint(np.asarray(starts, dtype=float) / flt.tracks.h).astype(int), flt.grid.size)
+    jaw = _jaw_now(flt, idx)
     out = []
     for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
-        a, ok_a = flt.tracks.advance(idx, edge)
-        b, ok_b = flt.tracks.advance(idx, edge + sign * lookahead)
+        a, ok_a = flt.tracks.roll(idx, edge, **jaw)
+        b, ok_b = flt.tracks.roll(idx, edge + sign * lookahead, **jaw)
         moved = np.where(ok_a & ok_b, b - a, 0.0)
         out.append(float(np.std(moved)))
     return tuple(out)
@@ -127,8 +131,15 @@ def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, at: float 
     """
     w = flt.posterior()
     top = np.flatnonzero(w > 1e-9 * w.max())
-    _, ok = flt.tracks.advance(top, (flt.turn if at is None else at) + direction * lookahead)
+    _, ok = flt.tracks.roll(top, (flt.turn if at is None else at) + direction * lookahead, **_jaw_now(flt, top))
     return float(np.sum(w[top][ok]) / np.sum(w[top]))
+
+
+def _jaw_now(flt: ContactFilter, idx) -> dict:
+    """Where the jaw touches now, as :meth:`localizer.ModeTracks.roll` takes it (nothing before a reading)."""
+    if not math.isfinite(flt.jaw_position):
+        return {}
+    return {"jaw": flt.jaw_position, "at": flt.current[idx]}
 
 
 def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, approach_pose,
@@ -194,8 +205,9 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             return False
 
     d_prev = read()
+    flt.touch(d_prev)  # the first contact's place on the jaw: where the jaw could have been laid
     phi0 = rig.pose()[2]
-    z, rotation, steps, reversals, regrasps = 0.0, 0.0, 0, 0, 0
+    z, rotation, steps, reversals, regrasps, bridges = 0.0, 0.0, 0, 0, 0, 0
     explored = [0.0, 0.0]
     blocked = {1: False, -1: False}
     arcs, turns, history = [0.0], [0.0], []
@@ -214,7 +226,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         except RigError:
             d = math.inf  # left the calibrated span, or the press was refused: treated as a bridge
         bridged = abs(d - d_prev) > bridge_jump or not math.isfinite(d)
-        regrasped = False
+        regrasped = slid_off = False
         if not bridged and abs(d) > jaw_limit:
             # the contact reached the end of the jaw's span: lift, slide the jaw along itself so
             # that the contact comes back near the other end, put it back on the same point
@@ -229,7 +241,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             if abs(d_new - target_d) <= bridge_jump:
                 d = d_new
                 turn = rig.pose()[2] - phi0
-                flt.regrasp(z, turn)
+                flt.regrasp(z, turn, d)
                 regrasps += 1
                 regrasped = True
             else:
@@ -238,8 +250,12 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
                 hand.press_by(-backoff)
                 hand.slide_by(-slide)
                 pressed()
-                bridged = True
+                bridged = slid_off = True
         if bridged:
+            bridges += 1
+            if not slid_off:
+                # evidence: the starts under which this turn keeps the jaw clear are less likely
+                flt.bridged(rig.pose()[2] - phi0, jump=bridge_jump)
             # bridged a concavity: roll back, re-read, and go the other way
             hand.rotate_by(-s)
             rotation += step
@@ -251,7 +267,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
                 stopped = "lost"
                 break
             # the re-read is a new base for the increments: a new segment with its own offset
-            flt.regrasp(z, rig.pose()[2] - phi0)
+            flt.regrasp(z, rig.pose()[2] - phi0, d_prev)
             blocked[direction] = True
             if blocked[-direction]:
                 stopped = "blocked"
@@ -262,7 +278,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         if not regrasped:
             turn = rig.pose()[2] - phi0
             z += direction * arc_from_jaw_positions([d_prev, d], s, offset)
-            flt.update(z, turn)
+            flt.update(z, turn, d)
         explored = [min(explored[0], turn), max(explored[1], turn)]
         arcs.append(z)
         turns.append(turn)
@@ -307,5 +323,5 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         belief = flt.belief()
         history.append((rotation, belief.map_arc, belief.mass, truth[-1][0] if truth else math.nan))
     return ReactiveRun(belief=belief, rotation=rotation, steps=steps, stopped=stopped, reversals=reversals,
-                       regrasps=regrasps, history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
+                       regrasps=regrasps, bridges=bridges, history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
                        true_arcs=tuple(true_arcs), segments=tuple(segments))

@@ -51,7 +51,7 @@ def test_it_stops_when_sure_and_is_right(trefoil):
 def test_the_rotation_budget_stops_it(trefoil):
     part, cal = trefoil
     rig = SimRig(part, noise="none", seed=1)
-    run = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(2.0),
+    run = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(2.0), confidence=1 - 1e-9,
                               approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
     assert run.stopped == "max_rotation" and run.rotation == pytest.approx(math.radians(2.0), abs=1e-9)
     assert run.steps == 10
