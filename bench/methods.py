@@ -18,6 +18,8 @@ import math
 import numpy as np
 
 MARK_DEG = 5.0
+#: How far short of a mark (degrees) a measured turn still reaches it: more than the encoder's step.
+ENCODER_SLACK_DEG = 0.05
 
 
 def _curve(pairs) -> str:
@@ -33,14 +35,14 @@ def parse_curve(text: str) -> list:
     return out
 
 
-def fixed_readings(run, part) -> dict:
+def fixed_readings(rolls, part) -> dict:
     """The fixed rolls as one step sequence: cumulative signed arc z (mm), net measured turn (rad),
-    the true contact (mm), and each step's signed arc."""
+    the true contact (mm), each step's signed arc, and the contact's place on the jaw (mm)."""
     from localizer import arc_from_jaw_positions
 
-    z, turns, truth, steps = [0.0], [0.0], [run.rolls[0].truth[0][0]], []
-    phi0 = run.rolls[0].angles[0]
-    for r in run.rolls:
+    z, turns, truth, steps, jaw = [0.0], [0.0], [rolls[0].truth[0][0]], [], [rolls[0].positions[0]]
+    phi0 = rolls[0].angles[0]
+    for r in rolls:
         sign = 1.0 if r.step > 0 else -1.0
         for i in range(1, len(r.positions)):
             a = sign * arc_from_jaw_positions(r.positions[i - 1:i + 1], r.step, r.offset)
@@ -48,7 +50,9 @@ def fixed_readings(run, part) -> dict:
             z.append(z[-1] + a)
             turns.append(r.angles[i] - phi0)
             truth.append(r.truth[i][0])
-    return {"z": np.array(z), "turn": np.array(turns), "truth": np.array(truth), "steps": np.array(steps)}
+            jaw.append(r.positions[i])
+    return {"z": np.array(z), "turn": np.array(turns), "truth": np.array(truth), "steps": np.array(steps),
+            "jaw": np.array(jaw)}
 
 
 def _err(part, est, truth) -> float:
@@ -58,56 +62,99 @@ def _err(part, est, truth) -> float:
 
 
 def _marks(turns) -> list:
-    """(mark deg, index of the first reading at or past it) for every 5° of |turn|."""
+    """(mark deg, index of the first reading at or past it) for every 5° of |turn|.
+
+    A mark counts as reached within the arm encoder's resolution (0.03°): the measured turn of a
+    commanded 35° may read 34.98°."""
     rot = np.degrees(np.abs(turns))
     out = []
     mark = MARK_DEG
-    while mark <= rot[-1] + 1e-9:
-        idx = int(np.argmax(rot >= mark - 1e-9))
+    while mark <= rot[-1] + ENCODER_SLACK_DEG:
+        idx = int(np.argmax(rot >= mark - ENCODER_SLACK_DEG))
         out.append((mark, idx))
         mark += MARK_DEG
     return out
 
 
-def score_paper(study, part, run, seq, rule: str) -> dict:
+def _localize(study, part, rolls, rule: str, cache: dict):
+    """The localizer's rule on the fixed rolls' (L, Ω), once per trial and rule (a failure is kept too)."""
+    from localizer import localize
+
+    if rule not in cache:
+        try:
+            cache[rule] = localize(part, [(r.length, r.turn) for r in rolls], rule=rule,
+                                   direction="ccw" if rolls[0].step > 0 else "cw", sd_length=study.sd_length,
+                                   sd_turn=math.radians(study.sd_turn_deg))
+        except Exception as exc:  # noqa: BLE001 - the rule's failure is its result
+            cache[rule] = exc
+    return cache[rule]
+
+
+def _mass(part, candidates, best, radius: float) -> float:
+    """Stated probability of the candidates whose present contact is within ``radius`` of the best's."""
+    return float(sum(c.probability for c in candidates
+                     if abs(float(part.arc_offset(c.end_arc, best.end_arc))) < radius))
+
+
+def score_rule(study, part, rolls, rule: str, true_arc: float, cache: dict) -> dict:
+    """The localizer's ``rule`` on the fixed rolls: the study's own columns, and a method's cells."""
+    loc = _localize(study, part, rolls, rule, cache)
+    if isinstance(loc, Exception):
+        return {"estimate_arc": math.nan, "error_mm": math.inf, "candidates": 0, "probability": 0.0, "ambiguous": 0,
+                "mass": "", "failure": f"{type(loc).__name__}: {loc}"[:200]}
+    best = loc.best
+    if best is None:
+        return {"estimate_arc": math.nan, "error_mm": math.inf, "candidates": 0, "probability": 0.0,
+                "ambiguous": int(loc.ambiguous), "mass": 0.0, "failure": ""}
+    return {"estimate_arc": best.end_arc, "error_mm": _err(part, best.end_arc, true_arc),
+            "candidates": len(loc.candidates), "probability": best.probability, "ambiguous": int(loc.ambiguous),
+            "mass": _mass(part, loc.candidates, best, study.success_radius), "failure": ""}
+
+
+def score_paper(study, part, rolls, seq, rule: str, cache: dict) -> dict:
     """The fixed rolls under a localizer rule, and the same rule on shorter prefixes."""
     from localizer import localize
 
-    loc = run.localization if rule == run.localization.rule else localize(
-        part, run.estimates, rule=rule, direction="ccw" if run.rolls[0].step > 0 else "cw",
-        sd_length=study.sd_length, sd_turn=math.radians(study.sd_turn_deg))
-    best = loc.best
-    est = best.end_arc if best is not None else math.nan
-    final = _err(part, est, seq["truth"][-1])
+    own = score_rule(study, part, rolls, rule, seq["truth"][-1], cache)
+    if own["failure"]:
+        raise _MethodError(own["failure"])
     share = study.rolls_deg[0] / sum(study.rolls_deg) if len(study.rolls_deg) > 1 else 1.0
-    sign = 1.0 if run.rolls[0].step > 0 else -1.0
+    sign = 1.0 if rolls[0].step > 0 else -1.0
     curve = []
     for mark, k in _marks(seq["turn"]):
         k1 = max(1, int(round(k * share)))
         segs = [(0, k1)] + ([(k1, k)] if k > k1 else [])
-        rolls = [(sign * (seq["z"][b] - seq["z"][a]), seq["turn"][b] - seq["turn"][a]) for a, b in segs]
+        pieces = [(sign * (seq["z"][b] - seq["z"][a]), seq["turn"][b] - seq["turn"][a]) for a, b in segs]
         try:
-            sub = localize(part, rolls, rule=rule, direction="ccw" if sign > 0 else "cw",
+            sub = localize(part, pieces, rule=rule, direction="ccw" if sign > 0 else "cw",
                            sd_length=study.sd_length, sd_turn=math.radians(study.sd_turn_deg)).best
             e = _err(part, sub.end_arc, seq["truth"][k]) if sub is not None else math.inf
-        except Exception:  # a prefix the rule cannot take counts as a miss
+        except Exception:  # noqa: BLE001 - a prefix the rule cannot take counts as a miss
             e = math.inf
         curve.append((mark, e))
-    return {"estimate_arc": est, "error_mm": final, "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)),
-            "curve": curve}
+    return {"estimate_arc": own["estimate_arc"], "error_mm": own["error_mm"],
+            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve, "stopped": "fixed",
+            "mass": own["mass"]}
+
+
+class _MethodError(Exception):
+    """A method's own failure, its text already formatted."""
 
 
 def _score_sequential(study, part, seq, update, estimate) -> dict:
-    """A filter fed the fixed rolls' readings one by one, its estimate at every 5° and at the end."""
+    """A filter fed the fixed rolls' readings one by one, its estimate at every 5° and at the end.
+
+    ``update(z, turn, jaw)``; ``estimate()`` gives (present contact mm, stated mass)."""
     marks = dict((k, m) for m, k in _marks(seq["turn"]))
     curve = []
     for j in range(1, len(seq["z"])):
-        update(float(seq["z"][j]), float(seq["turn"][j]))
+        update(float(seq["z"][j]), float(seq["turn"][j]), float(seq["jaw"][j]))
         if j in marks:
-            curve.append((marks[j], _err(part, estimate(), seq["truth"][j])))
-    est = estimate()
+            curve.append((marks[j], _err(part, estimate()[0], seq["truth"][j])))
+    est, mass = estimate()
     return {"estimate_arc": est, "error_mm": _err(part, est, seq["truth"][-1]),
-            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve}
+            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve, "stopped": "fixed",
+            "mass": mass}
 
 
 def score_particle(study, part, seq, seed: int) -> dict:
@@ -117,27 +164,46 @@ def score_particle(study, part, seq, seed: int) -> dict:
     o = study.particle
     pf = ParticleFilter(part, particles=o.particles, sd_position=o.sd_position, process=o.process,
                         radius=study.success_radius, seed=seed)
-    return _score_sequential(study, part, seq, pf.update, lambda: pf.estimate()[0])
+    return _score_sequential(study, part, seq, lambda z, t, d: pf.update(z, t), pf.estimate)
 
 
 def score_grid(study, part, noise, seq) -> dict:
     """The reactive method's grid filter over the fixed rolls' readings (no reactive rolling)."""
     flt = reactive_filter(study, part, noise)
-    return _score_sequential(study, part, seq, flt.update, lambda: flt.belief().map_arc)
+    flt.touch(float(seq["jaw"][0]))
+
+    def estimate():
+        b = flt.belief()
+        return b.map_arc, b.mass
+
+    return _score_sequential(study, part, seq, flt.update, estimate)
 
 
 def reactive_filter(study, part, noise):
-    """The ContactFilter a study's [reactive] options describe (sd_slope "auto" from the noise model)."""
+    """The ContactFilter a study's [reactive] options describe.
+
+    Standard deviations not given are the filter's own defaults; ``sd_slope = "auto"`` takes 5x the
+    study's noise model's RMS slope (machined parts vary: measured 0.8e-3 to 1.9e-3 rad RMS at the
+    paper preset, whose model RMS is 0.6e-3, and the basis' coefficients are not its values).
+    """
     from localizer import ContactFilter, machining_slope
 
     o = study.reactive
-    slope = o.sd_slope
-    if slope is None:
-        # 5x the model's RMS slope: machined parts vary (measured: 0.8e-3 to 1.9e-3 rad RMS at the
-        # paper preset, whose model RMS is 0.6e-3), and the basis' coefficients are not its values
-        slope = max(5.0 * machining_slope(noise.machining_error, noise.machining_wavelength, part.perimeter), 5e-4)
-    return ContactFilter(part, sd_position=o.sd_position, sd_scale=o.sd_scale, sd_slope=slope,
-                         radius=study.success_radius, confidence=o.confidence)
+    given = {k: getattr(o, k) for k in ("sd_position", "sd_scale", "sd_slope") if getattr(o, k) is not None}
+    if given.get("sd_slope") == "auto":
+        given["sd_slope"] = max(5.0 * machining_slope(noise.machining_error, noise.machining_wavelength,
+                                                      part.perimeter), 5e-4)
+    if o.noise_scales is not None:
+        given["noise_scales"] = o.noise_scales
+    return ContactFilter(part, radius=study.success_radius, confidence=o.confidence, **given)
+
+
+def reactive_stop(run) -> str:
+    """A reactive run's stop as trials.csv says it: confident, ambiguous (the belief ended with two or
+    more strong modes) or budget (not sure otherwise: the rotation budget, or blocked both ways)."""
+    if run.stopped == "confident":
+        return "confident"
+    return "ambiguous" if run.belief.ambiguous else "budget"
 
 
 def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict:
@@ -145,10 +211,12 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict
     from driver.reactive import localize_reactively
     from sim2d import SimRig
 
+    from .study import JAW_START
+
     o = study.reactive
     rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine)
     res = localize_reactively(rig, part, calibration=cal, filter=reactive_filter(study, part, noise),
-                              approach_pose=rig.approach_pose(start, jaw_position=-40.0, standoff=1.0),
+                              approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
                               step=math.radians(study.step_deg), confidence=o.confidence,
                               max_rotation=math.radians(o.max_rotation_deg), check_every=o.check_every,
                               min_spread=o.min_spread)
@@ -167,26 +235,36 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict
         curve.append((mark, e))
         mark += MARK_DEG
     return {"estimate_arc": res.estimate_arc, "error_mm": final, "rotation_deg": rot, "curve": curve,
-            "stopped": res.stopped}
+            "stopped": reactive_stop(res), "mass": res.belief.mass, "bridges": res.bridges}
 
 
-def score_methods(study, part, noise, cal, run, start: float, rig_seed: int, true_arc: float) -> dict:
-    """The ``<method>_<column>`` cells of one trial for every method of ``study``."""
-    seq = fixed_readings(run, part)
+def score_methods(study, part, noise, cal, rolls, start: float, rig_seed: int, true_arc: float,
+                  rules: dict | None = None) -> dict:
+    """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
+
+    ``rolls`` are the fixed rolls' :class:`driver.procedures.RollResult`; ``rules`` caches the
+    localizer's results per rule within the trial.
+    """
+    seq = fixed_readings(rolls, part)
+    rules = {} if rules is None else rules
     out = {}
     for m in study.methods:
         try:
             if m in ("paper", "likelihood"):
-                r = score_paper(study, part, run, seq, m)
+                r = score_paper(study, part, rolls, seq, m, rules)
             elif m == "particle":
                 r = score_particle(study, part, seq, seed=rig_seed)
             elif m == "grid":
                 r = score_grid(study, part, noise, seq)
             else:
                 r = score_reactive(study, part, noise, cal, start, rig_seed)
-        except Exception:  # this method failed on this trial: a miss, the others still count
-            r = {"estimate_arc": math.nan, "error_mm": math.inf, "rotation_deg": math.nan, "curve": []}
+            r["failure"] = ""
+        except Exception as exc:  # noqa: BLE001 - this method failed on this trial; the others still count
+            text = str(exc) if isinstance(exc, _MethodError) else f"{type(exc).__name__}: {exc}"
+            r = {"estimate_arc": math.nan, "error_mm": math.inf, "rotation_deg": math.nan, "curve": [],
+                 "stopped": "error", "mass": "", "failure": text[:200]}
         out.update({f"{m}_success": int(r["error_mm"] < study.success_radius), f"{m}_error_mm": r["error_mm"],
                     f"{m}_estimate_arc": r["estimate_arc"], f"{m}_rotation_deg": r["rotation_deg"],
-                    f"{m}_curve": _curve(r["curve"])})
+                    f"{m}_curve": _curve(r["curve"]), f"{m}_stopped": r["stopped"], f"{m}_mass": r["mass"],
+                    f"{m}_failure": r["failure"], f"{m}_bridges": r.get("bridges", "")})
     return out

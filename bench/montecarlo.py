@@ -137,9 +137,30 @@ def run_study(study: Study, out, *, workers: int | None = None, scheduler: str |
         sys.stderr.write("\n")
     summary = summarize(study, read_trials(table))
     summary["wall_s"] = time.monotonic() - t0
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    (out / "summary.json").write_text(json.dumps(json_safe(summary), indent=2, allow_nan=False) + "\n")
     plot_study(study, read_trials(table), out)
     return summary
+
+
+def json_safe(value):
+    """``value`` with every non-finite float as None: JSON has no NaN or Infinity."""
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _number(text) -> float:
+    """A trials.csv cell as a float (empty: nan)."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def summarize(study: Study, rows) -> dict:
@@ -151,19 +172,47 @@ def summarize(study: Study, rows) -> dict:
         ok = sum(int(r["success"]) for r in sel)
         err = np.array([float(r["error_mm"]) for r in sel]) if sel else np.array([])
         levels.append({
-            "level": level, "parameter": study.parameter, "value": study.level_value(level), "trials": n,
+            "level": level, "parameter": study.parameter, "value": study.level_label(level), "trials": n,
             "success": ok, "success_rate": ok / n if n else None, "ci95": list(wilson(ok, n)),
             "error_median_mm": float(np.median(err)) if n else None,
             "error_p90_mm": float(np.quantile(err, 0.9)) if n else None,
             "ambiguous": sum(int(r["ambiguous"]) for r in sel),
             "broken": sum(bool(r["failure"]) for r in sel),
             "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,
+            "mean_restarts": float(np.mean([float(r["restarts"]) for r in sel])) if n else None,
         })
+        if study.methods:
+            levels[-1]["methods"] = {m: method_detail(study, m, sel) for m in study.methods}
     out = {"study": study.name, "method": study.method, "engine": study.engine, "noise": study.noise,
            "success_radius": study.success_radius, "levels": levels}
     if study.methods:
         out.update(summarize_methods(study, rows))
     return out
+
+
+def method_detail(study: Study, m: str, rows) -> dict:
+    """One method's record over ``rows``: success, how it stopped, confident and wrong, per part."""
+    n = len(rows)
+    ok = sum(int(r[f"{m}_success"]) for r in rows)
+    rot = np.array([_number(r[f"{m}_rotation_deg"]) for r in rows], dtype=float)
+    err = np.array([_number(r[f"{m}_error_mm"]) for r in rows], dtype=float)
+    stopped = [r.get(f"{m}_stopped", "") for r in rows]
+    confident = [r for r, st in zip(rows, stopped) if st == "confident"]
+    per_part: dict = {}
+    for r in rows:
+        d = per_part.setdefault(r["part"], {"success": 0, "trials": 0})
+        d["trials"] += 1
+        d["success"] += int(r[f"{m}_success"])
+    wrong = sum(1 - int(r[f"{m}_success"]) for r in confident)
+    return {"success": ok, "trials": n, "ci95": list(wilson(ok, n)),
+            "mean_rotation_deg": float(np.nanmean(rot)) if n and np.isfinite(rot).any() else None,
+            "median_rotation_deg": float(np.nanmedian(rot)) if n and np.isfinite(rot).any() else None,
+            "error_median_mm": float(np.median(err)) if n else None,
+            "confident": len(confident), "confident_wrong": wrong,
+            "confident_wrong_ci95": list(wilson(wrong, len(confident))),
+            "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
+            "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
+            "per_part": dict(sorted(per_part.items()))}
 
 
 def summarize_methods(study: Study, rows) -> dict:
@@ -173,14 +222,8 @@ def summarize_methods(study: Study, rows) -> dict:
     rates, details, curves = {}, {}, {}
     n = len(rows)
     for m in study.methods:
-        ok = sum(int(r[f"{m}_success"]) for r in rows)
-        rot = np.array([float(r[f"{m}_rotation_deg"]) for r in rows], dtype=float)
-        err = np.array([float(r[f"{m}_error_mm"]) for r in rows], dtype=float)
-        rates[m] = ok / n if n else None
-        details[m] = {"success": ok, "trials": n, "ci95": list(wilson(ok, n)),
-                      "mean_rotation_deg": float(np.nanmean(rot)) if n else None,
-                      "median_rotation_deg": float(np.nanmedian(rot)) if n else None,
-                      "error_median_mm": float(np.median(err)) if n else None}
+        details[m] = method_detail(study, m, rows)
+        rates[m] = details[m]["success"] / n if n else None
         per_mark: dict = {}
         for r in rows:
             pairs = parse_curve(r[f"{m}_curve"])
@@ -197,6 +240,22 @@ def summarize_methods(study: Study, rows) -> dict:
     return {"methods": rates, "method_details": details, "success_by_rotation_deg": curves}
 
 
+#: Bins of stated confidence in the reliability diagram.
+RELIABILITY_BINS = (0.0, 0.5, 0.8, 0.9, 0.95, 0.99, 1.0 + 1e-12)
+
+
+def reliability(study: Study, m: str, rows) -> list:
+    """(mean stated mass, fraction within the success radius, trials) per bin of stated mass."""
+    mass = np.array([_number(r.get(f"{m}_mass", "")) for r in rows])
+    hit = np.array([int(r[f"{m}_success"]) for r in rows])
+    out = []
+    for lo, hi in zip(RELIABILITY_BINS[:-1], RELIABILITY_BINS[1:]):
+        sel = np.isfinite(mass) & (mass >= lo) & (mass < hi)
+        if sel.any():
+            out.append((float(mass[sel].mean()), float(hit[sel].mean()), int(sel.sum())))
+    return out
+
+
 def plot_study(study: Study, rows, out: Path) -> None:
     """success.png (rate against the swept value), errors.png, failures.png (where on the parts)."""
     import matplotlib
@@ -210,8 +269,9 @@ def plot_study(study: Study, rows, out: Path) -> None:
     summ = full["levels"]
     if study.methods and rows:
         _plot_methods(study, full, out)
+        _plot_reliability(study, rows, out)
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    x = [lv["value"] if lv["value"] is not None else k for k, lv in enumerate(summ)]
+    x = [lv["value"] if isinstance(lv["value"], (int, float)) else k for k, lv in enumerate(summ)]
     rate = np.array([lv["success_rate"] if lv["success_rate"] is not None else np.nan for lv in summ])
     lo = np.array([lv["ci95"][0] for lv in summ])
     hi = np.array([lv["ci95"][1] for lv in summ])
@@ -232,7 +292,7 @@ def plot_study(study: Study, rows, out: Path) -> None:
         e = np.array([float(r["error_mm"]) for r in rows if int(r["level"]) == lv])
         e = np.clip(e[np.isfinite(e)], 1e-4, 1e3)
         if e.size:
-            label = f"{study.parameter}={study.level_value(lv):g}" if study.parameter else "all trials"
+            label = f"{study.parameter}={study.level_label(lv)}" if study.parameter else "all trials"
             ax.hist(e, bins=bins, histtype="step", lw=1.5, label=label)
     ax.axvline(study.success_radius, color="tab:red", lw=1, ls="--", label=f"{study.success_radius} mm")
     ax.set_xscale("log")
@@ -292,17 +352,59 @@ def _plot_methods(study: Study, summary: dict, out: Path) -> None:
     plt.close(fig)
 
 
+def _plot_reliability(study: Study, rows, out: Path) -> None:
+    """reliability.png: stated confidence at the stop against the fraction within the radius, per level."""
+    import matplotlib.pyplot as plt
+
+    stating = [m for m in study.methods if any(np.isfinite(_number(r.get(f"{m}_mass", ""))) for r in rows)]
+    if not stating:
+        return
+    fig, axes = plt.subplots(1, len(stating), figsize=(4.6 * len(stating), 4.4), squeeze=False)
+    for ax, m in zip(axes[0], stating):
+        ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="a promise kept")
+        for level in range(study.levels):
+            sel = [r for r in rows if int(r["level"]) == level]
+            pts = reliability(study, m, sel)
+            if not pts:
+                continue
+            x, y, n = (np.array(v) for v in zip(*pts))
+            label = str(study.level_label(level)) if study.parameter else "all trials"
+            ax.plot(x, y, "o-", ms=3, label=label)
+            for xi, yi, ni in zip(x, y, n):
+                ax.annotate(str(ni), (xi, yi), fontsize=6, xytext=(2, -8), textcoords="offset points")
+        ax.set_xlim(0, 1.02)
+        ax.set_ylim(0, 1.02)
+        ax.set_xlabel("stated probability within the radius at the stop")
+        ax.set_ylabel(f"fraction actually within {study.success_radius} mm")
+        ax.set_title(f"{m}", fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper left")
+    fig.suptitle(f"{study.name}: reliability (numbers: trials per bin)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out / "reliability.png", dpi=110)
+    plt.close(fig)
+
+
 def print_summary(summary: dict) -> None:
     print(f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
           f"noise {Path(str(summary['noise'])).name}")
     for lv in summary["levels"]:
-        v = "" if lv["value"] is None else f"{lv['parameter']} = {lv['value']:g}: "
+        v = "" if lv["value"] is None else f"{lv['parameter']} = {lv['value']}: "
         rate = lv["success_rate"]
         print(f"  {v}{lv['success']}/{lv['trials']} within {summary['success_radius']} mm = "
               f"{rate:.1%} (95% CI {lv['ci95'][0]:.1%}–{lv['ci95'][1]:.1%}), median error "
               f"{lv['error_median_mm']:.3f} mm" if rate is not None else f"  {v}no trials")
-    for m, rate in summary.get("methods", {}).items():
-        d = summary["method_details"][m]
-        if rate is not None:
-            print(f"  {m:10s} {d['success']}/{d['trials']} = {rate:.1%} (95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), "
-                  f"mean rotation {d['mean_rotation_deg']:.1f}°, median error {d['error_median_mm']:.3f} mm")
+        if len(summary["levels"]) > 1:
+            for m, d in lv.get("methods", {}).items():
+                _print_method(m, d, indent="    ")
+    for m, d in summary.get("method_details", {}).items():
+        _print_method(m, d, indent="  ")
+
+
+def _print_method(m: str, d: dict, indent: str) -> None:
+    if not d["trials"]:
+        return
+    rot = "" if d["mean_rotation_deg"] is None else f"mean rotation {d['mean_rotation_deg']:.1f}°, "
+    print(f"{indent}{m:10s} {d['success']}/{d['trials']} = {d['success'] / d['trials']:.1%} "
+          f"(95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), {rot}median error {d['error_median_mm']:.3f} mm; "
+          f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}")

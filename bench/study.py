@@ -16,6 +16,9 @@ A study file::
     [sweep]                              # optional: one noise-model field over levels
     parameter = "v2_noise"
     values = [0.0, 0.0003, 0.0006, 0.0012]
+    # or whole noise models over levels (files relative to the study file, or presets):
+    # parameter = "noise"
+    # values = ["noise/paper-x0.5.toml", "paper", "noise/paper-x2.toml"]
 
     [likelihood]                         # optional: the standard deviations told to the
     sd_length = 0.3                      # likelihood rule (mm, degrees)
@@ -28,9 +31,12 @@ Several methods on the same trials (instead of ``method``)::
     [reactive]                           # the sequential filter (driver.reactive)
     confidence = 0.95
     max_rotation_deg = 180.0
-    sd_position = 0.04                   # mm, one contact-location reading
-    sd_scale = 0.003                     # calibration scale
-    sd_slope = 0.003                     # rad, the part's slope error ("auto": from the noise model)
+    sd_position = 0.04                   # mm, one contact-location reading   } each optional: the
+    sd_scale = 0.003                     # calibration scale                  } filter's own default,
+    sd_slope = 0.003                     # rad, the part's slope error        } with its noise scale
+                                         #   ("auto": from the study's noise model)  weighed out
+    noise_scales = [1.0]                 # optional: the factors on those it weighs (default
+                                         #   localizer.NOISE_SCALES; [1.0] trusts them)
 
     [particle]                           # the peer baseline, over the fixed rolls' readings
     particles = 2000
@@ -44,7 +50,12 @@ without the reactive rolling) use the readings of the fixed rolls
 rig with the same seed.
 
 Every trial is reproducible from (seed, level, trial): its generator is
-``numpy.random.SeedSequence([seed, level, trial])``.
+``numpy.random.SeedSequence([seed, level, trial])``. The start is drawn uniformly over the
+boundary points from which the jaw, laid with the contact 40 mm from its centre, can roll the
+fixed rolls without bridging (:class:`localizer.Reach`); the rig's own refusal, rare then, is
+redrawn (``restarts``). Calibration taps the most curved point the whole jaw reaches
+(:func:`localizer.calibration_arc`). Each method is scored on its own: an error in one is that
+method's failure (``<method>_stopped = "error"``, ``<method>_failure``), never the others'.
 """
 
 from __future__ import annotations
@@ -68,7 +79,14 @@ _KEYS = {"name", "parts", "rolls_deg", "step_deg", "method", "methods", "engine"
          "success_radius", "noise", "sweep", "likelihood", "reactive", "particle"}
 METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
-METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve")
+#: ``stopped``: confident, budget, ambiguous (the reactive method), fixed (the fixed-roll methods) or
+#: error; ``mass``: the stated probability within the success radius at the end (empty if the method
+#: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met.
+METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve", "stopped", "mass", "failure",
+                  "bridges")
+#: Where the jaw is laid on the part: the contact this far (mm) from the jaw's centre, behind it in
+#: the rolling direction, so that most of the jaw lies ahead.
+JAW_START = 40.0
 
 
 @dataclass(frozen=True)
@@ -78,10 +96,11 @@ class ReactiveOptions:
     confidence: float = 0.95
     max_rotation_deg: float = 180.0
     check_every: int = 5
-    sd_position: float = 0.04
-    sd_scale: float = 0.003
-    sd_slope: float | None = None   # None: "auto"
+    sd_position: float | None = None   # None: the filter's default
+    sd_scale: float | None = None
+    sd_slope: float | str | None = None   # "auto": from the study's noise model
     min_spread: float = 0.05
+    noise_scales: tuple | None = None  # None: localizer.NOISE_SCALES
 
 
 @dataclass(frozen=True)
@@ -132,6 +151,22 @@ class Study:
 
     def level_value(self, level: int):
         return self.values[level] if self.values else None
+
+    def level_label(self, level: int):
+        """The level's value as trials.csv and summary.json write it (a noise file by its name)."""
+        v = self.level_value(level)
+        return Path(v).stem if self.parameter == "noise" and v is not None else v
+
+    def level_noise(self, level: int):
+        """The noise model of a level."""
+        from sim2d import load_noise
+
+        if self.parameter == "noise":
+            return load_noise(self.values[level])
+        noise = load_noise(self.noise)
+        if self.parameter is not None:
+            noise = replace(noise, **{self.parameter: self.values[level]})
+        return noise
 
     def with_overrides(self, *, trials=None, engine=None) -> "Study":
         s = self
@@ -224,18 +259,30 @@ def load_study(path) -> Study:
         if not isinstance(sweep, dict) or set(sweep) - {"parameter", "values"}:
             raise StudyError(f"study {path}: [sweep] takes 'parameter' and 'values'")
         parameter = sweep.get("parameter")
-        if parameter not in NoiseModel.__dataclass_fields__:
-            raise StudyError(f"study {path}: sweep parameter {parameter!r} is not a noise-model field; "
-                             f"fields: {sorted(NoiseModel.__dataclass_fields__)}")
-        values = sweep.get("values")
-        if not isinstance(values, list) or not values:
-            raise StudyError(f"study {path}: sweep values must be a non-empty list")
-        for v in values:
-            try:
-                replace(base, **{parameter: v})
-            except (SimError, TypeError) as exc:
-                raise StudyError(f"study {path}: sweep value {v!r} of {parameter}: {exc}") from None
-        values = tuple(float(v) for v in values)
+        if parameter == "noise":
+            values = sweep.get("values")
+            if not isinstance(values, list) or not values or not all(isinstance(v, str) for v in values):
+                raise StudyError(f"study {path}: a noise sweep's values must be a non-empty list of presets or files")
+            values = [v if v in PRESETS else resolve(v) for v in values]
+            for v in values:
+                try:
+                    load_noise(v)
+                except SimError as exc:
+                    raise StudyError(f"study {path}: sweep noise {v!r}: {exc}") from None
+            values = tuple(values)
+        elif parameter not in NoiseModel.__dataclass_fields__:
+            raise StudyError(f"study {path}: sweep parameter {parameter!r} is not a noise-model field nor "
+                             f"'noise'; fields: {sorted(NoiseModel.__dataclass_fields__)}")
+        else:
+            values = sweep.get("values")
+            if not isinstance(values, list) or not values:
+                raise StudyError(f"study {path}: sweep values must be a non-empty list")
+            for v in values:
+                try:
+                    replace(base, **{parameter: v})
+                except (SimError, TypeError) as exc:
+                    raise StudyError(f"study {path}: sweep value {v!r} of {parameter}: {exc}") from None
+            values = tuple(float(v) for v in values)
     lk = data.get("likelihood", {})
     if not isinstance(lk, dict) or set(lk) - {"sd_length", "sd_turn_deg"}:
         raise StudyError(f"study {path}: [likelihood] takes 'sd_length' and 'sd_turn_deg'")
@@ -259,7 +306,14 @@ def _options(path, table, cls, name):
     values = {}
     for key, value in table.items():
         if key == "sd_slope" and value == "auto":
-            values[key] = None
+            values[key] = "auto"
+            continue
+        if key == "noise_scales":
+            if (not isinstance(value, list) or not value
+                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+                               for v in value)):
+                raise StudyError(f"study {path}: [{name}] noise_scales={value!r} must be a list of positive factors")
+            values[key] = tuple(float(v) for v in value)
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):
             raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a positive number")
@@ -293,82 +347,93 @@ def _part(path):
     return _PART_CACHE[path]
 
 
+def start_sampler(part, rolls, jaw_start: float):
+    """Boundary points (grid indices) and grid step of the filter's tracks from which the jaw, laid with
+    the contact at ``jaw_start`` mm on it, rolls through ``rolls`` (rad, one sign) without bridging,
+    with a millimetre to spare (:meth:`localizer.ModeTracks.rollable`)."""
+    from localizer import tracks_for
+
+    tracks = tracks_for(part, 0.02)
+    total = float(sum(rolls))
+    turns = np.append(np.arange(0.0, abs(total), math.radians(1.0)), abs(total)) * math.copysign(1.0, total)
+    ok = np.flatnonzero(tracks.rollable(turns, jaw_start, margin=1.0))
+    return ok, tracks
+
+
 def run_trial(spec: TrialSpec) -> dict:
     """One simulated localization: calibrate, pick a start, roll, localize, score. Never raises.
 
-    The start is drawn uniformly over the perimeter; a start where the pipeline
-    refuses to roll (not on the convex hull, or a roll would bridge a
-    concavity) is redrawn, up to 20 times (``restarts``). With ``methods``, every
-    method is scored on that same trial (module notes).
+    The start is drawn uniformly over the boundary points from which the fixed rolls can run
+    (module notes); a start where the simulated rig still refuses to roll (a bridge, or the jaw
+    laid off the point) is redrawn, up to 20 times (``restarts``). With ``methods``, every
+    method is scored on that same trial, each on its own.
     """
-    import math as _m
-
-    from driver.procedures import calibrate, localize_by_rolling
+    from driver.procedures import calibrate, roll_sequence
     from driver.rig import RigError
-    from sim2d import SimRig, load_noise
+    from localizer import calibration_arc
+    from sim2d import SimRig
+
+    from .methods import score_methods, score_rule
 
     s = spec.study
     t0 = time.perf_counter()
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
     part_file = s.parts[int(rng.integers(len(s.parts)))]
     part = _part(part_file)
-    noise = load_noise(s.noise)
-    value = s.level_value(spec.level)
-    if s.parameter is not None:
-        noise = replace(noise, **{s.parameter: value})
-    row = {"level": spec.level, "trial": spec.trial, "parameter": s.parameter or "", "value": value,
-           "part": Path(part_file).name}
-    rolls = [_m.radians(r) for r in s.rolls_deg]
+    noise = s.level_noise(spec.level)
+    row = {"level": spec.level, "trial": spec.trial, "parameter": s.parameter or "",
+           "value": s.level_label(spec.level), "part": Path(part_file).name}
+    rolls = [math.radians(r) for r in s.rolls_deg]
+    jaw_start = -JAW_START if rolls[0] > 0 else JAW_START
     rule = s.method if s.method in ("paper", "likelihood") else "paper"
     try:
-        t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
-        cal_arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+        cal_arc = calibration_arc(part)
         cal_rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=s.engine)
         cal = calibrate(cal_rig, cal_rig.approach_pose(cal_arc, jaw_position=0.0, standoff=1.0))
+        candidates, tracks = start_sampler(part, rolls, jaw_start)
+        if candidates.size == 0:
+            raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")
         run = None
         for restarts in range(20):
-            start = float(rng.uniform(0, part.perimeter))
+            start = float(part.wrap_arc(tracks.sigma[int(rng.choice(candidates))]
+                                        + rng.uniform(-0.5, 0.5) * tracks.h))
             rig_seed = int(rng.integers(1 << 31))
             rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine)
             try:
-                run = localize_by_rolling(
-                    rig, part, rolls, calibration=cal, step=_m.radians(s.step_deg), rule=rule,
-                    sd_length=s.sd_length, sd_turn=_m.radians(s.sd_turn_deg),
-                    approach_pose=rig.approach_pose(start, jaw_position=-40.0 if rolls[0] > 0 else 40.0,
-                                                    standoff=1.0))
+                run = roll_sequence(rig, rolls, calibration=cal, step=math.radians(s.step_deg),
+                                    approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0))
             except RigError:
                 continue
-            first = run.rolls[0].truth[0][0]
-            if abs(float(part.arc_offset(first, start))) > 1.0:  # laid off the hull
+            if abs(float(part.arc_offset(run[0].truth[0][0], start))) > 1.0:  # laid off the point
                 run = None
                 continue
             break
         if run is None:
-            raise RigError("no start out of 20 let the rolls run (a part with little convex hull?)")
-        true_arc = rig.truth()["contact_arc"]
-        best = run.localization.best
-        est = best.end_arc if best is not None else math.nan
-        err = abs(float(part.arc_offset(est, true_arc))) if best is not None else math.inf
-        row.update({"start_arc": start, "true_arc": true_arc, "estimate_arc": est, "error_mm": err,
-                    "success": int(err < s.success_radius), "candidates": len(run.localization.candidates),
-                    "probability": best.probability if best is not None else 0.0,
-                    "ambiguous": int(run.localization.ambiguous),
-                    "lengths": " ".join(f"{L:.6f}" for L, _ in run.estimates),
-                    "turns": " ".join(f"{w:.8f}" for _, w in run.estimates),
-                    "restarts": restarts, "failure": ""})
-        if s.methods:
-            from .methods import score_methods
-
-            row.update(score_methods(s, part, noise, cal, run, start, rig_seed, true_arc))
-            first_method = s.methods[0]
-            for key in ("success", "error_mm", "estimate_arc"):
-                row[key] = row[f"{first_method}_{key}"]
-    except Exception as exc:  # a trial that breaks is a recorded failure, not a lost study
+            raise RigError("no start out of 20 let the rolls run on the simulated rig")
+    except Exception as exc:  # the trial broke before any method could run: every method's failure
+        text = f"{type(exc).__name__}: {exc}"[:200]
         row.update({"start_arc": math.nan, "true_arc": math.nan, "estimate_arc": math.nan, "error_mm": math.inf,
                     "success": 0, "candidates": 0, "probability": 0.0, "ambiguous": 0, "lengths": "",
-                    "turns": "", "restarts": 0, "failure": f"{type(exc).__name__}: {exc}"[:200]})
+                    "turns": "", "restarts": 0, "failure": text})
         for m in s.methods:
             row.update({f"{m}_success": 0, f"{m}_error_mm": math.inf, f"{m}_estimate_arc": math.nan,
-                        f"{m}_rotation_deg": math.nan, f"{m}_curve": ""})
+                        f"{m}_rotation_deg": math.nan, f"{m}_curve": "", f"{m}_stopped": "error", f"{m}_mass": "",
+                        f"{m}_failure": text, f"{m}_bridges": ""})
+        row["time_s"] = time.perf_counter() - t0
+        return row
+    true_arc = rig.truth()["contact_arc"]
+    row.update({"start_arc": start, "true_arc": true_arc, "restarts": restarts, "failure": "",
+                "lengths": " ".join(f"{r.length:.6f}" for r in run), "turns": " ".join(f"{r.turn:.8f}" for r in run)})
+    rules: dict = {}
+    own = score_rule(s, part, run, rule, true_arc, rules)
+    row.update({"estimate_arc": own["estimate_arc"], "error_mm": own["error_mm"],
+                "success": int(own["error_mm"] < s.success_radius), "candidates": own["candidates"],
+                "probability": own["probability"], "ambiguous": own["ambiguous"],
+                "failure": "" if s.methods else own["failure"]})
+    if s.methods:
+        row.update(score_methods(s, part, noise, cal, run, start, rig_seed, true_arc, rules))
+        first_method = s.methods[0]
+        for key in ("success", "error_mm", "estimate_arc"):
+            row[key] = row[f"{first_method}_{key}"]
     row["time_s"] = time.perf_counter() - t0
     return row
