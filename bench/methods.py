@@ -195,6 +195,8 @@ def reactive_filter(study, part, noise):
                                                       part.perimeter), 5e-4)
     if o.noise_scales is not None:
         given["noise_scales"] = o.noise_scales
+    if o.temper is not None:
+        given["temper"] = o.temper
     return ContactFilter(part, radius=study.success_radius, confidence=o.confidence, **given)
 
 

@@ -30,10 +30,8 @@ def run(part_file: Path, start: float, seed: int):
     part = load_part(part_file)
     study = load_study(ROOT / "bench" / "studies" / "reactive.toml")
     noise = load_noise("paper")
-    t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
-    cal_arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
     cal_rig = SimRig(part, noise=noise, seed=seed + 1)
-    cal = calibrate(cal_rig, cal_rig.approach_pose(cal_arc, jaw_position=0.0, standoff=1.0))
+    cal = calibrate(cal_rig, cal_rig.calibration_pose())
     rig = SimRig(part, noise=noise, seed=seed)
     flt = reactive_filter(study, part, noise)
     snaps = []

@@ -31,9 +31,7 @@ def _log(msg):
 
 def calibration_for(part, noise="none", seed=0, engine="kinematic"):
     rig = SimRig(part, noise=noise, seed=seed, engine=engine)
-    t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
-    arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
-    return calibrate(rig, rig.approach_pose(arc, jaw_position=0.0, standoff=1.0))
+    return calibrate(rig, rig.calibration_pose())
 
 
 def fidelity(steps_deg=(0.8, 0.4, 0.2, 0.1), starts=(20.0, 90.0, 160.0, 230.0), angle_deg=40.0):

@@ -101,6 +101,7 @@ class ReactiveOptions:
     sd_slope: float | str | None = None   # "auto": from the study's noise model
     min_spread: float = 0.05
     noise_scales: tuple | None = None  # None: localizer.NOISE_SCALES
+    temper: float | None = None        # None: the filter's default
 
 
 @dataclass(frozen=True)
@@ -263,13 +264,12 @@ def load_study(path) -> Study:
             values = sweep.get("values")
             if not isinstance(values, list) or not values or not all(isinstance(v, str) for v in values):
                 raise StudyError(f"study {path}: a noise sweep's values must be a non-empty list of presets or files")
-            values = [v if v in PRESETS else resolve(v) for v in values]
             for v in values:
                 try:
-                    load_noise(v)
+                    load_noise(v if v in PRESETS else resolve(v))
                 except SimError as exc:
                     raise StudyError(f"study {path}: sweep noise {v!r}: {exc}") from None
-            values = tuple(values)
+            values = tuple(v if v in PRESETS else resolve(v) for v in values)
         elif parameter not in NoiseModel.__dataclass_fields__:
             raise StudyError(f"study {path}: sweep parameter {parameter!r} is not a noise-model field nor "
                              f"'noise'; fields: {sorted(NoiseModel.__dataclass_fields__)}")
@@ -318,6 +318,8 @@ def _options(path, table, cls, name):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):
             raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a positive number")
         values[key] = int(value) if key in ("particles", "check_every") else float(value)
+    if values.get("temper", 0.5) > 1:
+        raise StudyError(f"study {path}: [{name}] temper={values['temper']!r} must be at most 1")
     if values.get("confidence", 0.5) >= 1:
         raise StudyError(f"study {path}: [{name}] confidence={values['confidence']!r} must be below 1")
     if values.get("particles", 2) < 2:
@@ -370,7 +372,6 @@ def run_trial(spec: TrialSpec) -> dict:
     """
     from driver.procedures import calibrate, roll_sequence
     from driver.rig import RigError
-    from localizer import calibration_arc
     from sim2d import SimRig
 
     from .methods import score_methods, score_rule
@@ -387,9 +388,8 @@ def run_trial(spec: TrialSpec) -> dict:
     jaw_start = -JAW_START if rolls[0] > 0 else JAW_START
     rule = s.method if s.method in ("paper", "likelihood") else "paper"
     try:
-        cal_arc = calibration_arc(part)
         cal_rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=s.engine)
-        cal = calibrate(cal_rig, cal_rig.approach_pose(cal_arc, jaw_position=0.0, standoff=1.0))
+        cal = calibrate(cal_rig, cal_rig.calibration_pose())
         candidates, tracks = start_sampler(part, rolls, jaw_start)
         if candidates.size == 0:
             raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")

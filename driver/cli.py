@@ -97,7 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
     emu.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
     emu.add_argument("--start", type=float, metavar="MM",
                      help="the hand starts with the jaw's centre facing this arc position, 1 mm off "
-                          "(default: the part's most curved point)")
+                          "(default: the part's most curved point that the whole jaw reaches)")
     emu.add_argument("--noise", default="paper", metavar="none|paper|FILE.toml", help="noise model (default paper)")
     emu.add_argument("--engine", choices=("pymunk", "kinematic"), default="kinematic",
                      help="the simulated world (default kinematic)")
@@ -262,13 +262,12 @@ def _simulate(args) -> int:
     rolls = [math.radians(r) for r in (args.roll or [20.0])]
     if not 0 <= args.start < part.perimeter:
         raise LocalizerError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
-    # calibrate on the part's most curved point (on the hull), with its own rig instance
-    t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
-    cal_arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+    # calibrate on the part's most curved point that the whole jaw reaches, with its own rig instance
     cal_rig = SimRig(part, noise=noise, seed=args.seed + 1, engine=args.engine)
-    calibration = calibrate(cal_rig, cal_rig.approach_pose(cal_arc, jaw_position=0.0, standoff=1.0))
+    calibration = calibrate(cal_rig, cal_rig.calibration_pose())
     rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine)
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
+    _check_reach(part, args.start, jaw_start)
     if args.reactive:
         doc, res = _reactive(args, rig, part, calibration,
                              rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0))
@@ -298,6 +297,22 @@ def _simulate(args) -> int:
     doc["trace"] = str(args.out)
     _emit_run(args, doc, part, trace, run.localization)
     return 0
+
+
+def _check_reach(part, start: float, jaw: float) -> None:
+    """Refuse, before anything moves, a start the jaw cannot be laid on with the contact at ``jaw`` mm."""
+    from localizer import DEFAULT_JAW, reach_for
+
+    reach = reach_for(part, DEFAULT_JAW)
+    if bool(reach.touchable(start, jaw=jaw)):
+        return
+    lo, hi = (float(v) for v in reach.interval(start))
+    lo, hi = max(lo, -DEFAULT_JAW.half), min(hi, DEFAULT_JAW.half)
+    where = (f"it touches there only with the contact between {lo:+.1f} and {hi:+.1f} mm on the jaw"
+             if lo < hi else "no place on the jaw touches there (a concave stretch, or a concavity narrower "
+                             "than the jaw)")
+    raise RigError(f"--start {start} mm: a {DEFAULT_JAW} jaw laid there with the contact at {jaw:+.0f} mm on it "
+                   f"would touch the part elsewhere; {where}. Pick another start")
 
 
 def _locate(args) -> int:
@@ -374,12 +389,10 @@ def _emulate(args) -> int:
         raise RigError(str(exc)) from None
     rig = SimRig(part, noise=args.noise, seed=args.seed, engine=args.engine)
     if args.start is None:
-        t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
-        start = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+        start_pose = rig.calibration_pose()
     else:
-        start = float(args.start) % part.perimeter
-    emulator = Emulator(rig, start_pose=rig.approach_pose(start, jaw_position=0.0, standoff=1.0),
-                        faults=faults, seed=args.seed)
+        start_pose = rig.approach_pose(float(args.start) % part.perimeter, jaw_position=0.0, standoff=1.0)
+    emulator = Emulator(rig, start_pose=start_pose, faults=faults, seed=args.seed)
     if args.tcp is not None:
         arm, daq = emulator.serve_tcp(args.tcp)
     else:

@@ -13,35 +13,75 @@ of ``spacing`` mm over the whole boundary. After k steps, the measured
 cumulative signed arcs z_0 = 0, z_1, …, z_k and the predicted ones
 p_j(σ₀) = σ(θ(σ₀) + Ω_j) − σ₀ are related by
 
-    z_j = c + b·p_j(σ₀) + ρ̂_j·η(z_j) + e_j,   e_j ~ N(0, sd_position²) independent,
+    z_j = c_s + b·p_j(σ₀) + δ(z_j) + g(d_j) + e_j,
+    e_j ~ N(0, sd_position² + (ρ̂_j·sd_turn)²) independent,
 
-where c absorbs the noise of the first reading (flat prior), b is the
-calibration's scale (b ~ N(1, sd_scale²)), and ρ̂·η is the machining error's
-effect: a slope error η of the real boundary against its model (rad) moves the
-contact for a given jaw angle by ρ·η, ρ the radius of curvature there. η is a
-smooth random function along the path, cubic B-splines in z with knots every
-``shape_spacing`` mm and coefficients ~ N(0, sd_slope²), and ρ̂_j is the model's
-radius of curvature at the present contact of a reference hypothesis, the most
-probable one (re-chosen every ``refresh`` readings; the part's median radius
-before the first), the same for every hypothesis. ρ̂ must not be measured from
-the readings themselves (arc over rotation over the last few steps, as the first
-version did): that puts the reading noise into the basis, and the slope term
-then fitted the noise and moved the start, by up to 0.5 mm at a stated 99%
-(docs/robustness.md). This error repeats when the jaw rolls over the same
-stretch again, so more rolling does not average it away; near an inflection,
-where ρ grows without bound, it makes the readings say little, as they should.
-The same term at the last reading is how far the real present contact is from
-where the model puts it (:meth:`ContactFilter.shift`); the belief includes it
-and its spread.
-c, b and η are integrated out in closed form (Woodbury): each hypothesis keeps
-running sums (pᵀp, pᵀz and the basis projections Uᵀp, of which a reading
-touches five), so one step costs a few vector operations on the grid, and the
-belief a small dense solve. The rotations
-are taken as exact; the encoder's 0.03° moves a contact by ρ·5e-4 rad, a few
-µm at the parts' radii. A hypothesis that would have to cross an inflection
-(where a straight jaw bridges a concavity, which the rolling procedure refuses)
-has zero likelihood; so does a start on a concave stretch, which a straight jaw
-cannot touch.
+- c_s, one per contact segment (a regrasp or a bridge starts a new one), absorbs
+  the first reading's error (flat prior);
+- b is the calibration's scale, b ~ N(1, sd_scale²);
+- δ is the machining error's effect: a slope error η of the real boundary against
+  its model (rad) moves the contact for a given jaw angle by δ = ρ·η, ρ the radius
+  of curvature there. δ is a smooth function along the path, cubic B-splines in z
+  with knots every ``shape_spacing`` mm, each coefficient ~ N(0, (ρ̂·sd_slope)²)
+  with ρ̂ the largest model radius over its support along the path of a reference
+  hypothesis, the most probable one (re-chosen every ``refresh`` readings; the
+  part's median radius before the first), the same for every hypothesis. ρ̂ must
+  not be measured from the readings themselves (arc over rotation over the last
+  few steps, as the first version did): that puts the reading noise into the model
+  and the term fits it. Nor may the basis' *values* be scaled by ρ̂ (as the second
+  version did): when the reference changes, ρ̂ jumps, the term's constant part then
+  looks measured, and on a flat stretch the belief said 97% at 0.35 mm off. Only
+  the coefficients' prior changes, which the running sums do not depend on. δ
+  repeats when the jaw rolls over the same stretch again, so more rolling does not
+  average it away; its value at the last reading is how far the real present
+  contact is from where the model puts it (:meth:`ContactFilter.shift`), and the
+  belief includes it and its spread;
+- g is the calibration's error along the jaw: the contact's place on the jaw d_j is
+  read through a spline of 11 taps, whose error is a smooth function of d, the same
+  all run long (measured on the simulated rig: about 0.45 of one reading's standard
+  deviation, with a correlation length of about 10 mm). Rolling back and forth over
+  one corner reads the same places again, so without g the same error counted as
+  fresh evidence each time (the belief said 99% for the wrong one of two look-alike
+  corners). Cubic B-splines in d every ``jaw_spacing`` mm, coefficients
+  ~ N(0, sd_jaw²);
+- e_j, the reading's own error, with the rotation reading's error moving the
+  contact by ρ·e_Ω (the arm encoder's 0.03° steps: on a flat stretch of ρ = 300 mm
+  that is 0.05 mm, more than the reading's own error).
+
+c, b, δ and g are integrated out in closed form (Woodbury): each hypothesis keeps
+running sums (pᵀp, pᵀz and the basis projections Uᵀp, of which a reading touches
+nine), so one step costs a few vector operations on the grid, and the belief a
+small dense solve.
+
+*Noise it was not told.* Every standard deviation above is the setting times one
+common factor λ, unknown, with a log-uniform prior over :data:`NOISE_SCALES` (a
+quarter to sixteen times). Scaling every standard deviation by λ scales the
+quadratic form by 1/λ² and the determinant by λ^(2k), k the readings not absorbed
+by a segment's offset, and leaves the rest unchanged, so each hypothesis' marginal
+likelihood over λ costs a few vector operations per grid value. The readings thus
+set the noise level themselves: told 0.035 mm and read at 0.14, the belief widens
+instead of stopping sure and wrong.
+
+*Where the jaw reaches* (:class:`localizer.Reach`). A start on a concave stretch,
+or a roll that would cross an inflection, is ruled out (a straight jaw bridges
+there, which the rolling procedure undoes and reports). Each reading's place on
+the jaw (:meth:`ContactFilter.touch`) must be one at which the jaw can touch the
+hypothesis' present contact, within ``jaw_margin``: else the hypothesis is made
+:data:`CONTRADICTION` times less likely. A reported bridge makes the hypotheses
+under which the jaw surely stayed clear :data:`BRIDGE_MISS` times less likely
+(:meth:`ContactFilter.bridged`). Both are soft: a misread place or a refused press
+for another reason must not rule out the truth.
+
+*Trust.* The stop rule looks at the belief every few steps and stops at the first
+crossing of the confidence. Even for a posterior that is exactly right, the odds
+of a wrong place against the true one are a martingale, and the chance that they
+ever reach 19 (95%) is up to 1/19: stopping at the first crossing of 0.95 is
+wrong up to 5% of the time, and the model leaves out some errors (the encoder's
+three-step cycle, the ADC's pattern). The readings' likelihood is therefore
+raised to the power :data:`TEMPER` (½): a stop at 95% then needs the odds the
+model alone would put at 19² = 361. Measured on the tuning family (bench/parts/
+tuning, noise ×0.7, ×1.4, ×2.8): 3 of 119 confident stops wrong at power 1, 0 of
+118 at ½, for 7° more rolling on average.
 
 The belief over the *present* contact is the push-forward of the posterior over
 σ₀. :meth:`ContactFilter.belief` reports its maximum, the probability within the
@@ -67,13 +107,16 @@ from ._errors import QueryError
 from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "NOISE_SCALES"]
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for", "NOISE_SCALES",
+           "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
 #: log-uniform prior in steps of 2^(1/4) from a quarter to sixteen times what it was told. The
 #: steps are fine because with hundreds of readings the scale's posterior is sharp (a few per cent):
 #: a coarse grid would round it, and an underestimated scale overstates the evidence.
 NOISE_SCALES = tuple(float(2.0 ** (k / 4)) for k in range(-8, 17))
+#: The power on the readings' likelihood: the evidence counts half (module notes, "Trust").
+TEMPER = 0.5
 #: Probability that one reading puts the contact where the jaw cannot touch under the true start
 #: (a jaw position misread by more than ``jaw_margin``, a model error in the part's reach).
 CONTRADICTION = 1e-3
@@ -212,9 +255,11 @@ class ModeTracks:
         # where the jaw reaches, from its geometry (localizer._reach): no fixed tolerance below the hull
         self.reach = reach_for(part, jaw)
         self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
+        self.lo_sure, self.hi_sure = (np.array(v) for v in self.reach.interval(sigma, sure=True))
         self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
         self.convex = rising[a][self._run] & (kappa > 0) & self.touchable
-        for arr in (self.sigma, self.theta, self.kappa, self.lo, self.hi, self.touchable, self.convex, self._s,
+        for arr in (self.sigma, self.theta, self.kappa, self.lo, self.hi, self.lo_sure, self.hi_sure, self.touchable,
+                    self.convex, self._s,
                     self._banded, self._first, self._last, self._run):
             arr.setflags(write=False)
 
@@ -252,16 +297,18 @@ class ModeTracks:
         arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
         return np.where(ok, arc, np.nan), ok
 
-    def touches(self, arc, jaw=None, margin: float = 0.0) -> np.ndarray:
+    def touches(self, arc, jaw=None, margin: float = 0.0, sure: bool = False) -> np.ndarray:
         """Whether the jaw can touch at arc positions ``arc`` (mm, unwrapped; nan: no) with the contact
-        at jaw position(s) ``jaw`` (mm; None: at some place on the jaw), within ``margin`` mm."""
+        at jaw position(s) ``jaw`` (mm; None: at some place on the jaw), within ``margin`` mm (negative:
+        with that much to spare). ``sure`` takes the reach's sure interval (:meth:`Reach.interval`)."""
         arc = np.asarray(arc, dtype=float)
         finite = np.isfinite(arc)
         land = np.mod(np.rint(np.where(finite, arc, 0.0) / self.h).astype(np.int64), self.sigma.size)
         if jaw is None:
             return finite & self.touchable[land]
+        lo, hi = (self.lo_sure, self.hi_sure) if sure else (self.lo, self.hi)
         d = np.asarray(jaw, dtype=float)
-        return finite & (self.lo[land] - margin < d) & (d < self.hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
+        return finite & (lo[land] - margin < d) & (d < hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
 
     def roll(self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0,
              turn_margin: float = 0.0) -> tuple:
@@ -285,11 +332,11 @@ class ModeTracks:
         """Grid points from which the jaw, laid with the contact at ``jaw`` (mm on it), can roll through
         every net rotation of ``turns`` (rad, in order, one sign) without bridging, with ``margin``
         mm to spare on the jaw all along (boolean mask over the grid)."""
-        ok = self.convex & self.touches(self.sigma, jaw, -margin)
+        ok = self.convex & self.touches(self.sigma, jaw, -margin, sure=True)
         for t in np.atleast_1d(np.asarray(turns, dtype=float)):
             idx = np.flatnonzero(ok)
             arc, moved = self.advance(idx, float(t))
-            ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin)
+            ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin, sure=True)
         return ok
 
 
@@ -340,6 +387,9 @@ class ContactFilter:
         Measured on the simulated rig: about 0.45 of one reading's standard deviation.
     jaw_spacing : float, mm
         Knot spacing of that basis along the jaw.
+    temper : float
+        Power in (0, 1] on the readings' likelihood: below 1 the evidence counts for less than
+        the noise model says (a guard against errors the model leaves out).
     sd_turn : float, rad
         Standard deviation of one reading of the net rotation (default: the arm encoder's
         0.03° step, uniform: 0.03°/√12). It moves the contact by ρ·e, which on a flat stretch
@@ -366,7 +416,7 @@ class ContactFilter:
                  sd_slope: float = 0.001, shape_spacing: float = 5.0, radius: float = 0.3, mode_floor: float = 0.05,
                  confidence: float = 0.95, prune: float = 40.0, refresh: int = 5, jaw: StraightJaw = DEFAULT_JAW,
                  jaw_margin: float = 2.0, noise_scales=NOISE_SCALES, sd_jaw: float = 0.015,
-                 jaw_spacing: float = 5.0, sd_turn: float = ENCODER_SD):
+                 jaw_spacing: float = 5.0, sd_turn: float = ENCODER_SD, temper: float = TEMPER):
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")
@@ -383,11 +433,14 @@ class ContactFilter:
         scales = np.asarray(noise_scales, dtype=float).ravel()
         if scales.size == 0 or not np.all(np.isfinite(scales) & (scales > 0)):
             raise QueryError(f"noise_scales={noise_scales!r} must be positive factors")
+        if not (math.isfinite(temper) and 0 < temper <= 1):
+            raise QueryError(f"temper={temper!r} must be in (0, 1]")
         if not (math.isfinite(jaw_margin) and jaw_margin >= 0):
             raise QueryError(f"jaw_margin={jaw_margin!r} mm must be ≥ 0")
         self.part = part
         self.jaw = jaw
         self.jaw_margin = float(jaw_margin)
+        self.temper = float(temper)
         self.noise_scales = tuple(float(v) for v in scales)
         self.tracks = tracks_for(part, spacing, jaw)
         self.sd_position = float(sd_position)
@@ -438,7 +491,9 @@ class ContactFilter:
         self._uz = np.zeros(m)                # Uᵀz
         self._uu = np.zeros((m, m))           # UᵀU
         self._szz = 0.0
-        self._touched = {0}
+        self._touched = np.zeros(m, dtype=bool)  # basis columns some reading has touched
+        self._touched[0] = True
+        self._prior_ref, self._prior_upto = None, 0   # the slope priors' reference and readings done
         self._segment = 0
         self._penalty = np.zeros(n)           # log-probability of the reach evidence (touches, bridges)
         self.jaw_position = math.nan          # the contact's last measured place on the jaw, mm
@@ -513,7 +568,7 @@ class ContactFilter:
             wt2 = self._row_weight ** 2
             self._uu[np.ix_(old_cols, old_cols)] -= wt2 * np.outer(old_vals, old_vals)
             self._uu[np.ix_(cols, cols)] += wt2 * np.outer(vals, vals)
-            self._touched.update(int(c) for c in cols)
+            self._touched[cols] = True
             self._last_row = (cols, vals)
             self._version += 1
         idx = self._live_idx
@@ -547,7 +602,7 @@ class ContactFilter:
         for t in (turn, further):
             land, ok = self.tracks.advance(idx, t)
             moved = land - self.current[idx]
-            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin)
+            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin, sure=True)
             if t == turn:
                 clear &= np.abs(moved) < 0.5 * jump
         if clear.any():
@@ -607,7 +662,14 @@ class ContactFilter:
         constant part look measured (it is the segments' offsets' to absorb)."""
         if self.sd_slope <= 0 or self._ref is None or not self._hist:
             return
-        z, turn = np.array(self._hist).T
+        if self._ref != self._prior_ref:            # a new reference: its radii along the whole path
+            self._prior_ref, self._prior_upto = self._ref, 0
+            self._slope_var[self._segments:self._jaw0] = 0.0
+        new = np.array(self._hist[self._prior_upto:])
+        self._prior_upto = len(self._hist)
+        if new.size == 0:
+            return
+        z, turn = new.T
         arc, ok = self.tracks.advance(np.full(z.size, self._ref), turn, turn_margin=TURN_MARGIN)
         land = np.mod(np.rint(np.where(ok, arc, self.grid[self._ref]) / self.tracks.h).astype(np.int64),
                       self.grid.size)
@@ -615,11 +677,8 @@ class ContactFilter:
         rho = np.where(kappa > 0, np.clip(1.0 / np.maximum(kappa, 1e-12), 5.0, 500.0), 500.0)
         # column c (relative) is nonzero for z/spacing in [c - 3, c + 1): the largest radius there
         first = np.floor(z / self.shape_spacing).astype(np.int64) + self._segments + self._k0
-        var = np.zeros(self._m)
         for k in range(4):
-            np.maximum.at(var, first + k, (rho * self.sd_slope) ** 2)
-        touched = np.flatnonzero(var > 0)
-        self._slope_var[touched] = var[touched]
+            np.maximum.at(self._slope_var, first + k, (rho * self.sd_slope) ** 2)
         self._version += 1
 
     def _add_row(self, z: float, p: np.ndarray, idx=None, jaw: float | None = None, turn: float = 0.0) -> None:
@@ -639,9 +698,11 @@ class ContactFilter:
         self._row_weight = wt
         z, p, vals = z * wt, p * wt, vals * wt
         sel = slice(None) if idx is None else idx
-        for c, v in zip(cols, vals):
-            self._up[c, sel] += v * p
-        self._touched.update(int(c) for c in cols)
+        if idx is None:
+            self._up[cols] += np.outer(vals, p)
+        else:
+            self._up[np.ix_(cols, idx)] += np.outer(vals, p)
+        self._touched[cols] = True
         self._spp[sel] += p * p
         self._szp[sel] += z * p
         self._uz[cols] += vals * z
@@ -660,7 +721,7 @@ class ContactFilter:
 
     def _solve(self) -> dict:
         """The closed-form marginalisation over the live hypotheses (see the module notes)."""
-        cols = np.array(sorted(self._touched))
+        cols = np.flatnonzero(self._touched)
         s2 = self.sd_position ** 2
         prior = self._slope_var[cols].copy()            # the contact's offset ρ·η: (ρ·sd_slope)²
         prior[cols < self._segments] = 1e6              # the segments' offsets: flat
@@ -694,7 +755,7 @@ class ContactFilter:
         post = np.exp(terms - top)
         total = post.sum(axis=0)
         s["lam2"] = (post * lam[:, None] ** 2).sum(axis=0) / total
-        ll_live = top + np.log(total / lam.size) - 0.5 * np.log1p(t2 * qpp) + self._penalty[live]
+        ll_live = self.temper * (top + np.log(total / lam.size) - 0.5 * np.log1p(t2 * qpp)) + self._penalty[live]
         ll = np.full(self.grid.size, -np.inf)
         ll[live] = ll_live
         if self.prune > 0 and live.size:

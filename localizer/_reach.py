@@ -81,7 +81,7 @@ class Reach:
     part : Part
     jaw : StraightJaw
     spacing : float, mm
-        Grid step along the boundary (default 0.1 mm).
+        Grid step along the boundary (default 0.2 mm).
     clearance : float, mm
         A model point must cut into the jaw deeper than this to block it (module notes).
 
@@ -92,6 +92,9 @@ class Reach:
     lo, hi : ndarray, shape (n,), mm
         The open interval of jaw positions at which the jaw can touch there (lo ≥ hi: nowhere;
         ±inf where nothing blocks that way).
+    lo_sure, hi_sure : ndarray, shape (n,), mm
+        Where it surely touches there and nowhere else (no other point within the clearance
+        of the edge; inside ``lo, hi``).
     hull_depth : ndarray, shape (n,), mm
         Distance of each point below the part's convex hull (0 on it).
 
@@ -106,7 +109,7 @@ class Reach:
     (True, True)
     """
 
-    def __init__(self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.1,
+    def __init__(self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2,
                  clearance: float = 0.1):
         if not (math.isfinite(spacing) and spacing > 0):
             raise QueryError(f"spacing={spacing!r} mm must be a positive number")
@@ -127,34 +130,65 @@ class Reach:
             e = eq[c:c + 256]
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
         self.hull_depth = np.maximum(-depth, 0.0)
-        lo = np.full(n, -np.inf)
-        hi = np.full(n, np.inf)
-        # only points below the hull can be blocked: the hull's tangent is a supporting line
-        below = np.flatnonzero(self.hull_depth > 1e-9 * max(1.0, float(np.ptp(pts))))
         half = jaw.half
-        for c in range(0, below.size, 128):
-            i = below[c:c + 128]
-            rel = pts[None, :, :] - pts[i, None, :]                     # (b, n, 2): Q − P
+        c = self.clearance
+        tiny = 1e-9 * max(1.0, float(np.ptp(pts)))                     # rounding of the depth
+        lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
+        lo_sure, hi_sure = np.full(n, -np.inf), np.full(n, np.inf)
+        k = np.arange(n)
+        for start in range(0, n, 128):
+            i = np.arange(start, min(start + 128, n))
+            # the boundary in arc order from each P: column k is the point k grid steps ahead of P
+            q = pts[(i[:, None] + k[None, :]) % n] - pts[i, None, :]    # (b, n, 2): Q − P
             e = tan[i, None, :]
-            w = np.einsum("bnk,bnk->bn", rel, e)                         # along the tangent
-            dep = rel[..., 0] * e[..., 1] - rel[..., 1] * e[..., 0]      # −(Q−P)·m, m the inner normal
-            block = dep > self.clearance
-            w_plus = np.where(block & (w > 0), w, np.inf).min(axis=1)
-            w_minus = np.where(block & (w < 0), w, -np.inf).max(axis=1)
-            blocked_here = (block & (w == 0)).any(axis=1)
-            lo[i] = np.where(blocked_here, np.inf, half - w_plus)
-            hi[i] = np.where(blocked_here, -np.inf, -half - w_minus)
+            w = np.einsum("bnk,bnk->bn", q, e)                           # along the tangent
+            dep = q[..., 0] * e[..., 1] - q[..., 1] * e[..., 0]          # −(Q−P)·m, m the inner normal
+            # generous: blocked by a point deeper than the clearance
+            block = dep > c
+            lo[i], hi[i] = self._interval(w, block, half)
+            # sure: also by a point within the clearance of the edge, except P's own cap (the
+            # stretch around P that stays within it below the edge, which is the contact itself)
+            clear_of = dep < -c
+            ahead = np.where(clear_of[:, 1:].any(axis=1), np.argmax(clear_of[:, 1:], axis=1) + 1, n)
+            behind = np.where(clear_of[:, :0:-1].any(axis=1), np.argmax(clear_of[:, :0:-1], axis=1) + 1, n)
+            cap = (k[None, :] < ahead[:, None]) | (k[None, :] > n - behind[:, None])
+            cap &= dep <= tiny                                           # rising above the edge blocks
+            lo_sure[i], hi_sure[i] = self._interval(w, (dep > -c) & ~cap, half)
         self.lo, self.hi = lo, hi
-        for arr in (self.sigma, self.lo, self.hi, self.hull_depth):
+        self.lo_sure, self.hi_sure = np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
+        for arr in (self.sigma, self.lo, self.hi, self.lo_sure, self.hi_sure, self.hull_depth):
             arr.setflags(write=False)
 
-    def _index(self, arc) -> np.ndarray:
-        return np.mod(np.rint(np.asarray(arc, dtype=float) / self.h).astype(np.int64), self.sigma.size)
+    @staticmethod
+    def _interval(w, block, half: float) -> tuple:
+        """(lo, hi) per row from the blocking points' places ``w`` along the tangent (module notes)."""
+        w_plus = np.where(block & (w > 0), w, np.inf).min(axis=1)
+        w_minus = np.where(block & (w < 0), w, -np.inf).max(axis=1)
+        here = (block & (w == 0)).any(axis=1)
+        return np.where(here, np.inf, half - w_plus), np.where(here, -np.inf, -half - w_minus)
 
-    def interval(self, arc) -> tuple:
-        """(lo, hi) jaw positions, mm, at which the jaw can touch at arc position(s) ``arc`` (mm)."""
-        i = self._index(arc)
-        return self.lo[i], self.hi[i]
+    def _bracket(self, arc) -> tuple:
+        """Indices of the two grid points on either side of arc position(s) ``arc`` (mm)."""
+        x = np.asarray(arc, dtype=float) / self.h
+        i = np.floor(x).astype(np.int64)
+        n = self.sigma.size
+        return np.mod(i, n), np.mod(i + 1, n)
+
+    def interval(self, arc, sure: bool = False) -> tuple:
+        """(lo, hi) jaw positions, mm, at which the jaw can touch at arc position(s) ``arc`` (mm).
+
+        The generous interval (default) counts as blocking only points deeper than the
+        clearance; the ``sure`` one also those within the clearance of the edge (but the
+        contact's own stretch): where the jaw surely touches there and nowhere else. Between two
+        grid points the interval can change fast (where the obstruction is a far lobe grazing
+        the edge, a tangent turned by κ·Δσ moves a point 50 mm away by 50·κ·Δσ), so the
+        generous interval is the union of the two neighbouring grid points', and the sure one
+        their intersection.
+        """
+        i, j = self._bracket(arc)
+        if sure:
+            return np.maximum(self.lo_sure[i], self.lo_sure[j]), np.minimum(self.hi_sure[i], self.hi_sure[j])
+        return np.minimum(self.lo[i], self.lo[j]), np.maximum(self.hi[i], self.hi[j])
 
     def touchable(self, arc, jaw=None, margin: float = 0.0) -> np.ndarray:
         """Whether the jaw can touch at ``arc`` (mm) with the contact at jaw position ``jaw`` (mm).
@@ -169,20 +203,20 @@ class Reach:
         d = np.asarray(jaw, dtype=float)
         return (lo - margin < d) & (d < hi + margin) & (np.abs(d) <= half + margin)
 
-    def clear(self, arc, jaw, margin: float) -> np.ndarray:
-        """Whether the jaw touches at ``arc`` (mm) with the contact at ``jaw`` (mm) with room to spare:
-        ``margin`` mm inside the interval on both sides (a roll there surely does not bridge)."""
-        lo, hi = self.interval(arc)
+    def clear(self, arc, jaw, margin: float = 0.0) -> np.ndarray:
+        """Whether the jaw surely touches at ``arc`` (mm) with the contact at ``jaw`` (mm), with ``margin`` mm
+        to spare on both sides (a roll there does not bridge)."""
+        lo, hi = self.interval(arc, sure=True)
         d = np.asarray(jaw, dtype=float)
         return (lo + margin < d) & (d < hi - margin) & (np.abs(d) <= self.jaw.half - margin)
 
     @property
     def full(self) -> np.ndarray:
-        """Points the jaw touches at every place along it (as the calibration's taps need)."""
-        return (self.lo <= -self.jaw.half) & (self.hi >= self.jaw.half)
+        """Points the jaw surely touches at every place along it (as the calibration's taps need)."""
+        return (self.lo_sure <= -self.jaw.half) & (self.hi_sure >= self.jaw.half)
 
 
-def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.1, clearance: float = 0.1) -> Reach:
+def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, clearance: float = 0.1) -> Reach:
     """The part's :class:`Reach` for ``jaw``, built once per part, jaw, spacing and clearance (shared, read-only)."""
     return per_part("reach", part, (jaw, float(spacing), float(clearance)),
                     lambda: Reach(part, jaw, spacing=spacing, clearance=clearance))

@@ -178,6 +178,13 @@ class SimRig:
         return {"force": c.force, "jaw_position": c.jaw_position, "contact_arc": arc, "at_edge": c.at_edge}
 
     # ------------------------------------------------- simulation helpers
+    def calibration_pose(self, standoff: float = 1.0) -> tuple:
+        """Where to calibrate on the part itself (paper §III-B): the jaw's centre facing the most curved
+        point that the whole jaw reaches (:func:`localizer.calibration_arc`), ``standoff`` mm off."""
+        from localizer import calibration_arc
+
+        return self.approach_pose(calibration_arc(self.model), jaw_position=0.0, standoff=standoff)
+
     def approach_pose(self, arc: float, jaw_position: float = -30.0, standoff: float = 2.0) -> tuple:
         """A hand pose with the jaw parallel to the model's tangent at ``arc`` (mm),
         that point facing jaw position ``jaw_position`` (mm), ``standoff`` mm off the part."""

@@ -133,7 +133,7 @@ def test_wilson_interval():
 
 
 def test_shipped_studies_load():
-    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters"):
+    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters", "tuning", "heldout"):
         s = load_study(ROOT / "bench" / "studies" / f"{name}.toml")
         assert s.trials > 0
     paper = load_study(ROOT / "bench" / "studies" / "paper.toml")
@@ -153,6 +153,8 @@ def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
     assert len(rows) == 2 and all(f"{m}_curve" in rows[0] for m in summary["methods"])
     for r in rows:  # the paper method's row is the study's own result
         assert r["success"] == r["paper_success"] and float(r["reactive_rotation_deg"]) > 0
+        assert r["paper_stopped"] == "fixed" and r["reactive_stopped"] in ("confident", "budget", "ambiguous")
+        assert 0.0 <= float(r["reactive_mass"]) <= 1.0 and int(r["reactive_bridges"]) >= 0
     assert (out / "methods.png").exists()
 
 
@@ -173,3 +175,89 @@ def test_grid_method_scores_the_filter_on_the_fixed_readings(tmp_path):
         # the filter was fed the same readings as the paper's rule: it lands where the truth is
         # or fails like a method, never as a broken trial
         assert r["failure"] == "" and math.isfinite(float(r["grid_error_mm"]))
+
+
+def small_methods_study(tmp_path, extra=""):
+    f = tmp_path / "m.toml"
+    f.write_text(f'''
+name = "methods"
+parts = ["{ROOT / 'parts' / 'cam.json'}"]
+rolls_deg = [20.0, 15.0]
+methods = ["paper", "particle", "grid"]
+trials = 2
+seed = 3
+noise = "paper"
+[particle]
+particles = 500
+{extra}
+''')
+    return load_study(f)
+
+
+def test_one_methods_error_is_that_methods_failure_only(tmp_path, monkeypatch):
+    import localizer
+    from bench.study import TrialSpec, run_trial
+
+    study = small_methods_study(tmp_path)
+    real = localizer.localize
+
+    def paper_breaks(part, rolls, rule="likelihood", **kw):
+        if rule == "paper":
+            raise localizer.QueryError("length=-15.875 mm must be in (0, perimeter)")
+        return real(part, rolls, rule=rule, **kw)
+
+    monkeypatch.setattr(localizer, "localize", paper_breaks)
+    row = run_trial(TrialSpec(study, 0, 0))
+    assert row["failure"] == ""                                   # the trial itself did not break
+    assert row["paper_stopped"] == "error" and row["paper_success"] == 0
+    assert row["paper_failure"].startswith("QueryError: length=-15.875")
+    for m in ("particle", "grid"):
+        assert row[f"{m}_stopped"] == "fixed" and row[f"{m}_failure"] == ""
+        assert math.isfinite(row[f"{m}_error_mm"]) and 0.0 <= row[f"{m}_mass"] <= 1.0
+
+
+def test_summary_is_strict_json_with_the_per_method_record(tmp_path):
+    study = small_methods_study(tmp_path)
+    run_study(study, tmp_path / "out", workers=1, progress=False)
+
+    def refuse(name):
+        raise ValueError(f"{name} is not JSON")
+
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text(), parse_constant=refuse)
+    for m in study.methods:
+        d = summary["method_details"][m]
+        assert d["confident"] == 0 and d["confident_wrong"] == 0        # fixed rolls never stop sure
+        assert d["per_part"] == {"cam.json": {"success": d["success"], "trials": 2}}
+    rows = read_trials(tmp_path / "out" / "trials.csv")
+    for r in rows:
+        for m in study.methods:
+            assert r[f"{m}_stopped"] == "fixed" and r[f"{m}_failure"] == ""
+    assert (tmp_path / "out" / "reliability.png").stat().st_size > 5000
+
+
+def test_a_noise_sweep_runs_each_level_on_its_noise_file(tmp_path):
+    (tmp_path / "loud.toml").write_text('preset = "paper"\nv2_noise = 0.0004\n')
+    study = load_study(study_file(tmp_path, trials=1, extra='[sweep]\nparameter = "noise"\nvalues = ["paper", "loud.toml"]'))
+    assert study.levels == 2 and [study.level_label(k) for k in range(2)] == ["paper", "loud"]
+    assert study.level_noise(1).v2_noise == 0.0004 and study.level_noise(0).v2_noise == 0.0001
+    run_study(study, tmp_path / "o", workers=1, progress=False)
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert [lv["value"] for lv in summary["levels"]] == ["paper", "loud"]
+    with pytest.raises(StudyError, match="sweep noise 'nope'"):
+        load_study(study_file(tmp_path, extra='[sweep]\nparameter = "noise"\nvalues = ["nope"]'))
+
+
+def test_a_reactive_table_without_standard_deviations_uses_the_filters_own(tmp_path):
+    from bench.methods import reactive_filter
+    from localizer import NOISE_SCALES, ContactFilter, load_part
+    from sim2d import load_noise
+
+    study = small_methods_study(tmp_path, extra="[reactive]\nconfidence = 0.9")
+    flt = reactive_filter(study, load_part(ROOT / "parts" / "cam.json"), load_noise("paper"))
+    default = ContactFilter(flt.part)
+    assert (flt.sd_position, flt.sd_scale, flt.sd_slope) == (default.sd_position, default.sd_scale, default.sd_slope)
+    assert flt.noise_scales == NOISE_SCALES and flt.confidence == 0.9
+    pinned = small_methods_study(tmp_path, extra="[reactive]\nnoise_scales = [1.0]\nsd_slope = \"auto\"")
+    assert reactive_filter(pinned, flt.part, load_noise("paper")).noise_scales == (1.0,)
+    with pytest.raises(StudyError, match="noise_scales"):
+        small_methods_study(tmp_path, extra="[reactive]\nnoise_scales = [-1.0]")

@@ -20,11 +20,9 @@ def part_named(name):
 
 
 def calibration_for(part, noise="none", seed=0):
-    """Calibrate on the part's most curved point (a well-defined contact)."""
+    """Calibrate on the most curved point the whole jaw reaches (a well-defined contact)."""
     rig = SimRig(part, noise=noise, seed=seed)
-    t = np.linspace(0, part.n_knots, 4000, endpoint=False)
-    arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
-    return calibrate(rig, rig.approach_pose(arc, jaw_position=0.0, standoff=1.0))
+    return calibrate(rig, rig.calibration_pose())
 
 
 @pytest.fixture(scope="module")

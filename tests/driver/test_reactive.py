@@ -17,13 +17,9 @@ PARTS = Path(__file__).resolve().parents[2] / "parts"
 
 
 def calibration_with(part, noise="none", seed=99):
-    """The studies' calibration: taps at the part's sharpest point."""
-    import numpy as np
-
-    t = np.linspace(0, part.n_knots, 20 * part.n_knots, endpoint=False)
-    arc = float(part.arc_at_param(t[np.argmax(part.curvature(t))]))
+    """The studies' calibration: taps at the most curved point the whole jaw reaches."""
     rig = SimRig(part, noise=noise, seed=seed)
-    return calibrate(rig, rig.approach_pose(arc, jaw_position=0.0, standoff=1.0))
+    return calibrate(rig, rig.calibration_pose())
 
 
 def calibration(part, noise="none"):
@@ -153,3 +149,27 @@ def test_the_two_turning_rules_do_not_rock_the_jaw():
     assert run.reversals <= 4
     assert run.stopped == "confident"
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
+
+
+def test_a_start_deep_in_a_wide_concavity_is_not_localized_elsewhere_and_sure():
+    # Issue 14: a star whose concavities are wider than the jaw. The jaw laid more than 4 mm below
+    # the hull, rolling without noise, stopped after 3° "99.999999% sure" 57.6 mm off, because the
+    # filter kept only the boundary within 4 mm of the hull. The jaw's reach now decides.
+    import numpy as np
+
+    from localizer import part_from_points, tracks_for
+
+    a = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    r = 80 * (1 + 0.3 * np.cos(3 * a) + 0.04 * np.cos(a + 0.5) + 0.03 * np.cos(2 * a + 1.0))   # no symmetry
+    part = part_from_points(np.c_[r * np.cos(a), r * np.sin(a)], name="star")
+    t = tracks_for(part, 0.02)
+    depth = t.reach.hull_depth[np.rint(t.sigma / t.reach.h).astype(int) % t.reach.sigma.size]
+    ok = np.flatnonzero(t.rollable(np.radians(np.arange(0.0, 21.0)), -40.0, margin=1.0) & (depth > 4.0))
+    assert ok.size
+    cal = calibration_with(part)
+    for start in t.sigma[ok[:: max(1, ok.size // 3)]][:3]:
+        rig = SimRig(part, noise="none", seed=1)
+        run = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(90.0),
+                                  approach_pose=rig.approach_pose(float(start), jaw_position=-40.0, standoff=1.0))
+        err = abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))
+        assert run.stopped == "confident" and err < 0.3, (start, run.stopped, err)

@@ -62,7 +62,7 @@ def test_simulate_errors(tmp_path, capsys):
     rc = main(["simulate", str(PARTS / "cam.json"), "--start", "10", "--roll", "20", "--noise", "lab",
                "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
     assert rc == 2 and "use a preset" in capsys.readouterr().err
-    # a start in a concavity is not on the hull
+    # a start in a concavity: refused before anything moves (the jaw's reach)
     from localizer import load_part
 
     part = load_part(PARTS / "trefoil.json")
@@ -71,7 +71,7 @@ def test_simulate_errors(tmp_path, capsys):
     rc = main(["simulate", str(PARTS / "trefoil.json"), "--start", f"{concave:.3f}", "--roll", "10", "--noise", "none",
                "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
     err = capsys.readouterr().err
-    assert rc == 2 and ("convex hull" in err or "bridged" in err)
+    assert rc == 2 and "no place on the jaw touches there" in err
 
 
 def test_locate_bad_trace(tmp_path, capsys):
@@ -81,3 +81,17 @@ def test_locate_bad_trace(tmp_path, capsys):
     assert rc == 2 and "not a rolltouch trace" in capsys.readouterr().err
     with pytest.raises(RigError, match="no such file"):
         Trace.load(tmp_path / "missing.npz")
+
+
+def test_a_start_the_jaw_cannot_be_laid_on_is_refused_before_anything_moves(tmp_path, capsys):
+    from localizer import load_part
+
+    kidney = load_part(PARTS / "kidney.csv")
+    s = np.arange(0, kidney.perimeter, 0.5)
+    deepest = float(s[np.argmin(np.asarray(kidney.curvature_at_arc(s)))])    # inside the concavity
+    rc = main(["simulate", str(PARTS / "kidney.csv"), "--start", f"{deepest}", "--roll", "20", "--noise", "none",
+               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert f"--start {deepest} mm" in err and "no place on the jaw touches there" in err
+    assert not (tmp_path / "x.npz").exists()

@@ -7,7 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import ContactFilter, ParticleFilter, QueryError, load_part, machining_slope, part_from_points
+from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, ParticleFilter, QueryError, load_part, machining_slope,
+                       part_from_points)
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 STEP = math.radians(0.2)
@@ -221,3 +222,88 @@ def test_the_shift_recovers_a_known_slope_error(cam):
     rho_now = 1.0 / np.asarray(cam.curvature_at_arc(cam.wrap_arc(encoder.current[live])))
     assert not np.any(mean)
     np.testing.assert_allclose(sd[live], rho_now * math.radians(0.03) / math.sqrt(12), rtol=0.02)
+
+
+def stop_rule(flt, z, turns, confidence=0.95, every=5):
+    """Feed readings under the reactive method's stop rule: (stopped sure, estimate mm, readings used)."""
+    for k, (a, t) in enumerate(zip(z, turns), 1):
+        flt.update(float(a), float(t))
+        if k % every == 0 and flt.belief().mass >= confidence:
+            return True, flt.belief().map_arc, k
+    return False, flt.belief().map_arc, len(z)
+
+
+def test_noise_four_times_what_it_was_told_does_not_make_it_sure_and_wrong(kidney):
+    # Told 0.035 mm, read at 0.14 mm: the filter weighs the noise scale out and discounts the
+    # evidence, so it rolls on instead of stopping sure at the wrong place. Held to what it was told
+    # (one scale, the evidence at face value), the same readings make it stop sure and wrong.
+    turns = -STEP * np.arange(1, 551)
+    start = 29.3
+    travel = exact_travel(kidney, start, turns)
+    told = {"sd_position": 0.035, "sd_scale": 0.003, "sd_slope": 0.002}
+    wrong = {"weighed": 0, "told": 0}
+    for seed in range(16):
+        e = 0.14 * np.random.default_rng(seed).standard_normal(len(turns) + 1)
+        z = travel + e[1:] - e[0]
+        for name, extra in (("weighed", {}), ("told", {"noise_scales": (1.0,), "temper": 1.0})):
+            sure, est, k = stop_rule(ContactFilter(kidney, spacing=0.05, **told, **extra), z, turns, every=10)
+            wrong[name] += sure and abs(kidney.arc_offset(est, start + travel[k - 1])) > 0.3
+    assert wrong["weighed"] == 0 and wrong["told"] >= 3, wrong
+
+
+def test_the_noise_scale_is_found_from_the_readings(kidney):
+    turns = -STEP * np.arange(1, 401)
+    travel = exact_travel(kidney, 29.3, turns)
+    for true_sd in (0.02, 0.08):
+        flt = ContactFilter(kidney, sd_position=0.04, sd_scale=0.0, sd_slope=0.0, sd_turn=0.0, sd_jaw=0.0)
+        e = true_sd * np.random.default_rng(1).standard_normal(len(turns) + 1)
+        feed(flt, travel + e[1:] - e[0], turns)
+        s = flt._solved()
+        i = int(np.argmax(s["ll"][s["live"]]))
+        assert math.sqrt(s["lam2"][i]) * 0.04 == pytest.approx(true_sd, rel=0.15)
+
+
+@pytest.fixture(scope="module")
+def star():
+    a = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    r = 80 * (1 + 0.3 * np.cos(3 * a))
+    return part_from_points(np.c_[r * np.cos(a), r * np.sin(a)], name="star")
+
+
+def test_a_start_below_the_hull_is_a_hypothesis_where_the_jaw_reaches_it(star):
+    # the old filter kept only the boundary within 4 mm of the hull: a jaw laid deeper in a
+    # concavity wider than itself was localized elsewhere, sure (issue 14)
+    flt = ContactFilter(star)
+    t = flt.tracks
+    deep = np.flatnonzero(t.convex & (t.reach.hull_depth[np.rint(t.sigma / t.reach.h).astype(int) % t.reach.sigma.size] > 4))
+    assert deep.size and flt.feasible[deep].all()
+    i = int(deep[deep.size // 2])
+    lo, hi = max(t.lo[i], -50.0), min(t.hi[i], 50.0)
+    inside, outside = 0.5 * (lo + hi), (hi + 5.0 if hi < 40 else lo - 5.0)
+    laid = ContactFilter(star)
+    laid.touch(inside)
+    wrong = ContactFilter(star)
+    wrong.touch(outside)
+    assert laid.log_likelihood()[i] == pytest.approx(0.0, abs=1e-9)
+    assert wrong.log_likelihood()[i] == pytest.approx(math.log(CONTRADICTION), abs=1e-9)
+
+
+def test_a_bridge_counts_against_the_starts_that_expected_the_way_clear(star):
+    flt = ContactFilter(star)
+    t = flt.tracks
+    flt.touch(-40.0)
+    ll0 = flt.log_likelihood()
+    flt.bridged(STEP, jump=3.0)
+    ll1 = flt.log_likelihood()
+    live = np.isfinite(ll0)
+    changed = live & (ll1 < ll0 - 1e-9)
+    np.testing.assert_allclose((ll0 - ll1)[changed], -math.log(BRIDGE_MISS))
+    # on the hull, mid-way along a long convex stretch, the jaw surely stays clear: counted against
+    depth = t.reach.hull_depth[np.rint(t.sigma / t.reach.h).astype(int) % t.reach.sigma.size]
+    arc, ok = t.advance(np.arange(t.sigma.size), math.radians(5.0))
+    open_way = live & (depth < 1e-6) & ok & (t.kappa > 0.004)
+    assert open_way.any() and changed[open_way].all()
+    # where the step leaves the convex stretch (an inflection ahead), the bridge was expected
+    _, ok_step = t.advance(np.arange(t.sigma.size), STEP)
+    ends = live & ~ok_step
+    assert ends.any() and not changed[ends].any()
