@@ -57,3 +57,41 @@ def test_particle_filter_update(benchmark, part100, particles):
     z, turn = _roll(grid, part100)
     benchmark.extra_info.update({"particles": particles})
     benchmark(pf.update, z, turn)
+
+
+@pytest.mark.parametrize("scales", ["weighed", "told"])
+def test_grid_filter_roll(benchmark, part100, scales):
+    """A whole 25° roll, 125 readings with a belief every 5: what weighing the noise scale out costs
+    (``weighed``: the default grid of 25 factors; ``told``: the settings taken at their word)."""
+    kwargs = {} if scales == "weighed" else {"noise_scales": (1.0,)}
+    i = int(round(40.0 / ContactFilter(part100).tracks.h))
+    turns = STEP * np.arange(1, 126)
+
+    def roll():
+        flt = ContactFilter(part100, **kwargs)
+        arcs, _ = flt.tracks.advance(np.full(turns.size, i), turns)
+        flt.touch(-40.0)
+        for k, (a, t) in enumerate(zip(arcs - flt.grid[i], turns)):
+            flt.update(float(a), float(t), jaw=-40.0 + float(a))
+            if k % 5 == 4:
+                flt.belief()
+        return flt
+
+    flt = benchmark.pedantic(roll, rounds=5, iterations=1, warmup_rounds=1)
+    assert abs(part100.arc_offset(flt.belief().map_arc, flt.current[i])) < 0.05
+    benchmark.extra_info.update({"scales": len(flt.noise_scales), "readings": int(turns.size)})
+    if not benchmark.disabled:
+        benchmark.extra_info["per_reading_ms"] = benchmark.stats.stats.min / turns.size * 1e3
+
+
+@pytest.mark.parametrize("name", ["egg100", "heldout star-16"])
+def test_reach_build(benchmark, part100, name):
+    """Building a part's reach for the 100 mm jaw (once per part; shared by every filter after)."""
+    from pathlib import Path
+
+    from localizer import Reach, load_part
+
+    part = part100 if name == "egg100" else load_part(
+        Path(__file__).resolve().parent / "parts" / "heldout" / "star-16.json")
+    r = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)
+    benchmark.extra_info.update({"perimeter_mm": round(part.perimeter, 1), "grid": int(r.sigma.size)})
