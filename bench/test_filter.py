@@ -84,7 +84,7 @@ def test_grid_filter_roll(benchmark, part100, scales):
         benchmark.extra_info["per_reading_ms"] = benchmark.stats.stats.min / turns.size * 1e3
 
 
-@pytest.mark.parametrize("name", ["egg100", "heldout star-16"])
+@pytest.mark.parametrize("name", ["egg100", "heldout-a star-16"])
 def test_reach_build(benchmark, part100, name):
     """Building a part's reach for the 100 mm jaw (once per part; shared by every filter after)."""
     from pathlib import Path
@@ -92,6 +92,6 @@ def test_reach_build(benchmark, part100, name):
     from localizer import Reach, load_part
 
     part = part100 if name == "egg100" else load_part(
-        Path(__file__).resolve().parent / "parts" / "heldout" / "star-16.json")
+        Path(__file__).resolve().parent / "parts" / "heldout-a" / "star-16.json")
     r = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)
     benchmark.extra_info.update({"perimeter_mm": round(part.perimeter, 1), "grid": int(r.sigma.size)})

@@ -133,7 +133,7 @@ def test_wilson_interval():
 
 
 def test_shipped_studies_load():
-    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters", "tuning", "heldout"):
+    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters", "tuning", "heldout", "heldout-a"):
         s = load_study(ROOT / "bench" / "studies" / f"{name}.toml")
         assert s.trials > 0
     paper = load_study(ROOT / "bench" / "studies" / "paper.toml")
