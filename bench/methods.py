@@ -18,6 +18,9 @@ import math
 import numpy as np
 
 MARK_DEG = 5.0
+#: Where the jaw is laid on the part: the contact this far (mm) from the jaw's centre, behind it in
+#: the rolling direction, so that most of the jaw lies ahead.
+JAW_START = 40.0
 #: How far short of a mark (degrees) a measured turn still reaches it: more than the encoder's step.
 ENCODER_SLACK_DEG = 0.05
 
@@ -212,8 +215,6 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict
     """The reactive filter from the same start on a rig with the same seed."""
     from driver.reactive import localize_reactively
     from sim2d import SimRig
-
-    from .study import JAW_START
 
     o = study.reactive
     rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine)

@@ -84,9 +84,7 @@ METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met.
 METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve", "stopped", "mass", "failure",
                   "bridges")
-#: Where the jaw is laid on the part: the contact this far (mm) from the jaw's centre, behind it in
-#: the rolling direction, so that most of the jaw lies ahead.
-JAW_START = 40.0
+
 
 
 @dataclass(frozen=True)
@@ -374,7 +372,7 @@ def run_trial(spec: TrialSpec) -> dict:
     from driver.rig import RigError
     from sim2d import SimRig
 
-    from .methods import score_methods, score_rule
+    from .methods import JAW_START, score_methods, score_rule
 
     s = spec.study
     t0 = time.perf_counter()
