@@ -240,8 +240,8 @@ def summarize_methods(study: Study, rows) -> dict:
     return {"methods": rates, "method_details": details, "success_by_rotation_deg": curves}
 
 
-#: Bins of stated confidence in the reliability diagram.
-RELIABILITY_BINS = (0.0, 0.5, 0.8, 0.9, 0.95, 0.99, 1.0 + 1e-12)
+#: Bins of stated confidence in the reliability diagram (fine near 1, where the stops are).
+RELIABILITY_BINS = (0.0, 0.5, 0.8, 0.9, 0.95, 0.97, 0.99, 0.999, 1.0 + 1e-12)
 
 
 def reliability(study: Study, m: str, rows) -> list:
@@ -353,33 +353,43 @@ def _plot_methods(study: Study, summary: dict, out: Path) -> None:
 
 
 def _plot_reliability(study: Study, rows, out: Path) -> None:
-    """reliability.png: stated confidence at the stop against the fraction within the radius, per level."""
+    """reliability.png: stated confidence at the stop against the fraction within the radius, per level.
+
+    For each method that states one: the whole range, and the range from 0.9 up, where a promise
+    of 95% is about the few that miss. Bars: each bin's 95% Wilson interval."""
     import matplotlib.pyplot as plt
 
     stating = [m for m in study.methods if any(np.isfinite(_number(r.get(f"{m}_mass", ""))) for r in rows)]
     if not stating:
         return
-    fig, axes = plt.subplots(1, len(stating), figsize=(4.6 * len(stating), 4.4), squeeze=False)
-    for ax, m in zip(axes[0], stating):
-        ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="a promise kept")
-        for level in range(study.levels):
-            sel = [r for r in rows if int(r["level"]) == level]
-            pts = reliability(study, m, sel)
-            if not pts:
+    fig, axes = plt.subplots(len(stating), 2, figsize=(10, 4.2 * len(stating)), squeeze=False)
+    for row_axes, m in zip(axes, stating):
+        if not any(r.get(f"{m}_stopped") == "confident" for r in rows):
+            row_axes[1].set_visible(False)                # it never stops sure: nothing to zoom into
+        for ax, lo in zip(row_axes, (0.0, 0.9)):
+            if not ax.get_visible():
                 continue
-            x, y, n = (np.array(v) for v in zip(*pts))
-            label = str(study.level_label(level)) if study.parameter else "all trials"
-            ax.plot(x, y, "o-", ms=3, label=label)
-            for xi, yi, ni in zip(x, y, n):
-                ax.annotate(str(ni), (xi, yi), fontsize=6, xytext=(2, -8), textcoords="offset points")
-        ax.set_xlim(0, 1.02)
-        ax.set_ylim(0, 1.02)
-        ax.set_xlabel("stated probability within the radius at the stop")
-        ax.set_ylabel(f"fraction actually within {study.success_radius} mm")
-        ax.set_title(f"{m}", fontsize=10)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper left")
-    fig.suptitle(f"{study.name}: reliability (numbers: trials per bin)", fontsize=10)
+            ax.plot([lo, 1], [lo, 1], color="0.6", lw=1, ls="--", label="a promise kept")
+            for level in range(study.levels):
+                sel = [r for r in rows if int(r["level"]) == level]
+                pts = [p for p in reliability(study, m, sel) if p[0] >= lo]
+                if not pts:
+                    continue
+                x, y, n = (np.array(v) for v in zip(*pts))
+                ci = np.array([wilson(int(round(a * b)), int(b)) for a, b in zip(y, n)])
+                label = str(study.level_label(level)) if study.parameter else "all trials"
+                err = [np.clip(y - ci[:, 0], 0, None), np.clip(ci[:, 1] - y, 0, None)]
+                ax.errorbar(x, y, yerr=err, fmt="o-", ms=3, capsize=2, lw=1, label=label)
+                for xi, yi, ni in zip(x, y, n):
+                    ax.annotate(str(ni), (xi, yi), fontsize=6, xytext=(3, -9), textcoords="offset points")
+            ax.set_xlim(lo, 1.0 + (1 - lo) * 0.01)
+            ax.set_ylim(lo if lo else 0.0, 1.0 + (1 - lo) * 0.01)
+            ax.set_xlabel("stated probability within the radius at the stop")
+            ax.set_ylabel(f"fraction actually within {study.success_radius} mm")
+            ax.set_title(f"{m}" + (" (from 0.9 up)" if lo else ""), fontsize=10)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="upper left" if not lo else "lower right")
+    fig.suptitle(f"{study.name}: reliability (numbers: trials per bin; bars: 95% intervals)", fontsize=10)
     fig.tight_layout()
     fig.savefig(out / "reliability.png", dpi=110)
     plt.close(fig)
