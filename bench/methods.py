@@ -222,7 +222,7 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict
                               approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
                               step=math.radians(study.step_deg), confidence=o.confidence,
                               max_rotation=math.radians(o.max_rotation_deg), check_every=o.check_every,
-                              min_spread=o.min_spread)
+                              min_spread=o.min_spread, **({} if o.confirm is None else {"confirm": o.confirm}))
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)
     rot = math.degrees(res.rotation)

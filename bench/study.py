@@ -94,6 +94,7 @@ class ReactiveOptions:
     confidence: float = 0.95
     max_rotation_deg: float = 180.0
     check_every: int = 5
+    confirm: int | None = None         # None: driver.reactive.CONFIRM (checks in a row at the confidence)
     sd_position: float | None = None   # None: the filter's default
     sd_scale: float | None = None
     sd_slope: float | str | None = None   # "auto": from the study's noise model
@@ -315,7 +316,7 @@ def _options(path, table, cls, name):
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):
             raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a positive number")
-        values[key] = int(value) if key in ("particles", "check_every") else float(value)
+        values[key] = int(value) if key in ("particles", "check_every", "confirm") else float(value)
     if values.get("temper", 0.5) > 1:
         raise StudyError(f"study {path}: [{name}] temper={values['temper']!r} must be at most 1")
     if values.get("confidence", 0.5) >= 1:
