@@ -44,6 +44,26 @@ def test_it_stops_when_sure_and_is_right(trefoil):
     assert len(run.arcs) == len(run.turns) == len(run.true_arcs) == len(run.segments) == run.steps + 1
 
 
+def test_it_stops_only_after_the_confidence_held_at_confirm_checks_in_a_row(trefoil):
+    part, cal = trefoil
+    runs = {}
+    for confirm in (1, 4):
+        rig = SimRig(part, noise="none", seed=1)
+        flt = ContactFilter(part)
+        runs[confirm] = localize_reactively(rig, part, calibration=cal, filter=flt, confidence=0.95, confirm=confirm,
+                                            approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
+    for confirm, run in runs.items():
+        masses = [h[2] for h in run.history]
+        assert run.stopped == "confident"
+        assert all(m >= 0.95 for m in masses[-confirm:])
+        # it did not stop earlier: no earlier run of confirm checks in a row at the confidence
+        for k in range(len(masses) - confirm):
+            assert not all(m >= 0.95 for m in masses[k:k + confirm])
+    # the same rig and readings up to the first stop: the longer rule rolls on from there
+    assert runs[4].history[:len(runs[1].history)] == runs[1].history
+    assert len(runs[4].history) >= len(runs[1].history) + 3
+
+
 def test_the_rotation_budget_stops_it(trefoil):
     part, cal = trefoil
     rig = SimRig(part, noise="none", seed=1)
@@ -82,7 +102,8 @@ def test_bad_arguments(trefoil):
     rig = SimRig(part, seed=0)
     pose = rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0)
     for kwargs, match in (({"max_rotation": 0}, "max_rotation=0"), ({"direction": 2}, "direction=2"),
-                          ({"confidence": 1.0}, "confidence=1.0"), ({"step": -1}, "step=-1")):
+                          ({"confidence": 1.0}, "confidence=1.0"), ({"step": -1}, "step=-1"),
+                          ({"confirm": 0}, "confirm=0"), ({"confirm": 1.5}, "confirm=1.5")):
         with pytest.raises(RigError, match=match):
             localize_reactively(rig, part, calibration=cal, approach_pose=pose, **kwargs)
 
