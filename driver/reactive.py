@@ -9,11 +9,13 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    jaw; turn the step's jaw travel into signed arc (second-order inversion)
    and give the filter the cumulative arc and the arm's measured net rotation;
 3. every ``check_every`` steps: stop when the probability within the success
-   radius has reached ``confidence`` at ``confirm`` checks in a row. The first
-   crossing alone is a weak promise: on the tuning family at four times the
-   ``paper`` noise (bench/parts/heldout-a, ×4), 9 of 84 first crossings were on
-   the wrong place or 0.31-0.4 mm off, 5 of 83 with a second look one check
-   (1°) later, for 6° more rolling on average and 1-2° at the lower levels;
+   radius has reached ``confidence`` at ``confirm`` checks in a row (default 1:
+   the first crossing). Two in a row turned 9 of 84 confident stops that were
+   wrong into 5 of 83 on bench/parts/heldout-a at four times the ``paper``
+   noise, and 5 of 21 into 3 of 18 on the tuning family at ×5.6, for 1–6° more
+   rolling; on the held-out family (heldout-b, ×4) it made no difference (6 of
+   81 against 5 of 82: near misses at 0.3–0.7 mm come as often one check later),
+   so it is not the default;
 4. the direction rule: while the belief has two or more modes, compare how much
    the next ``lookahead`` of *unexplored* rotation each way separates the two
    leading ones (how much their radii of curvature differ over it,
@@ -52,7 +54,7 @@ from .rig import Rig, RigError
 __all__ = ["ReactiveRun", "localize_reactively", "spread_by_direction", "CONFIRM"]
 
 #: Checks in a row at which the belief must reach the confidence before the rolling stops (step 3).
-CONFIRM = 2
+CONFIRM = 1
 
 
 @dataclass(frozen=True)
