@@ -123,7 +123,8 @@ def _filleted(rng) -> tuple:
         p, q, r_ = v[i - 1], v[i], v[(i + 1) % corners]
         a_in, a_out = (q - p) / np.linalg.norm(q - p), (r_ - q) / np.linalg.norm(r_ - q)
         turn = math.atan2(a_in[0] * a_out[1] - a_in[1] * a_out[0], a_in @ a_out)
-        f = min(fillet[i], 0.3 * min(np.linalg.norm(q - p), np.linalg.norm(r_ - q)) / max(abs(math.tan(turn / 2)), 1e-6))
+        shorter = min(np.linalg.norm(q - p), np.linalg.norm(r_ - q))
+        f = min(fillet[i], 0.3 * shorter / max(abs(math.tan(turn / 2)), 1e-6))
         back = f * abs(math.tan(turn / 2))
         t0 = q - a_in * back
         normal = np.array([-a_in[1], a_in[0]]) * np.sign(turn)

@@ -113,7 +113,8 @@ from ._errors import QueryError
 from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for", "NOISE_SCALES",
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for",
+           "NOISE_SCALES",
            "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
@@ -609,7 +610,8 @@ class ContactFilter:
         in it (or cannot be read). ``jaw`` (mm) is the contact's place on the jaw at the last
         reading (default: the last one given). A hypothesis under which that turn, and
         :data:`TURN_MARGIN` more, keep the contact on its convex stretch, the turn moving it by
-        less than half of ``jump``, with the jaw clear by ``jaw_margin`` there, did not expect it and is made :data:`BRIDGE_MISS` times
+        less than half of ``jump``, with the jaw clear by ``jaw_margin`` there, did not expect it and
+        is made :data:`BRIDGE_MISS` times
         less likely; the others predicted it (a concavity, or a flat stretch where one step
         moves the contact far) or cannot tell. No reading is added: call :meth:`regrasp` with
         the next one.
@@ -664,7 +666,8 @@ class ContactFilter:
             vals.append(v)
         if self.sd_jaw > 0 and jaw is not None:
             # a place read a little beyond the basis' span takes its end's values
-            x = float(np.clip((float(jaw) - self._jaw_lo) / self.jaw_spacing, 0.0, self._jaw_end - self._jaw0 - 3 - 1e-9))
+            top = self._jaw_end - self._jaw0 - 3 - 1e-9
+            x = float(np.clip((float(jaw) - self._jaw_lo) / self.jaw_spacing, 0.0, top))
             c, v = _bspline(x)
             cols.append(c + self._jaw0)
             vals.append(v)

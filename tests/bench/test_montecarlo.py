@@ -110,7 +110,8 @@ def test_dask_local_cluster_gives_the_same_table(reference):
     ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "paper"\nmethods = ["paper"]', "not both"),
     ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\nconfidence = 1.5',
      "confidence=1.5 must be below 1"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2', r"unknown key\(s\) \['speed'\]"),
+    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2',
+     r"unknown key\(s\) \['speed'\]"),
 ])
 def test_bad_study_files(tmp_path, text, match):
     f = tmp_path / "bad.toml"
@@ -133,7 +134,8 @@ def test_wilson_interval():
 
 
 def test_shipped_studies_load():
-    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters", "tuning", "heldout", "heldout-a"):
+    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters", "tuning", "heldout",
+                 "heldout-a"):
         s = load_study(ROOT / "bench" / "studies" / f"{name}.toml")
         assert s.trials > 0
     paper = load_study(ROOT / "bench" / "studies" / "paper.toml")
@@ -237,7 +239,8 @@ def test_summary_is_strict_json_with_the_per_method_record(tmp_path):
 
 def test_a_noise_sweep_runs_each_level_on_its_noise_file(tmp_path):
     (tmp_path / "loud.toml").write_text('preset = "paper"\nv2_noise = 0.0004\n')
-    study = load_study(study_file(tmp_path, trials=1, extra='[sweep]\nparameter = "noise"\nvalues = ["paper", "loud.toml"]'))
+    sweep = '[sweep]\nparameter = "noise"\nvalues = ["paper", "loud.toml"]'
+    study = load_study(study_file(tmp_path, trials=1, extra=sweep))
     assert study.levels == 2 and [study.level_label(k) for k in range(2)] == ["paper", "loud"]
     assert study.level_noise(1).v2_noise == 0.0004 and study.level_noise(0).v2_noise == 0.0001
     run_study(study, tmp_path / "o", workers=1, progress=False)

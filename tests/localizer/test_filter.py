@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, ParticleFilter, QueryError, load_part, machining_slope,
-                       part_from_points)
+from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, ParticleFilter, QueryError, load_part,
+                       machining_slope, part_from_points)
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 STEP = math.radians(0.2)
@@ -279,7 +279,8 @@ def test_a_start_below_the_hull_is_a_hypothesis_where_the_jaw_reaches_it(star):
     # concavity wider than itself was localized elsewhere, sure (issue 14)
     flt = ContactFilter(star)
     t = flt.tracks
-    deep = np.flatnonzero(t.convex & (t.reach.hull_depth[np.rint(t.sigma / t.reach.h).astype(int) % t.reach.sigma.size] > 4))
+    depth = t.reach.hull_depth[np.rint(t.sigma / t.reach.h).astype(int) % t.reach.sigma.size]
+    deep = np.flatnonzero(t.convex & (depth > 4))
     assert deep.size and flt.feasible[deep].all()
     i = int(deep[deep.size // 2])
     lo, hi = max(t.lo[i], -50.0), min(t.hi[i], 50.0)
