@@ -182,8 +182,9 @@ def score_grid(study, part, noise, seq) -> dict:
     return _score_sequential(study, part, seq, flt.update, estimate)
 
 
-def reactive_filter(study, part, noise):
-    """The ContactFilter a study's [reactive] options describe.
+def reactive_filter(study, part, noise, filter_class=None):
+    """The ContactFilter a study's [reactive] options describe (``filter_class``: a subclass to build
+    instead, e.g. :class:`bench.replay.FilterRecorder`).
 
     Standard deviations not given are the filter's own defaults; ``sd_slope = "auto"`` takes 5x the
     study's noise model's RMS slope (machined parts vary: measured 0.8e-3 to 1.9e-3 rad RMS at the
@@ -200,7 +201,8 @@ def reactive_filter(study, part, noise):
         given["noise_scales"] = o.noise_scales
     if o.temper is not None:
         given["temper"] = o.temper
-    return ContactFilter(part, radius=study.success_radius, confidence=o.confidence, **given)
+    cls = ContactFilter if filter_class is None else filter_class
+    return cls(part, radius=study.success_radius, confidence=o.confidence, **given)
 
 
 def reactive_stop(run) -> str:
@@ -211,14 +213,14 @@ def reactive_stop(run) -> str:
     return "ambiguous" if run.belief.ambiguous else "budget"
 
 
-def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict:
+def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None) -> dict:
     """The reactive filter from the same start on a rig with the same seed."""
     from driver.reactive import localize_reactively
     from sim2d import SimRig
 
     o = study.reactive
     rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine)
-    res = localize_reactively(rig, part, calibration=cal, filter=reactive_filter(study, part, noise),
+    res = localize_reactively(rig, part, calibration=cal, filter=reactive_filter(study, part, noise, filter_class),
                               approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
                               step=math.radians(study.step_deg), confidence=o.confidence,
                               max_rotation=math.radians(o.max_rotation_deg), check_every=o.check_every,
@@ -242,11 +244,12 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int) -> dict
 
 
 def score_methods(study, part, noise, cal, rolls, start: float, rig_seed: int, true_arc: float,
-                  rules: dict | None = None) -> dict:
+                  rules: dict | None = None, filter_class=None) -> dict:
     """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
 
     ``rolls`` are the fixed rolls' :class:`driver.procedures.RollResult`; ``rules`` caches the
-    localizer's results per rule within the trial.
+    localizer's results per rule within the trial; ``filter_class`` is the reactive method's filter
+    (default :class:`localizer.ContactFilter`).
     """
     seq = fixed_readings(rolls, part)
     rules = {} if rules is None else rules
@@ -260,7 +263,7 @@ def score_methods(study, part, noise, cal, rolls, start: float, rig_seed: int, t
             elif m == "grid":
                 r = score_grid(study, part, noise, seq)
             else:
-                r = score_reactive(study, part, noise, cal, start, rig_seed)
+                r = score_reactive(study, part, noise, cal, start, rig_seed, filter_class)
             r["failure"] = ""
         except Exception as exc:  # noqa: BLE001 - this method failed on this trial; the others still count
             text = str(exc) if isinstance(exc, _MethodError) else f"{type(exc).__name__}: {exc}"

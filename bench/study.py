@@ -329,7 +329,11 @@ def _options(path, table, cls, name):
 # ------------------------------------------------------------------ trial
 @dataclass(frozen=True)
 class TrialSpec:
-    """Everything one trial needs (picklable, sent to worker processes)."""
+    """Everything one trial needs (picklable, sent to worker processes).
+
+    ``extra`` may hold ``filter_class``: the reactive method's filter class (default
+    :class:`localizer.ContactFilter`; :mod:`bench.replay` records the filter's calls with it).
+    """
 
     study: Study
     level: int
@@ -430,7 +434,8 @@ def run_trial(spec: TrialSpec) -> dict:
                 "probability": own["probability"], "ambiguous": own["ambiguous"],
                 "failure": "" if s.methods else own["failure"]})
     if s.methods:
-        row.update(score_methods(s, part, noise, cal, run, start, rig_seed, true_arc, rules))
+        row.update(score_methods(s, part, noise, cal, run, start, rig_seed, true_arc, rules,
+                                 filter_class=spec.extra.get("filter_class")))
         first_method = s.methods[0]
         for key in ("success", "error_mm", "estimate_arc"):
             row[key] = row[f"{first_method}_{key}"]

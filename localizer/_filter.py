@@ -799,6 +799,12 @@ class ContactFilter:
                 self._live_idx = np.flatnonzero(self._live)
         return ll
 
+    def noise_scale(self) -> float:
+        """The factor λ on the noise settings that the readings say at the most probable start: the
+        root of its posterior mean square (1 when the settings are right)."""
+        s = self._solved()
+        return float(math.sqrt(s["lam2"][int(np.argmax(s["ll"][s["live"]]))]))
+
     def log_likelihood(self) -> np.ndarray:
         """Log-likelihood of each start (−inf where infeasible or pruned), up to a constant."""
         return self._solved()["ll"].copy()

@@ -262,9 +262,7 @@ def test_the_noise_scale_is_found_from_the_readings(kidney):
         flt = ContactFilter(kidney, sd_position=0.04, sd_scale=0.0, sd_slope=0.0, sd_turn=0.0, sd_jaw=0.0)
         e = true_sd * np.random.default_rng(1).standard_normal(len(turns) + 1)
         feed(flt, travel + e[1:] - e[0], turns)
-        s = flt._solved()
-        i = int(np.argmax(s["ll"][s["live"]]))
-        assert math.sqrt(s["lam2"][i]) * 0.04 == pytest.approx(true_sd, rel=0.15)
+        assert flt.noise_scale() * 0.04 == pytest.approx(true_sd, rel=0.15)
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,188 @@
+"""Replay one study trial's reactive filter with other settings: the same readings, another filter.
+
+A failed trial says little by itself: was it the readings, or the filter's model of them? This
+reruns one trial of a study (the same seeds, so the same rig, start and readings), records every
+call the rolling procedure made to its :class:`localizer.ContactFilter`, and feeds the same calls
+to filters built with other settings. Only the filter differs; the rolling is not redone (a
+variant that would have stopped earlier, or rolled elsewhere, is judged on the same readings)::
+
+    python -m bench.replay bench/studies/heldout-a.toml --level 3 --trial 26 \\
+        --set sd_slope=0 --set sd_jaw=0.045 --set temper=1
+
+Each variant's line gives the stated probability within the success radius, the error of the
+most probable present contact, and how much more likely (natural log, the evidence untempered)
+the best start within 2 mm of the true one is than the best start elsewhere: negative means the
+filter prefers a wrong place. Issue 14's study of the ×4 failures was done this way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+from localizer import ContactFilter
+
+from .study import TrialSpec, load_study, run_trial
+
+__all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "VariantResult"]
+
+#: A start within this of the true one counts as the true start (mm).
+NEAR = 2.0
+
+_CALLS = ("update", "touch", "bridged", "regrasp")
+
+
+class FilterRecorder(ContactFilter):
+    """A :class:`localizer.ContactFilter` that keeps the calls made to it (``calls``: name, args,
+    keyword args), the outermost only (``regrasp`` calls ``update`` itself). The latest instance
+    is :attr:`last`."""
+
+    last: ClassVar["FilterRecorder | None"] = None
+
+    def __init__(self, *args, **kwargs):
+        self.calls: list = []
+        self._depth = 0
+        self.settings = dict(kwargs)
+        super().__init__(*args, **kwargs)
+        FilterRecorder.last = self
+
+    def reset(self) -> None:
+        self.calls = []
+        super().reset()
+
+    def _record(self, name, args, kwargs):
+        if self._depth == 0:
+            self.calls.append((name, args, kwargs))
+        self._depth += 1
+        try:
+            return getattr(super(), name)(*args, **kwargs)
+        finally:
+            self._depth -= 1
+
+    def update(self, *args, **kwargs):
+        return self._record("update", args, kwargs)
+
+    def touch(self, *args, **kwargs):
+        return self._record("touch", args, kwargs)
+
+    def bridged(self, *args, **kwargs):
+        return self._record("bridged", args, kwargs)
+
+    def regrasp(self, *args, **kwargs):
+        return self._record("regrasp", args, kwargs)
+
+
+@dataclass(frozen=True)
+class Recorded:
+    """One trial's reactive filter: the part, the settings it was built with, the calls, the trial's
+    row of trials.csv and its start (mm)."""
+
+    part: object
+    settings: dict
+    calls: tuple
+    row: dict
+    start_arc: float
+
+
+@dataclass(frozen=True)
+class VariantResult:
+    """What a variant of the filter says after the recorded calls.
+
+    mass : stated probability within the success radius; error_mm : the most probable present
+    contact against the true start's present contact on the model (mm); margin : log-likelihood of
+    the best start within :data:`NEAR` mm of the true one minus the best elsewhere (untempered;
+    inf if no other is left); noise_scale : the λ the readings say."""
+
+    settings: dict
+    mass: float
+    error_mm: float
+    margin: float
+    noise_scale: float
+
+
+def record_trial(study_path, level: int, trial: int) -> Recorded:
+    """Rerun trial ``trial`` of level ``level`` of a study, recording its reactive filter's calls."""
+    study = load_study(study_path)
+    if "reactive" not in study.methods:
+        raise ValueError(f"study {study_path}: no reactive method to replay (methods = {list(study.methods)})")
+    if not 0 <= level < study.levels:
+        raise ValueError(f"level={level!r}: the study has levels 0 to {study.levels - 1}")
+    FilterRecorder.last = None
+    row = run_trial(TrialSpec(study, level, trial, extra={"filter_class": FilterRecorder}))
+    rec = FilterRecorder.last
+    if rec is None or row.get("reactive_failure"):
+        raise RuntimeError(f"trial {trial} of level {level} did not run its reactive method: "
+                           f"{row.get('reactive_failure') or row.get('failure')}")
+    return Recorded(part=rec.part, settings=rec.settings, calls=tuple(rec.calls), row=row,
+                    start_arc=float(row["start_arc"]))
+
+
+def replay(rec: Recorded, **changes) -> VariantResult:
+    """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied."""
+    settings = {**rec.settings, **changes, "prune": math.inf}
+    flt = ContactFilter(rec.part, **settings)
+    for name, args, kwargs in rec.calls:
+        getattr(flt, name)(*args, **kwargs)
+    belief = flt.belief()
+    part = rec.part
+    off = np.abs(np.asarray(part.arc_offset(flt.grid, rec.start_arc)))
+    ll = flt.log_likelihood() / flt.temper
+    near, far = ll[off < NEAR], ll[off >= NEAR]
+    best_near = float(near.max()) if near.size else -math.inf
+    best_far = float(far.max()) if far.size else -math.inf
+    margin = best_near - best_far if np.isfinite(best_far) else math.inf
+    i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
+    error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(flt.current[i])))))
+    return VariantResult(settings=dict(changes), mass=belief.mass, error_mm=error, margin=margin,
+                         noise_scale=flt.noise_scale())
+
+
+def _value(text: str):
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    if text.startswith("(") or text.startswith("["):
+        return tuple(float(v) for v in text.strip("()[]").split(",") if v.strip())
+    return text
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m bench.replay", description=__doc__.split("\n\n")[0])
+    ap.add_argument("study", type=Path)
+    ap.add_argument("--level", type=int, required=True, help="level index (0 = the first swept value)")
+    ap.add_argument("--trial", type=int, required=True)
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="a ContactFilter setting for one variant (repeat for more variants)")
+    args = ap.parse_args(argv)
+    variants = [{}]
+    for item in args.set:
+        name, sep, value = item.partition("=")
+        if not sep:
+            ap.error(f"--set {item!r}: use NAME=VALUE, e.g. sd_slope=0")
+        variants.append({name: _value(value)})
+    rec = record_trial(args.study, args.level, args.trial)
+    r = rec.row
+    print(f"{r['part']} {r['value']} trial {args.trial}: reactive {r['reactive_stopped']} at mass "
+          f"{r['reactive_mass']}, error {float(r['reactive_error_mm']):.3f} mm after "
+          f"{float(r['reactive_rotation_deg']):.1f} degrees, {len(rec.calls)} filter calls")
+    for changes in variants:
+        try:
+            v = replay(rec, **changes)
+        except (TypeError, ValueError) as exc:
+            print(f"  {changes!s:40s} cannot be built: {exc}", file=sys.stderr)
+            continue
+        print(f"  {str(changes) if changes else 'as run':40s} mass {v.mass:.3f}  error {v.error_mm:8.3f} mm  "
+              f"true-start margin {v.margin:+8.2f} nats  noise scale {v.noise_scale:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

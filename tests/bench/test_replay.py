@@ -1,0 +1,54 @@
+"""Replaying one trial's reactive filter with other settings (bench.replay)."""
+
+from pathlib import Path
+
+import pytest
+
+from bench.replay import main, record_trial, replay
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    f = tmp_path_factory.mktemp("replay") / "s.toml"
+    f.write_text(f'''
+name = "replay"
+parts = ["{ROOT / 'parts' / 'trefoil.json'}"]
+rolls_deg = [20.0, 15.0]
+methods = ["reactive"]
+trials = 1
+seed = 3
+noise = "paper"
+[reactive]
+max_rotation_deg = 60.0
+''')
+    return f, record_trial(f, 0, 0)
+
+
+def test_the_recorded_calls_give_back_the_run_belief(recorded):
+    _, rec = recorded
+    names = {c[0] for c in rec.calls}
+    assert {"touch", "update"} <= names and len(rec.calls) > 20
+    as_run = replay(rec)
+    assert as_run.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
+    assert as_run.error_mm == pytest.approx(float(rec.row["reactive_error_mm"]), abs=0.06)
+    assert as_run.margin > 0                 # it localized: the true start leads
+
+
+def test_a_variant_changes_only_the_filter(recorded):
+    _, rec = recorded
+    told_ten_times = replay(rec, sd_position=0.4, noise_scales=(1.0,))
+    as_run = replay(rec)
+    assert told_ten_times.mass < as_run.mass
+    assert told_ten_times.settings == {"sd_position": 0.4, "noise_scales": (1.0,)}
+
+
+def test_the_command_line(recorded, capsys):
+    f, _ = recorded
+    assert main([str(f), "--level", "0", "--trial", "0", "--set", "temper=1", "--set", "nonsense=2"]) == 0
+    out, err = capsys.readouterr()
+    assert "as run" in out and "{'temper': 1}" in out
+    assert "nonsense" in err
+    with pytest.raises(ValueError, match="level=5"):
+        record_trial(f, 5, 0)
