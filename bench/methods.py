@@ -215,7 +215,7 @@ def reactive_stop(run) -> str:
 
 def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None) -> dict:
     """The reactive filter from the same start on a rig with the same seed."""
-    from driver.reactive import localize_reactively
+    from driver.reactive import CONFIRM, localize_reactively
     from sim2d import SimRig
 
     o = study.reactive
@@ -224,7 +224,7 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
                               approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
                               step=math.radians(study.step_deg), confidence=o.confidence,
                               max_rotation=math.radians(o.max_rotation_deg), check_every=o.check_every,
-                              min_spread=o.min_spread, **({} if o.confirm is None else {"confirm": o.confirm}))
+                              min_spread=o.min_spread, confirm=CONFIRM if o.confirm is None else o.confirm)
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)
     rot = math.degrees(res.rotation)

@@ -86,7 +86,6 @@ METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve"
                   "bridges")
 
 
-
 @dataclass(frozen=True)
 class ReactiveOptions:
     """[reactive] of a study file (see :func:`driver.reactive.localize_reactively`)."""

@@ -114,8 +114,7 @@ from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 
 __all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for",
-           "NOISE_SCALES",
-           "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
+           "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
 #: log-uniform prior in steps of 2^(1/4) from a quarter to sixteen times what it was told. The
@@ -611,10 +610,9 @@ class ContactFilter:
         reading (default: the last one given). A hypothesis under which that turn, and
         :data:`TURN_MARGIN` more, keep the contact on its convex stretch, the turn moving it by
         less than half of ``jump``, with the jaw clear by ``jaw_margin`` there, did not expect it and
-        is made :data:`BRIDGE_MISS` times
-        less likely; the others predicted it (a concavity, or a flat stretch where one step
-        moves the contact far) or cannot tell. No reading is added: call :meth:`regrasp` with
-        the next one.
+        is made :data:`BRIDGE_MISS` times less likely; the others predicted it (a concavity, or a
+        flat stretch where one step moves the contact far) or cannot tell. No reading is added:
+        call :meth:`regrasp` with the next one.
         """
         if not (math.isfinite(turn) and math.isfinite(jump) and jump > 0):
             raise QueryError(f"turn={turn!r} rad and jump={jump!r} mm must be finite, jump positive")
@@ -722,10 +720,11 @@ class ContactFilter:
         self._hist.append((z, turn))
         fresh = cols[(cols >= self._segments) & (cols < self._jaw0)]
         fresh = fresh[self._slope_var[fresh] == 0]
-        self._slope_var[fresh] = (min(self._radius_here(), SLOPE_RHO_MAX) * self.sd_slope) ** 2
+        rho = self._radius_here()
+        self._slope_var[fresh] = (min(rho, SLOPE_RHO_MAX) * self.sd_slope) ** 2
         # the rotation's error moves the contact by ρ·e: the reading's variance grows by (ρ̂·sd_turn)²
         # (weighted least squares: the row times 1/relative sd)
-        wt = 1.0 / math.hypot(1.0, self._radius_here() * self.sd_turn / self.sd_position)
+        wt = 1.0 / math.hypot(1.0, rho * self.sd_turn / self.sd_position)
         self._row_weight = wt
         z, p, vals = z * wt, p * wt, vals * wt
         sel = slice(None) if idx is None else idx
