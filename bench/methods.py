@@ -199,8 +199,9 @@ def reactive_filter(study, part, noise, filter_class=None):
                                                       part.perimeter), 5e-4)
     if o.noise_scales is not None:
         given["noise_scales"] = o.noise_scales
-    if o.temper is not None:
-        given["temper"] = o.temper
+    for key in ("temper", "shape_spacing"):
+        if getattr(o, key) is not None:
+            given[key] = getattr(o, key)
     cls = ContactFilter if filter_class is None else filter_class
     return cls(part, radius=study.success_radius, confidence=o.confidence, **given)
 

@@ -100,6 +100,7 @@ class ReactiveOptions:
     min_spread: float = 0.05
     noise_scales: tuple | None = None  # None: localizer.NOISE_SCALES
     temper: float | None = None        # None: the filter's default
+    shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
 
 
 @dataclass(frozen=True)
