@@ -19,7 +19,7 @@ demo: $(STAMP)
 	$(VENV)/bin/rolltouch locate out/demo.npz --part parts/trefoil.json
 
 test: $(STAMP)
-	$(PY) -m pytest -q tests localizer
+	$(PY) -m pytest -q tests localizer passivity
 	$(PY) -m pytest -q bench --benchmark-disable -p no:cacheprovider
 
 bench: $(STAMP)

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from localizer import PassivityController
+from passivity import PassivityController
 from sim2d.haptic import Axis, Operator, Servo, simulate_servo, simulate_wall
 from sim2d.noise import PRESETS
 from sim2d.wrist import Wrist

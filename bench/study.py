@@ -68,6 +68,8 @@ from pathlib import Path
 
 import numpy as np
 
+from localizer import RolltouchError
+
 __all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS"]
 
 #: Columns of trials.csv, in order.
@@ -112,7 +114,7 @@ class ParticleOptions:
     process: float = 0.005
 
 
-class StudyError(ValueError):
+class StudyError(RolltouchError, ValueError):
     """A study file that cannot be run; the message names the key and what is wrong."""
 
 

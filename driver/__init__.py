@@ -1,3 +1,5 @@
 """Rig protocol, procedures, pipeline, serial rig and the command line (depends on localizer)."""
 
-__all__: list[str] = []
+from .rig import ProtocolError, Rig, RigError
+
+__all__ = ["Rig", "RigError", "ProtocolError"]

@@ -15,12 +15,9 @@ from dataclasses import asdict
 
 import numpy as np
 
-from localizer import DIRECTIONS, RULES, LocalizerError, load_part, localize
+from localizer import DIRECTIONS, RULES, LocalizerError, RolltouchError, load_part, localize
 
 from .rig import RigError
-
-# sim2d errors are ValueErrors; caught by their base so that the CLI imports no physics at start
-SimErrorBase = ValueError
 
 __all__ = ["main", "build_parser"]
 
@@ -383,10 +380,7 @@ def _emulate(args) -> int:
     from sim2d import SimRig
 
     part = load_part(args.part)
-    try:
-        faults = Faults.parse(args.fault)
-    except ValueError as exc:
-        raise RigError(str(exc)) from None
+    faults = Faults.parse(args.fault)
     rig = SimRig(part, noise=args.noise, seed=args.seed, engine=args.engine)
     if args.start is None:
         start_pose = rig.calibration_pose()
@@ -526,7 +520,7 @@ def main(argv=None) -> int:
             return _calibrate(args)
         if args.command == "run":
             return _run(args)
-    except (LocalizerError, RigError, SimErrorBase) as exc:
+    except RolltouchError as exc:
         print(f"rolltouch: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

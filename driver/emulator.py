@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .protocol import ARM_COMMANDS, DAQ_COMMANDS, MAX_LINE, encode_reply, parse_request
+from .rig import ProtocolError, RigError
 
 __all__ = ["Faults", "Emulator"]
 
@@ -52,11 +53,11 @@ class Faults:
         for spec in specs or ():
             name, _, value = str(spec).partition("=")
             if name not in names or not value:
-                raise ValueError(f"fault {spec!r}: use NAME=VALUE with NAME one of {sorted(names)}")
+                raise RigError(f"fault {spec!r}: use NAME=VALUE with NAME one of {sorted(names)}")
             try:
                 kwargs[name.replace("-", "_")] = names[name](value)
             except ValueError:
-                raise ValueError(f"fault {spec!r}: {value!r} is not a {names[name].__name__}") from None
+                raise RigError(f"fault {spec!r}: {value!r} is not a {names[name].__name__}") from None
         return cls(**kwargs)
 
 
@@ -141,11 +142,8 @@ class Emulator:
         commands = ARM_COMMANDS if device == "arm" else DAQ_COMMANDS
         try:
             seq, cmd, args = parse_request(line, commands)
-        except (ValueError, UnicodeDecodeError) as exc:
-            words = line.split()
-            seq = int(words[0]) if words and words[0].isdigit() else 0
-            code, _, msg = str(exc).partition(" ")
-            return [encode_reply(seq, "ERR", code if code.isupper() else "BADCMD", msg.replace("\n", " ")[:120])]
+        except ProtocolError as exc:
+            return [encode_reply(exc.seq, "ERR", exc.code, exc.message.replace("\n", " ")[:120])]
         with self.lock:
             if device == "arm":
                 self.arm_commands += 1

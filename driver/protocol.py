@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .rig import RigError
+from .rig import ProtocolError, RigError
 
 __all__ = ["Reply", "encode_request", "encode_reply", "parse_reply", "parse_request", "checksum",
            "ARM_COMMANDS", "DAQ_COMMANDS", "MAX_LINE"]
@@ -120,20 +120,31 @@ def parse_reply(line: bytes) -> Reply:
 
 
 def parse_request(line: bytes, commands: dict):
-    """(seq, command, args) of a request line, for the device side; ValueError if malformed."""
-    text = line.decode("ascii").strip()
+    """(seq, command, args) of a request line, for the device side.
+
+    Raises
+    ------
+    ProtocolError
+        With code ``BADCMD`` (not a request, or an unknown command) or ``BADARG`` (wrong count,
+        not numbers, not finite), and the request's sequence number when it could be read.
+    """
+    try:
+        text = line.decode("ascii").strip()
+    except UnicodeDecodeError:
+        raise ProtocolError("BADCMD", f"request {bytes(line)[:40]!r} is not ASCII") from None
     words = text.split()
     if len(words) < 2 or not words[0].isdigit():
-        raise ValueError(f"BADCMD not '<seq> <COMMAND> ...': {text[:40]!r}")
+        seq = int(words[0]) if words and words[0].isdigit() else 0
+        raise ProtocolError("BADCMD", f"not '<seq> <COMMAND> ...': {text[:40]!r}", seq)
     seq, cmd, args = int(words[0]), words[1].upper(), words[2:]
     if cmd not in commands:
-        raise ValueError(f"BADCMD unknown command {cmd!r}; known: {' '.join(sorted(commands))}")
+        raise ProtocolError("BADCMD", f"unknown command {cmd!r}; known: {' '.join(sorted(commands))}", seq)
     if len(args) != commands[cmd]:
-        raise ValueError(f"BADARG {cmd} takes {commands[cmd]} argument(s), got {len(args)}")
+        raise ProtocolError("BADARG", f"{cmd} takes {commands[cmd]} argument(s), got {len(args)}", seq)
     try:
         values = [float(a) for a in args]
     except ValueError:
-        raise ValueError(f"BADARG {cmd} arguments must be numbers: {' '.join(args)}") from None
+        raise ProtocolError("BADARG", f"{cmd} arguments must be numbers: {' '.join(args)}", seq) from None
     if not all(math.isfinite(v) for v in values):
-        raise ValueError(f"BADARG {cmd} arguments must be finite")
+        raise ProtocolError("BADARG", f"{cmd} arguments must be finite", seq)
     return seq, cmd, values

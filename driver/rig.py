@@ -4,11 +4,33 @@ from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
-__all__ = ["Rig", "RigError"]
+from localizer import RolltouchError
+
+__all__ = ["Rig", "RigError", "ProtocolError"]
 
 
-class RigError(IOError):
+class RigError(RolltouchError, IOError):
     """A rig that did not do what was asked: no contact, contact off the jaw, a bad reply, a limit."""
+
+
+class ProtocolError(RigError):
+    """A request or reply the serial protocol refuses, with its error code.
+
+    Parameters
+    ----------
+    code : str
+        The protocol's code (``BADCMD``, ``BADARG``, ``LIMIT``, ...), as an ``ERR`` reply carries it.
+    message : str
+        What was wrong, naming the value.
+    seq : int
+        The request's sequence number (0 when it could not be read).
+    """
+
+    def __init__(self, code: str, message: str, seq: int = 0):
+        super().__init__(f"{code}: {message}")
+        self.code = code
+        self.message = message
+        self.seq = seq
 
 
 @runtime_checkable

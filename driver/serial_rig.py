@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import serial
 
 from .protocol import MAX_LINE, Reply, encode_request, parse_reply
-from .rig import RigError
+from .rig import ProtocolError, RigError
 
 __all__ = ["SerialRig", "Workspace"]
 
@@ -125,7 +125,9 @@ class SerialRig:
                     if reply.seq != seq:
                         continue  # a late reply to an earlier try: skip it
                     if reply.status == "ERR":
-                        raise RigError(f"the {device} refused {command}: {reply.error}")
+                        code = reply.fields[0] if reply.fields else "ERR"
+                        raise ProtocolError(code, f"the {device} refused {command}: {' '.join(reply.fields[1:])}",
+                                            reply.seq)
                     if reply.status == "DATA":
                         continue
                     return reply

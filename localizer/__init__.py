@@ -1,18 +1,17 @@
 """Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
 
-from ._errors import LocalizerError, PartError, QueryError
+from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
-from ._passivity import PassivityController, PassivityStep
 from ._filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, Belief, ContactFilter, Mode, ModeTracks, ParticleFilter, machining_slope, tracks_for
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._march import MarchGrid, MarchResult, march, march_grid
 from ._disambiguate import RULES, Candidate, Localization, localize
-from ._solver import DIRECTIONS, METHODS, Segment, feasible_segments
+from ._segment import DIRECTIONS, Segment
+from ._solver import METHODS, feasible_segments
 
 __all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for",
-           "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
+           "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "RolltouchError", "LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
            "Segment", "feasible_segments", "METHODS", "DIRECTIONS",
            "Candidate", "Localization", "localize", "RULES",
-           "march", "march_grid", "MarchResult", "MarchGrid", "arc_from_jaw_positions",
-           "PassivityController", "PassivityStep"]
+           "march", "march_grid", "MarchResult", "MarchGrid", "arc_from_jaw_positions"]

@@ -31,7 +31,8 @@ from scipy.optimize import least_squares
 
 from ._errors import QueryError
 from ._part import Part
-from ._solver import DIRECTIONS, feasible_segments
+from ._segment import DIRECTIONS
+from ._solver import feasible_segments
 
 __all__ = ["Candidate", "Localization", "localize", "RULES"]
 

@@ -1,10 +1,17 @@
-"""Exceptions of the localizer: one root, subclassing ``ValueError``."""
+"""The package's errors: one root, :class:`RolltouchError`, for every error rolltouch raises on
+purpose. Each specific error also subclasses the built-in it is a kind of, so ``except
+ValueError`` keeps working; a bug (a ``TypeError`` from our own code, say) is not one of ours
+and is never reported as bad input."""
 
-__all__ = ["LocalizerError", "PartError", "QueryError"]
+__all__ = ["RolltouchError", "LocalizerError", "PartError", "QueryError"]
 
 
-class LocalizerError(ValueError):
-    """Root of every error raised by :mod:`localizer`."""
+class RolltouchError(Exception):
+    """Root of every error that rolltouch raises on purpose; the message names the bad value."""
+
+
+class LocalizerError(RolltouchError, ValueError):
+    """Root of the errors raised by :mod:`localizer`."""
 
 
 class PartError(LocalizerError):

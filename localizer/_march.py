@@ -31,6 +31,7 @@ import numpy as np
 
 from ._errors import QueryError
 from ._part import Part, _curvature
+from ._segment import Segment
 
 __all__ = ["MarchGrid", "MarchResult", "march_grid", "march"]
 
@@ -233,7 +234,6 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
     -------
     MarchResult
     """
-    from ._solver import Segment
 
     grid = march_grid(part, step)
     h, M = grid.h, grid.cells

@@ -1,7 +1,9 @@
-"""Exceptions of the simulator: one root, subclassing ``ValueError``."""
+"""The simulator's error, under the package's one root."""
+
+from localizer import RolltouchError
 
 __all__ = ["SimError"]
 
 
-class SimError(ValueError):
+class SimError(RolltouchError, ValueError):
     """A bad simulation setting (noise model, world parameter, pose); the message names it."""

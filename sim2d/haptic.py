@@ -238,7 +238,7 @@ def simulate_wall(controller=None, *, axis: Axis = Axis(), operator: Operator = 
     The wall at x = 0 pushes back with K·x_enc(n) (N) while the encoder reads
     inside it. With impedance causality the wall's port takes the differenced
     velocity v(n) and gives the force; ``controller`` (a
-    :class:`localizer.PassivityController`, or None for the bare wall) sits on
+    :class:`passivity.PassivityController`, or None for the bare wall) sits on
     that port, its force pushed back onto the device with the wall's.
 
     Returns

@@ -138,7 +138,7 @@ class SimRig:
             ``dv1`` (mean of the last half, V), ``dv1_std`` (V), ``contact_lost`` (samples of the
             last half with no contact), ``min_energy`` (J), ``guard``.
         """
-        from localizer import PassivityController
+        from passivity import PassivityController
 
         from .haptic import Axis, Servo, simulate_servo
 

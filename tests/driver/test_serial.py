@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from driver.emulator import Emulator, Faults
 from driver.procedures import run_from_here
 from driver.protocol import encode_reply, encode_request, parse_reply, parse_request, ARM_COMMANDS
-from driver.rig import RigError
+from driver.rig import ProtocolError, RigError
 from driver.runlog import RunLog
 from driver.serial_rig import SerialRig, Workspace
 from driver.trace import Trace
@@ -173,6 +173,17 @@ def test_reply_parser_only_raises_rig_error(data):
 def test_replies_round_trip(seq, values):
     r = parse_reply(encode_reply(seq, "OK", *values))
     assert r.seq == seq and r.numbers(len(values)) == tuple(values)
+
+
+@pytest.mark.parametrize("line, code, seq", [(b"7 FLY 1 2 3", "BADCMD", 7), (b"9 MOVE 1 2", "BADARG", 9),
+                                             (b"4 MOVE 1 x 3", "BADARG", 4), (b"4 MOVE 1 nan 3", "BADARG", 4),
+                                             (b"MOVE 1 2 3", "BADCMD", 0), (b"\xff\xfe", "BADCMD", 0)])
+def test_bad_requests_carry_their_code_and_sequence(line, code, seq):
+    with pytest.raises(ProtocolError) as info:
+        parse_request(line, ARM_COMMANDS)
+    assert (info.value.code, info.value.seq) == (code, seq)
+    reply = parse_reply(emulator().handle("arm", line)[0])
+    assert (reply.status, reply.seq, reply.fields[0]) == ("ERR", seq, code)
 
 
 def test_requests_round_trip():

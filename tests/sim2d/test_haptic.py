@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from localizer import PassivityController
+from passivity import PassivityController
 from sim2d import SimError
 from sim2d.haptic import Axis, Operator, Servo, simulate_servo, simulate_wall
 

@@ -45,7 +45,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["PassivityController", "PassivityStep"]
+from localizer import RolltouchError
+
+__all__ = ["PassivityController", "PassivityStep", "ControlError"]
+
+
+class ControlError(RolltouchError, ValueError):
+    """A controller setting or sample that cannot be used; the message names it."""
 
 
 @dataclass(frozen=True)
@@ -96,11 +102,11 @@ class PassivityController:
     def __init__(self, dt: float, *, sign_fix: bool = False, hold_fix: bool = False,
                  force_limit: float | None = None, booking: str = "assumed"):
         if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt={dt!r} s must be a positive number")
+            raise ControlError(f"dt={dt!r} s must be a positive number")
         if force_limit is not None and not force_limit > 0:
-            raise ValueError(f"force_limit={force_limit!r} N must be positive or None")
+            raise ControlError(f"force_limit={force_limit!r} N must be positive or None")
         if booking not in ("assumed", "observed"):
-            raise ValueError(f"booking={booking!r}: use 'assumed' or 'observed'")
+            raise ControlError(f"booking={booking!r}: use 'assumed' or 'observed'")
         self.booking = booking
         self.dt = float(dt)
         self.sign_fix = bool(sign_fix)
@@ -128,7 +134,7 @@ class PassivityController:
             Port velocity.
         """
         if not (math.isfinite(f) and math.isfinite(v)):
-            raise ValueError(f"f={f!r} N and v={v!r} m/s must be finite")
+            raise ControlError(f"f={f!r} N and v={v!r} m/s must be finite")
         dt = self.dt
         if self.booking == "assumed":
             # the previous sample's dissipation, now booked

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from localizer import PassivityController
+from passivity import ControlError, PassivityController
 
 DT = 0.001
 
@@ -77,9 +77,9 @@ def test_force_limit_bounds_the_control_and_keeps_the_rest_in_the_observer():
 
 
 def test_bad_parameters():
-    with pytest.raises(ValueError, match="dt=0"):
+    with pytest.raises(ControlError, match="dt=0"):
         PassivityController(0)
-    with pytest.raises(ValueError, match="force_limit=-1"):
+    with pytest.raises(ControlError, match="force_limit=-1"):
         PassivityController(DT, force_limit=-1)
 
 
@@ -126,7 +126,7 @@ def test_observed_sign_change_of_a_held_control_force_is_what_the_sign_fix_drops
 
 
 def test_bad_booking_and_non_finite_samples():
-    with pytest.raises(ValueError, match="booking='zoh'"):
+    with pytest.raises(ControlError, match="booking='zoh'"):
         PassivityController(DT, booking="zoh")
-    with pytest.raises(ValueError, match="v=nan"):
+    with pytest.raises(ControlError, match="v=nan"):
         PassivityController(DT).update(1.0, float("nan"))
