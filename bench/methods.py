@@ -190,7 +190,8 @@ def reactive_filter(study, part, noise, filter_class=None):
     study's noise model's RMS slope (machined parts vary: measured 0.8e-3 to 1.9e-3 rad RMS at the
     paper preset, whose model RMS is 0.6e-3, and the basis' coefficients are not its values).
     """
-    from localizer import ContactFilter, machining_slope
+    from localizer import ContactFilter
+    from sim2d import machining_slope
 
     o = study.reactive
     given = {k: getattr(o, k) for k in ("sd_position", "sd_scale", "sd_slope") if getattr(o, k) is not None}

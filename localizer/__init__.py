@@ -2,7 +2,7 @@
 
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
-from ._filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, Belief, ContactFilter, Mode, ModeTracks, ParticleFilter, machining_slope, tracks_for
+from ._filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, Belief, ContactFilter, Mode, ModeTracks, ParticleFilter, tracks_for
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._march import MarchGrid, MarchResult, march, march_grid
@@ -10,7 +10,7 @@ from ._disambiguate import RULES, Candidate, Localization, localize
 from ._segment import DIRECTIONS, Segment
 from ._solver import METHODS, feasible_segments
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for",
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "tracks_for",
            "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "RolltouchError", "LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",
            "Segment", "feasible_segments", "METHODS", "DIRECTIONS",
            "Candidate", "Localization", "localize", "RULES",

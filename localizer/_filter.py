@@ -113,7 +113,7 @@ from ._errors import QueryError
 from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "machining_slope", "tracks_for",
+__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "tracks_for",
            "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
@@ -194,15 +194,6 @@ class Belief:
     ambiguous: bool
     informative: bool
     steps: int
-
-
-def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
-    """RMS slope error (rad) of a boundary deviation of ``rms`` mm made of harmonics of the
-    perimeter with 1/k amplitudes down to ``wavelength`` mm (the simulator's machining model)."""
-    if rms <= 0:
-        return 0.0
-    k = np.arange(1, max(1, int(perimeter / wavelength)) + 1)
-    return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k ** 2)))
 
 
 def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> "ModeTracks":
@@ -377,7 +368,7 @@ class ContactFilter:
         Standard deviation of the calibration's relative scale error (0: none).
     sd_slope : float, rad
         Standard deviation of the B-spline coefficients of the part's slope error
-        against its model (0: a perfect part). :func:`machining_slope` gives it for
+        against its model (0: a perfect part). :func:`sim2d.machining_slope` gives it for
         the simulator's machining model.
     shape_spacing : float, mm
         Knot spacing of that B-spline basis, in cumulative arc.

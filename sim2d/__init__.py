@@ -1,8 +1,9 @@
 """The simulated rig: instruments, noise model, worlds and ``SimRig`` (depends on localizer)."""
 
 from ._errors import SimError
+from .machining import machined_part, machining_slope
 from .noise import PRESETS, NoiseModel, load_noise
 from .rig import SimRig
 from .wrist import Wrist, encoder_angle
 
-__all__ = ["SimError", "NoiseModel", "PRESETS", "load_noise", "SimRig", "Wrist", "encoder_angle"]
+__all__ = ["SimError", "NoiseModel", "PRESETS", "load_noise", "SimRig", "Wrist", "encoder_angle", "machined_part", "machining_slope"]

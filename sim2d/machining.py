@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from localizer import Part, part_from_points
 
 from .noise import NoiseModel
 
-__all__ = ["machined_part"]
+__all__ = ["machined_part", "machining_slope"]
 
 
 def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Part:
@@ -31,3 +33,12 @@ def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Pa
     dev *= noise.machining_error / max(np.sqrt(np.mean(dev ** 2)), 1e-300)
     pts = part.points + dev[:, None] * part.normal(knots)
     return part_from_points(pts, name=f"{part.name} (machined)")
+
+
+def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
+    """RMS slope error (rad) of a boundary deviation of ``rms`` mm made of harmonics of the
+    perimeter with 1/k amplitudes down to ``wavelength`` mm (the simulator's machining model)."""
+    if rms <= 0:
+        return 0.0
+    k = np.arange(1, max(1, int(perimeter / wavelength)) + 1)
+    return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k ** 2)))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, ParticleFilter, QueryError, load_part,
-                       machining_slope, part_from_points)
+                       part_from_points)
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 STEP = math.radians(0.2)
@@ -135,12 +135,6 @@ def test_many_particles_agree_with_the_grid_filter(cam):
     est, mass = pf.estimate()
     assert abs(cam.arc_offset(est, b.map_arc)) < 0.15
     assert mass == pytest.approx(b.mass, abs=0.2)
-
-
-def test_machining_slope_of_one_harmonic():
-    # one harmonic: amplitude √2·rms, slope amplitude √2·rms·2π/P, slope RMS rms·2π/P
-    assert machining_slope(0.01, 100.0, 100.0) == pytest.approx(0.01 * 2 * math.pi / 100.0)
-    assert machining_slope(0.0, 20.0, 300.0) == 0.0
 
 
 @pytest.mark.parametrize("kwargs, match", [

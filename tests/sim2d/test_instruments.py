@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from localizer import load_part
-from sim2d.machining import machined_part
+from sim2d.machining import machined_part, machining_slope
 from sim2d import SimError
 from sim2d.noise import PRESETS, NoiseModel, load_noise
 from sim2d.wrist import Wrist, encoder_angle
@@ -77,6 +77,12 @@ def test_bad_noise_spec():
         load_noise("lab")
     with pytest.raises(SimError, match="no field 'x'"):
         PRESETS["paper"].scaled(x=2.0)
+
+
+def test_machining_slope_of_one_harmonic():
+    # one harmonic: amplitude √2·rms, slope amplitude √2·rms·2π/P, slope RMS rms·2π/P
+    assert machining_slope(0.01, 100.0, 100.0) == pytest.approx(0.01 * 2 * math.pi / 100.0)
+    assert machining_slope(0.0, 20.0, 300.0) == 0.0
 
 
 def test_machining_error_is_smooth_and_of_the_stated_size():
