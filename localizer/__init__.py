@@ -2,7 +2,10 @@
 
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
-from ._filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, Belief, ContactFilter, Mode, ModeTracks, ParticleFilter, tracks_for
+from ._belief import Belief, Mode
+from ._tracks import ModeTracks, tracks_for
+from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, ContactFilter
+from ._particle_filter import ParticleFilter
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._march import MarchGrid, MarchResult, march, march_grid

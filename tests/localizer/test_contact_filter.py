@@ -1,5 +1,4 @@
-"""The sequential filters: the grid filter's posterior against known answers, the particle filter
-against the grid filter."""
+"""The grid filter: its posterior against known answers (exact readings, analytic shapes)."""
 
 import math
 from pathlib import Path
@@ -7,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, ParticleFilter, QueryError, load_part,
+from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, QueryError, load_part,
                        part_from_points)
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
@@ -122,21 +121,6 @@ def test_a_start_off_the_hull_is_not_a_hypothesis():
     assert flt.feasible.mean() < 1.0 and flt.feasible.mean() > 0.5
 
 
-def test_many_particles_agree_with_the_grid_filter(cam):
-    rng = np.random.default_rng(11)
-    grid = ContactFilter(cam, sd_position=0.04, sd_scale=0.0, sd_slope=0.0)
-    pf = ParticleFilter(cam, particles=60000, sd_position=0.04, process=0.0005, seed=3)
-    turns = STEP * np.arange(1, 176)
-    z, arcs = readings(grid, 200.0, turns, rng, 0.04)
-    for a, t in zip(z, turns):
-        grid.update(float(a), float(t))
-        pf.update(float(a), float(t))
-    b = grid.belief()
-    est, mass = pf.estimate()
-    assert abs(cam.arc_offset(est, b.map_arc)) < 0.15
-    assert mass == pytest.approx(b.mass, abs=0.2)
-
-
 @pytest.mark.parametrize("kwargs, match", [
     ({"spacing": 0}, "spacing=0"), ({"sd_position": -1}, "sd_position=-1"),
     ({"sd_slope": float("nan")}, "sd_slope=nan"), ({"confidence": 1.0}, "confidence=1.0"),
@@ -150,8 +134,6 @@ def test_bad_readings(cam):
     flt = ContactFilter(cam)
     with pytest.raises(QueryError, match="arc=nan"):
         flt.update(float("nan"), 0.0)
-    with pytest.raises(QueryError, match="particles=1"):
-        ParticleFilter(cam, particles=1)
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""Sequential localization while rolling: an exact grid filter and a particle-filter baseline.
+"""Sequential localization while rolling: the exact grid filter over the start of the rolling.
 
 The jaw rolls on a convex stretch of the part. With the contact at arc
 position σ₀ when the rolling starts, a net jaw rotation Ω puts it at the σ
@@ -93,28 +93,22 @@ The belief over the *present* contact is the push-forward of the posterior over
 σ₀. :meth:`ContactFilter.belief` reports its maximum, the probability within the
 success radius of it, the separate modes, and whether the data said anything at
 all (on a circle every start predicts the same readings).
-
-**ParticleFilter** is the conventional peer method: particles over the present
-contact, moved by each measured rotation step with a small process noise,
-weighted by each step's measured arc increment, resampled systematically when
-the effective sample size drops below half.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import ndtr
 
-from ._cache import per_part
+from ._belief import Belief, Mode
 from ._errors import QueryError
 from ._part import Part
-from ._reach import DEFAULT_JAW, StraightJaw, reach_for
+from ._reach import DEFAULT_JAW, StraightJaw
+from ._tracks import tracks_for
 
-__all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "tracks_for",
-           "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
+__all__ = ["ContactFilter", "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
 #: log-uniform prior in steps of 2^(1/4) from a quarter to sixteen times what it was told. The
@@ -144,206 +138,6 @@ SLOPE_RHO_MAX = 1000.0
 #: at that end: the machined part's slope differs from the model's by 0.6 mrad RMS at the `paper`
 #: preset, peaks of 10 mrad at five times that.
 TURN_MARGIN = 0.02
-
-
-@dataclass(frozen=True)
-class Mode:
-    """One separate mode of the belief over the present contact.
-
-    Attributes
-    ----------
-    arc : float, mm
-        Most probable present contact in the mode.
-    mass : float
-        Probability of the mode.
-    start_arc : float, mm
-        The corresponding start of the rolling.
-    """
-
-    arc: float
-    mass: float
-    start_arc: float
-
-
-@dataclass(frozen=True)
-class Belief:
-    """What the filter believes about the present contact.
-
-    Attributes
-    ----------
-    map_arc : float, mm
-        The most probable present contact.
-    mass : float
-        Probability that the contact is within ``radius`` of ``map_arc``.
-    radius : float, mm
-    modes : tuple of Mode
-        Separate modes, most probable first.
-    ambiguous : bool
-        More than one mode holds at least ``mode_floor`` of the probability and the
-        first does not reach the confidence: the data cannot tell them apart (yet).
-    informative : bool
-        False when the posterior is as flat as the prior (e.g. on a circle).
-    steps : int
-        Updates so far.
-    """
-
-    map_arc: float
-    mass: float
-    radius: float
-    modes: tuple
-    ambiguous: bool
-    informative: bool
-    steps: int
-
-
-def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> "ModeTracks":
-    """The part's :class:`ModeTracks` at ``spacing`` mm for ``jaw``, built once per part, spacing and jaw.
-
-    Building them takes most of a second (the dense sample, the jaw's reach, the banded
-    tangent-angle table); a Monte Carlo trial makes a grid filter and a particle filter on
-    the same part. The tables are read-only, so the filters can share them.
-    """
-    return per_part("tracks", part, (float(spacing), jaw), lambda: ModeTracks(part, spacing, jaw))
-
-
-class ModeTracks:
-    """Where each of a set of hypotheses' contacts goes under further rotation, and where the jaw reaches.
-
-    Attributes
-    ----------
-    sigma, theta, kappa : ndarray, shape (n,)
-        The grid's arc positions (mm), unwrapped tangent angles (rad) and curvatures (1/mm).
-    lo, hi : ndarray, shape (n,), mm
-        The jaw positions at which the jaw can touch each grid point (:class:`localizer.Reach`).
-    touchable : ndarray of bool
-        The jaw touches the point at some place along it.
-    convex : ndarray of bool
-        Where a rolling can be: a convex stretch (θ rising, κ > 0) the jaw touches.
-    """
-
-    def __init__(self, part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW):
-        self.part = part
-        self.jaw = jaw
-        p = part.perimeter
-        n = max(64, int(math.ceil(p / spacing)))
-        self.h = p / n
-        sigma = np.arange(n) * self.h
-        theta = np.asarray(part.tangent_angle_at_arc(sigma), dtype=float)
-        kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
-        self.sigma, self.theta, self.kappa = sigma, theta, kappa
-        # three laps so that any rotation of less than a lap stays on the table
-        turn = 2.0 * math.pi
-        arcs = np.concatenate([sigma - p, sigma, sigma + p, [2 * p]])
-        th = np.concatenate([theta - turn, theta, theta + turn, [theta[0] + 2 * turn]])
-        rising = np.diff(th) > 0
-        # runs of cells with rising θ (convex stretches) or not; run r spans nodes a_r..b_r
-        change = np.flatnonzero(np.diff(rising.astype(np.int8)) != 0) + 1
-        a = np.concatenate([[0], change])
-        b = np.concatenate([change, [rising.size]])
-        span = float(th.max() - th.min()) + 1.0
-        # each run's nodes, its θ shifted into a band of its own (flat on falling runs), concatenated:
-        # one searchsorted then serves every run
-        pieces_s, pieces_b, offsets = [], [], []
-        at = 0
-        for r, (lo, hi) in enumerate(zip(a, b)):
-            offsets.append(at)
-            pieces_s.append(arcs[lo:hi + 1])
-            vals = th[lo:hi + 1] if rising[lo] else np.full(hi + 1 - lo, th[lo])
-            pieces_b.append(vals + r * span)
-            at += hi + 1 - lo
-        self._s = np.concatenate(pieces_s)
-        self._banded = np.concatenate(pieces_b)
-        self._first = np.array(offsets)
-        self._last = np.array(offsets) + (b - a)
-        self._span = span
-        run_of_cell = np.repeat(np.arange(a.size), b - a)
-        self._run = run_of_cell[np.arange(n) + n]
-        # where the jaw reaches, from its geometry (localizer._reach): no fixed tolerance below the hull
-        self.reach = reach_for(part, jaw)
-        self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
-        self.lo_sure, self.hi_sure = (np.array(v) for v in self.reach.interval(sigma, sure=True))
-        self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
-        self.convex = rising[a][self._run] & (kappa > 0) & self.touchable
-        for arr in (self.sigma, self.theta, self.kappa, self.lo, self.hi, self.lo_sure, self.hi_sure, self.touchable,
-                    self.convex, self._s,
-                    self._banded, self._first, self._last, self._run):
-            arr.setflags(write=False)
-
-    def advance(self, index: np.ndarray, turn, *, turn_margin: float = 0.0) -> tuple:
-        """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``, along their
-        convex stretches (no check of where the jaw reaches: :meth:`touches`, :meth:`roll`).
-
-        Parameters
-        ----------
-        index : array of int
-            Grid points the rotation starts from.
-        turn : float or array, rad
-            Net rotation from there (counter-clockwise positive).
-        turn_margin : float, rad
-            A rotation up to this far past the end of the point's convex stretch keeps the
-            contact at the end (the real part's slope differs from the model's near an
-            inflection) instead of ruling the point out.
-
-        Returns
-        -------
-        arc : ndarray, mm
-            Unwrapped; ``nan`` where the rotation leaves the point's convex stretch.
-        ok : ndarray of bool
-        """
-        idx = np.asarray(index)
-        run = self._run[idx]
-        target = self.theta[idx] + turn + run * self._span
-        first, last = self._first[run], self._last[run]
-        lo_b, hi_b = self._banded[first], self._banded[last]
-        ok = self.convex[idx] & (target >= lo_b - turn_margin) & (target <= hi_b + turn_margin)
-        target = np.clip(target, lo_b, hi_b)
-        j = np.clip(np.searchsorted(self._banded, target, side="left"), first + 1, last)
-        b0, b1 = self._banded[j - 1], self._banded[j]
-        w = (target - b0) / np.where(b1 > b0, b1 - b0, 1.0)
-        arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
-        return np.where(ok, arc, np.nan), ok
-
-    def touches(self, arc, jaw=None, margin: float = 0.0, sure: bool = False) -> np.ndarray:
-        """Whether the jaw can touch at arc positions ``arc`` (mm, unwrapped; nan: no) with the contact
-        at jaw position(s) ``jaw`` (mm; None: at some place on the jaw), within ``margin`` mm (negative:
-        with that much to spare). ``sure`` takes the reach's sure interval (:meth:`Reach.interval`)."""
-        arc = np.asarray(arc, dtype=float)
-        finite = np.isfinite(arc)
-        land = np.mod(np.rint(np.where(finite, arc, 0.0) / self.h).astype(np.int64), self.sigma.size)
-        if jaw is None:
-            return finite & self.touchable[land]
-        lo, hi = (self.lo_sure, self.hi_sure) if sure else (self.lo, self.hi)
-        d = np.asarray(jaw, dtype=float)
-        return finite & (lo[land] - margin < d) & (d < hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
-
-    def roll(self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0,
-             turn_margin: float = 0.0) -> tuple:
-        """:meth:`advance`, and the landing must be touchable.
-
-        ``jaw`` (mm) is the contact's place on the jaw at arc ``at`` (mm, default the grid
-        points): the landing's place is taken as that plus the arc rolled (the contact moves
-        as far along the jaw as along the part, to first order in the step), within
-        ``margin`` mm. Without ``jaw`` the landing must be touchable at some place on the jaw.
-        Returns (arc mm, nan where not; ok).
-        """
-        arc, ok = self.advance(index, turn, turn_margin=turn_margin)
-        if jaw is not None:
-            base = self.sigma[np.asarray(index)] if at is None else np.asarray(at, dtype=float)
-            jaw = np.asarray(jaw, dtype=float) + (arc - base)
-        ok = ok & self.touches(arc, jaw, margin)
-        return np.where(ok, arc, np.nan), ok
-
-
-    def rollable(self, turns, jaw: float, margin: float = 0.0) -> np.ndarray:
-        """Grid points from which the jaw, laid with the contact at ``jaw`` (mm on it), can roll through
-        every net rotation of ``turns`` (rad, in order, one sign) without bridging, with ``margin``
-        mm to spare on the jaw all along (boolean mask over the grid)."""
-        ok = self.convex & self.touches(self.sigma, jaw, -margin, sure=True)
-        for t in np.atleast_1d(np.asarray(turns, dtype=float)):
-            idx = np.flatnonzero(ok)
-            arc, moved = self.advance(idx, float(t))
-            ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin, sure=True)
-        return ok
 
 
 def _bspline(x: float) -> tuple:
@@ -917,107 +711,3 @@ class ContactFilter:
                             start_arc=float(self.grid[k])))
         out.sort(key=lambda m: -m.mass)
         return out
-
-
-class ParticleFilter:
-    """Conventional particle filter over the present contact (the peer baseline).
-
-    Each particle carries the present contact x (mm), the arc P (mm) it has rolled
-    since the first reading, and the first reading's error c (mm), so that the
-    cumulative reading z_j ~ N(P_j + c, sd_position²) can be weighed directly (a
-    filter on the step increments alone would treat the differences of
-    neighbouring readings as independent and lose the total travel). Particles
-    move by each measured rotation step along their convex stretch, with a small
-    random walk, and are resampled systematically when the effective sample
-    size drops below half. It models neither the calibration's scale nor the
-    part's machining error.
-
-    Parameters
-    ----------
-    part : Part
-    particles : int
-        Number of particles.
-    sd_position : float, mm
-        Standard deviation of one reading of the cumulative arc.
-    process : float, mm
-        Standard deviation of the random walk added to each particle per step.
-    radius : float, mm
-    seed : int
-    """
-
-    def __init__(self, part: Part, *, particles: int = 2000, sd_position: float = 0.04, process: float = 0.005,
-                 radius: float = 0.3, seed: int = 0, spacing: float = 0.02):
-        if particles < 2:
-            raise QueryError(f"particles={particles!r} must be at least 2")
-        for name, value in (("sd_position", sd_position), ("radius", radius)):
-            if not (math.isfinite(value) and value > 0):
-                raise QueryError(f"{name}={value!r} mm must be a positive number")
-        if not (math.isfinite(process) and process >= 0):
-            raise QueryError(f"process={process!r} mm must be ≥ 0")
-        self.part = part
-        self.tracks = tracks_for(part, spacing)
-        self.n = int(particles)
-        self.sd_position = float(sd_position)
-        self.process = float(process)
-        self.radius = float(radius)
-        self.rng = np.random.default_rng(seed)
-        self.reset()
-
-    def reset(self) -> None:
-        """Particles drawn uniformly over the stretches the jaw can touch."""
-        convex = np.flatnonzero(self.tracks.convex)
-        pick = self.rng.choice(convex, size=self.n)
-        self.x = self.tracks.sigma[pick] + self.rng.uniform(0, self.tracks.h, size=self.n)
-        self.rolled = np.zeros(self.n)
-        self.offset = self.sd_position * self.rng.standard_normal(self.n)
-        self.w = np.full(self.n, 1.0 / self.n)
-        self._turn = 0.0
-        self.steps = 0
-
-    def _advance(self, x, turn):
-        """Move particles at arc x by a rotation ``turn`` along their convex stretch."""
-        t = self.tracks
-        i = np.minimum(np.rint(np.mod(x, self.part.perimeter) / t.h).astype(int), t.sigma.size - 1)
-        moved, ok = t.roll(i, turn)
-        return moved - t.sigma[i], ok
-
-    def update(self, arc: float, turn: float) -> None:
-        """Take one reading: cumulative signed arc (mm) and net rotation (rad), as ContactFilter."""
-        if not (math.isfinite(arc) and math.isfinite(turn)):
-            raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
-        d_turn = turn - self._turn
-        self._turn = float(turn)
-        step, ok = self._advance(self.x, d_turn)
-        step = np.where(ok, step, 0.0)
-        jitter = self.process * self.rng.standard_normal(self.n)
-        self.x = np.mod(self.x + step + jitter, self.part.perimeter)
-        self.rolled = self.rolled + step + jitter
-        like = np.exp(-0.5 * ((arc - self.rolled - self.offset) / self.sd_position) ** 2) * ok
-        w = self.w * like
-        total = w.sum()
-        self.steps += 1
-        if not total > 0:  # every particle ruled out: keep the prior weights (a known PF failure)
-            return
-        self.w = w / total
-        if 1.0 / np.sum(self.w ** 2) < self.n / 2:
-            u = (self.rng.random() + np.arange(self.n)) / self.n
-            idx = np.minimum(np.searchsorted(np.cumsum(self.w), u), self.n - 1)
-            self.x, self.rolled, self.offset = self.x[idx], self.rolled[idx], self.offset[idx]
-            self.w = np.full(self.n, 1.0 / self.n)
-
-    def estimate(self) -> tuple:
-        """(most probable present contact mm, probability within the radius of it).
-
-        The estimate is the particle with the most weight within ``radius`` around it.
-        """
-        part = self.part
-        order = np.argsort(self.x)
-        xs, ws = self.x[order], self.w[order]
-        # weight within ±radius of every particle, by a cumulative sum over a doubled circle
-        xx = np.concatenate([xs, xs + part.perimeter])
-        cw = np.concatenate([[0.0], np.cumsum(np.concatenate([ws, ws]))])
-        lo = np.searchsorted(xx, xs - self.radius + part.perimeter, side="left")
-        hi = np.searchsorted(xx, xs + self.radius + part.perimeter, side="right")
-        mass = cw[hi] - cw[lo]
-        k = int(np.argmax(mass))
-        return float(xs[k]), float(mass[k])
