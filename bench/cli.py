@@ -1,20 +1,18 @@
-"""The ``rolltouch`` console script: driver's commands plus ``montecarlo`` (which needs bench)."""
+"""The ``montecarlo`` command of ``rolltouch``, added to driver's command line through its registry
+(the entry point ``montecarlo`` of the group ``rolltouch.commands`` in pyproject.toml)."""
 
 from __future__ import annotations
 
-import sys
+from driver.cli import UsageError, add_command
 
-from driver import cli as driver_cli
-
-__all__ = ["main", "build_parser"]
+__all__ = ["register", "montecarlo_command"]
 
 
-def build_parser():
-    parser = driver_cli.build_parser()
-    sub = next(a for a in parser._actions if a.dest == "command")
-    mc = sub.add_parser("montecarlo", help="run a Monte Carlo study of localization success",
-                        description="Run the simulated trials of a study file in parallel, appending each to "
-                                    "DIR/trials.csv as it finishes; write DIR/summary.json and plots.")
+def register(sub) -> None:
+    """Add ``montecarlo`` to the subparsers ``sub``."""
+    mc = add_command(sub, "montecarlo", montecarlo_command, help="run a Monte Carlo study of localization success",
+                     description="Run the simulated trials of a study file in parallel, appending each to "
+                                 "DIR/trials.csv as it finishes; write DIR/summary.json and plots.")
     mc.add_argument("study", help="study file (TOML), e.g. bench/studies/paper.toml")
     mc.add_argument("--out", required=True, metavar="DIR", help="output folder")
     mc.add_argument("--trials", type=int, metavar="N", help="trials per level (overrides the study file)")
@@ -22,31 +20,16 @@ def build_parser():
     mc.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
     mc.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask distributed scheduler")
     mc.add_argument("--resume", action="store_true", help="keep finished trials, run only the missing ones")
-    return parser
+    mc.set_defaults(interrupted="interrupted: finished trials are kept; rerun with --resume")
 
 
-def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if args.command != "montecarlo":
-        return driver_cli.main(argv)
-    from bench.montecarlo import print_summary, run_study
-    from bench.study import StudyError, load_study
+def montecarlo_command(args) -> int:
+    from .montecarlo import print_summary, run_study
+    from .study import load_study
 
-    try:
-        if args.workers is not None and args.workers < 1:
-            raise StudyError(f"--workers {args.workers} must be at least 1")
-        study = load_study(args.study).with_overrides(trials=args.trials, engine=args.engine)
-        summary = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume)
-    except StudyError as exc:
-        print(f"rolltouch: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("\nrolltouch: interrupted: finished trials are kept; rerun with --resume", file=sys.stderr)
-        return 130
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers} must be at least 1")
+    study = load_study(args.study).with_overrides(trials=args.trials, engine=args.engine)
+    summary = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume)
     print_summary(summary)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -67,7 +67,7 @@ def test_columns_of_the_contract(reference):
 def test_resume_after_a_killed_run(tmp_path):
     f = study_file(tmp_path, trials=8)
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "bench.cli", "montecarlo", str(f), "--out", str(out), "--workers", "1"]
+    cmd = [sys.executable, "-m", "driver.cli", "montecarlo", str(f), "--out", str(out), "--workers", "1"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and len(read_trials(out / "trials.csv")) < 3:
@@ -121,7 +121,7 @@ def test_bad_study_files(tmp_path, text, match):
 
 
 def test_cli_reports_bad_study(tmp_path, capsys):
-    from bench.cli import main
+    from driver.cli import main
 
     assert main(["montecarlo", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "o")]) == 2
     assert "cannot read" in capsys.readouterr().err
@@ -143,7 +143,7 @@ def test_shipped_studies_load():
 
 
 def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
-    from bench.cli import main
+    from driver.cli import main
 
     out = tmp_path / "r"
     assert main(["montecarlo", str(ROOT / "bench" / "studies" / "reactive.toml"), "--out", str(out),
@@ -161,7 +161,7 @@ def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
 
 
 def test_grid_method_scores_the_filter_on_the_fixed_readings(tmp_path):
-    from bench.cli import main
+    from driver.cli import main
 
     text = (ROOT / "bench" / "studies" / "filters.toml").read_text()
     text = text.replace("../../parts/", str(ROOT / "parts") + "/").replace("particles = 200000", "particles = 500")

@@ -56,3 +56,31 @@ def test_shipped_parts_load():
         assert part.perimeter > 0
     k = load_part(PARTS / "trefoil.json").curvature(np.linspace(0, 90, 9000))
     assert (np.diff(np.sign(k)) != 0).sum() >= 6  # several inflections
+
+
+def test_the_command_line_is_built_from_its_registry(capsys):
+    from importlib import metadata
+
+    from driver.cli import COMMAND_GROUPS, ENTRY_POINT_GROUP, build_parser
+
+    sub = build_parser()._subparsers._group_actions[0]  # test only: which commands the parser holds
+    names = set(sub.choices)
+    assert {"localize", "locate", "simulate", "emulate", "calibrate", "run"} <= names
+    # bench's command comes through the entry-point group, not by patching driver's parser
+    assert "montecarlo" in {ep.name for ep in metadata.entry_points(group=ENTRY_POINT_GROUP)}
+    assert "montecarlo" in names
+    assert all(name.startswith("driver.cli.") for name in COMMAND_GROUPS)
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0 and capsys.readouterr().out.startswith("rolltouch ")
+
+
+def test_flags_that_do_not_go_together_are_argparse_errors(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "parts/cam.json", "--start", "10", "--out", "x.npz", "--noise", "none"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert "usage: rolltouch simulate" in err and "give the rolls" in err
+    with pytest.raises(SystemExit) as info:
+        main(["simulate", "parts/cam.json", "--start", "10", "--out", "x.npz", "--reactive", "--confidence", "1.5"])
+    assert info.value.code == 2 and "must be between 0 and 1" in capsys.readouterr().err

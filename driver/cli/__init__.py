@@ -1,0 +1,79 @@
+"""The ``rolltouch`` command line, built from a registry of command groups.
+
+Each group is a module with ``register(sub)``, which adds its subcommands to ``sub`` (the
+subparsers of ``rolltouch``) with :func:`add_command`: a parser of its own and the function that
+runs it. driver's groups are :data:`COMMAND_GROUPS`; another package adds its own as an entry
+point of the group :data:`ENTRY_POINT_GROUP` (``bench`` adds ``montecarlo`` so), so that driver
+never imports the packages above it.
+
+Angles are given in degrees on the command line and converted to radians at this edge; lengths
+are in mm. Any error of ours ends the command with one line on stderr and exit status 2; flags
+that do not go together are argparse's own error (usage, status 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from importlib import metadata
+
+from localizer import RolltouchError
+
+from ._options import UsageError, add_command
+
+__all__ = ["main", "build_parser", "add_command", "UsageError", "COMMAND_GROUPS", "ENTRY_POINT_GROUP"]
+
+#: driver's command groups, in the order ``rolltouch --help`` lists them.
+COMMAND_GROUPS = ("driver.cli.offline", "driver.cli.simulated", "driver.cli.rig")
+#: The entry-point group through which other packages add command groups (a ``register(sub)`` each).
+ENTRY_POINT_GROUP = "rolltouch.commands"
+#: What an interrupted command says unless it sets its own (``interrupted`` in its parser's defaults).
+INTERRUPTED = "interrupted: the arm was stopped and the jaw backed off"
+
+
+def _version() -> str:
+    try:
+        return metadata.version("rolltouch")
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed)"
+
+
+def _registrars() -> list:
+    """The ``register`` functions: driver's groups, then the entry points' (by name)."""
+    found = [importlib.import_module(name).register for name in COMMAND_GROUPS]
+    for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+        try:
+            found.append(ep.load())
+        except Exception as exc:   # a broken add-on must not take the rig's commands with it
+            print(f"rolltouch: warning: command group {ep.name!r} ({ep.value}) not loaded: {exc}", file=sys.stderr)
+    return found
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``rolltouch`` parser with every registered command group."""
+    parser = argparse.ArgumentParser(prog="rolltouch", description="Localize a jaw on a known curved part by rolling.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for register in _registrars():
+        register(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Run ``rolltouch`` with ``argv`` (default: the process's); returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.run(args))
+    except UsageError as exc:
+        args.parser.error(str(exc))     # exits with status 2
+    except RolltouchError as exc:
+        print(f"rolltouch: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"\nrolltouch: {getattr(args, 'interrupted', INTERRUPTED)}", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+    return 2

@@ -1,0 +1,80 @@
+"""What the commands share on the command line: argument types, the rig's, the servo's and the reactive
+rolling's options, and the error for flags that do not go together."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from localizer import RolltouchError
+
+__all__ = ["UsageError", "add_command", "positive", "probability", "rig_arguments", "servo_arguments",
+           "reactive_arguments", "servo_option"]
+
+
+class UsageError(RolltouchError, ValueError):
+    """Flags that do not go together; the command line reports it as argparse's own error."""
+
+
+def add_command(sub, name: str, run, **kwargs) -> argparse.ArgumentParser:
+    """Add the subcommand ``name`` to ``sub`` (the subparsers of ``rolltouch``) with ``run(args) -> int``
+    as what it does; ``kwargs`` go to ``add_parser`` (help, description)."""
+    p = sub.add_parser(name, **kwargs)
+    p.set_defaults(run=run, parser=p)
+    return p
+
+
+def probability(text: str) -> float:
+    """A probability strictly between 0 and 1 (argparse type)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0 < value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} must be between 0 and 1")
+    return value
+
+
+def positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a positive number")
+    return value
+
+
+def rig_arguments(p) -> None:
+    """--arm, --daq and --timeout of the commands that talk to a rig."""
+    p.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
+    p.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
+    p.add_argument("--timeout", type=positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
+
+
+def servo_arguments(p) -> None:
+    """--servo-gain and --no-guard: hold the force with the arm's servo after every press."""
+    p.add_argument("--servo-gain", type=positive, metavar="G",
+                   help="after every press, hold Δv1 with the arm's 1 kHz force servo at this gain (N/N) "
+                        "for 0.3 s, refusing a loop that loses the part or rings above 0.05 V (docs/passivity.md); default: no servo")
+    p.add_argument("--no-guard", action="store_true",
+                   help="run that servo without its passivity observer/controller")
+
+
+def reactive_arguments(p) -> None:
+    """--reactive and its options: roll until the belief is sure (driver.reactive)."""
+    p.add_argument("--reactive", action="store_true",
+                   help="instead of fixed rolls, roll step by step until the contact is known within 0.3 mm "
+                        "with --confidence, or --max-rotation is rolled (docs/robustness.md)")
+    p.add_argument("--confidence", type=probability, default=0.95, metavar="P",
+                   help="reactive: probability within 0.3 mm that stops the rolling (default 0.95)")
+    p.add_argument("--max-rotation", type=positive, default=240.0, metavar="DEG",
+                   help="reactive: rotation budget, both directions counted (default 240°)")
+
+
+def servo_option(args) -> dict:
+    if args.servo_gain is None:
+        if args.no_guard:
+            raise UsageError("--no-guard needs --servo-gain: without the servo there is nothing to guard")
+        return {}
+    return {"servo": {"gain": args.servo_gain, "guard": not args.no_guard, "duration": 0.3, "max_std": 0.05}}

@@ -1,0 +1,96 @@
+"""What the commands print and save: the JSON objects of a run and their text form, and the plots."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+from localizer import ContactFilter
+
+from ._options import servo_option
+
+__all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run"]
+
+
+def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> dict:
+    """Run the reactive localization on ``rig``; the JSON object of 'simulate|run --reactive'."""
+    from driver.reactive import localize_reactively
+
+    res = localize_reactively(rig, part, calibration=calibration, filter=ContactFilter(part),
+                              approach_pose=approach_pose, step=math.radians(args.step),
+                              confidence=args.confidence, max_rotation=math.radians(args.max_rotation),
+                              observer=observer, **servo_option(args))
+    b = res.belief
+    doc = {"part": part.name, "method": "reactive", "estimate_arc": b.map_arc, "mass": b.mass,
+           "ambiguous": b.ambiguous, "informative": b.informative, "stopped": res.stopped,
+           "rotation_deg": math.degrees(res.rotation), "steps": res.steps, "reversals": res.reversals,
+           "regrasps": res.regrasps, "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]]}
+    truth = getattr(rig, "truth", None)
+    if truth is not None:
+        true_arc = truth()["contact_arc"]
+        doc["true_arc"] = true_arc
+        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
+    return doc, res
+
+
+def print_reactive(doc) -> None:
+    verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
+    print(f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
+          f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)")
+    print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within 0.3 mm")
+    for m in doc["modes"][1:3]:
+        print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")
+    if doc.get("error_mm") is not None:
+        err = doc["error_mm"]
+        print(f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)")
+
+
+def run_summary(part, trace, loc) -> dict:
+    """The JSON object of 'simulate' and 'locate'."""
+    best = loc.best
+    estimate = best.end_arc if best is not None else None
+    doc = {
+        "part": part.name,
+        "estimates": [{"length": L, "turn": w, "turn_deg": math.degrees(w)} for L, w in loc.rolls],
+        "estimate_arc": estimate,
+        "ambiguous": loc.ambiguous,
+        "candidates": [c.as_dict() for c in loc.candidates],
+    }
+    true_arc = trace.true_arc
+    if math.isfinite(true_arc):
+        doc["true_arc"] = true_arc
+        doc["error_mm"] = None if estimate is None else abs(float(part.arc_offset(estimate, true_arc)))
+    return doc
+
+
+def emit_run(args, doc, part, trace, loc) -> None:
+    """Print a run's result (JSON or text) and draw it if asked: simulate, locate and run alike."""
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        print_run(doc)
+        if "trace" in doc:
+            print(f"trace written to {doc['trace']}")
+    if args.plot:
+        from driver.plotting import plot_run
+
+        plot_run(part, trace, loc, args.plot)
+        if not args.json:
+            print(f"plot written to {args.plot}")
+
+
+def print_run(doc) -> None:
+    for k, e in enumerate(doc["estimates"]):
+        print(f"roll {k + 1}: L = {e['length']:.3f} mm, Ω = {e['turn_deg']:.3f}°")
+    if doc["estimate_arc"] is None:
+        print("no place on the part fits these rolls")
+    else:
+        verdict = "AMBIGUOUS" if doc["ambiguous"] else "localized"
+        print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm "
+              f"(p={doc['candidates'][0]['probability']:.3f})")
+    if "true_arc" in doc:
+        err = doc["error_mm"]
+        print(f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
+              f"({'success' if err is not None and err < 0.3 else 'failure'} at 0.3 mm)")
