@@ -101,7 +101,8 @@ def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int,
                 if hit.size == 0:
                     continue
                 i = int(hit[0])
-                L = brentq(lambda x: float(part.curvature_at_arc(s0 + x)) / k0 - (1 + sgn * d), Ls[i], Ls[i + 1])
+                L = brentq(lambda x, part=part, s0=s0, k0=k0, sgn=sgn, d=d:
+                           float(part.curvature_at_arc(s0 + x)) / k0 - (1 + sgn * d), Ls[i], Ls[i + 1])
                 w = float(part.tangent_angle_at_arc(s0 + L) - part.tangent_angle_at_arc(s0))
                 res = march(part, L, w, step=h, max_iterations=max_iterations, **TIGHT)
                 seg = _nearest(part, res.segments, s0) if res.segments else None
@@ -120,7 +121,7 @@ def theorem_2(n_parts: int, seed: int, h: float = 1e-4):
     """Steps taken against the bound 6τ/h, convex and non-convex."""
     rng = np.random.default_rng(seed)
     rows = []
-    for k in range(n_parts):
+    for _k in range(n_parts):
         for convex in (True, False):
             part = _random_part(rng, convex)
             _, L, w = _query(part, rng)
@@ -189,7 +190,7 @@ def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
     feasible_segments(part, 10.0, 0.1)  # the exact solver's tables, once per part
     t0 = time.perf_counter()
     grid = march_grid(part, h)  # the march's h-grid, once per part and step
-    grid.inflections, grid.negated_turn  # and what it derives from it
+    _ = grid.inflections, grid.negated_turn  # and what it derives from it
     build = time.perf_counter() - t0
     rows = []
     for s0, L, w in qs:

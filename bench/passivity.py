@@ -124,7 +124,7 @@ def _plots(out: Path, wall: dict, servo_traces: dict) -> None:
     for ax in axes[:3]:
         ax.legend(fontsize=7, loc="upper right")
     for ax in axes:
-        for name, t0, t1 in bare.phases[1:]:
+        for _name, t0, _t1 in bare.phases[1:]:
             ax.axvline(t0, color="k", lw=0.5, ls=":")
     fig.suptitle("1-DOF device on a 20 kN/m wall: passivity controller variants")
     fig.tight_layout()

@@ -43,7 +43,7 @@ class FilterRecorder(ContactFilter):
     keyword args), the outermost only (``regrasp`` calls ``update`` itself). The latest instance
     is :attr:`last`."""
 
-    last: ClassVar["FilterRecorder | None"] = None
+    last: ClassVar[FilterRecorder | None] = None
 
     def __init__(self, *args, **kwargs):
         self.calls: list = []

@@ -110,7 +110,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
         part = load_part(PARTS_DIR / name)
         cal = calibration_for(part, noise, seed, engine)
         rows = []
-        for k in range(trials):
+        for _k in range(trials):
             start = float(rng.uniform(0, part.perimeter))
             rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=engine)
             try:

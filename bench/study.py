@@ -170,7 +170,7 @@ class Study:
             noise = replace(noise, **{self.parameter: self.values[level]})
         return noise
 
-    def with_overrides(self, *, trials=None, engine=None) -> "Study":
+    def with_overrides(self, *, trials=None, engine=None) -> Study:
         s = self
         if trials is not None:
             if int(trials) < 1:
@@ -399,7 +399,7 @@ def run_trial(spec: TrialSpec) -> dict:
         if candidates.size == 0:
             raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")
         run = None
-        for restarts in range(20):
+        for restarts in range(20):  # noqa: B007 (the count is reported after the loop)
             start = float(part.wrap_arc(tracks.sigma[int(rng.choice(candidates))]
                                         + rng.uniform(-0.5, 0.5) * tracks.h))
             rig_seed = int(rng.integers(1 << 31))

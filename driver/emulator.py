@@ -6,6 +6,7 @@ pseudo-terminals, one thread per device, with injectable faults.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import socket
@@ -46,7 +47,7 @@ class Faults:
     saturate: float | None = None
 
     @classmethod
-    def parse(cls, specs) -> "Faults":
+    def parse(cls, specs) -> Faults:
         """From strings ``name=value`` (``drop``, ``garble``, ``delay``, ``disconnect-after``, ``saturate``)."""
         kwargs = {}
         names = {"drop": float, "garble": float, "delay": float, "disconnect-after": int, "saturate": float}
@@ -215,7 +216,7 @@ class Emulator:
         while not self.stopped.is_set():
             try:
                 conn, _ = srv.accept()
-            except socket.timeout:
+            except TimeoutError:
                 continue
             except OSError:
                 return
@@ -223,10 +224,8 @@ class Emulator:
             self._closers.append(conn.close)
 
             def shutdown(c=conn):
-                try:
+                with contextlib.suppress(OSError):
                     c.shutdown(socket.SHUT_RDWR)
-                except OSError:
-                    pass
             self._closers.append(shutdown)
             threading.Thread(target=self._serve, args=(device, lambda c=conn: c.recv(4096), conn.sendall),
                              daemon=True).start()
@@ -250,8 +249,6 @@ class Emulator:
         """Stop serving and close every connection (a pulled cable)."""
         self.stopped.set()
         for c in reversed(self._closers):
-            try:
+            with contextlib.suppress(OSError):
                 c()
-            except OSError:
-                pass
         self._closers.clear()

@@ -232,7 +232,7 @@ class Calibration:
                                           "target": self.target}, indent=2) + "\n")
 
     @classmethod
-    def load(cls, path) -> "Calibration":
+    def load(cls, path) -> Calibration:
         """Read a calibration written by :meth:`save`."""
         try:
             data = json.loads(Path(path).read_text())

@@ -57,7 +57,8 @@ class RunLog:
     def __init__(self, path, header: dict):
         self.path = str(path)
         try:
-            self._f = open(self.path, "w", encoding="utf-8")
+            # open for the run's whole length, closed by close() (on success and on every failure)
+            self._f = open(self.path, "w", encoding="utf-8")  # noqa: SIM115
         except OSError as exc:
             raise RigError(f"cannot write the run log {self.path}: {exc.strerror or exc}") from None
         self({"event": "start", "format": LOG_FORMAT, **header})

@@ -10,6 +10,7 @@ manager to get it on any error.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass
@@ -191,10 +192,8 @@ class SerialRig:
     def safe_stop(self) -> None:
         """Best effort: stop the arm and back the jaw ``backoff`` mm off the part. Never raises."""
         for action in (self.stop, self._back_off):
-            try:
+            with contextlib.suppress(RigError, OSError, serial.SerialException):
                 action()
-            except (RigError, OSError, serial.SerialException):
-                pass
         self._emit({"event": "safe_stop"})
 
     def _back_off(self):
@@ -206,10 +205,8 @@ class SerialRig:
 
     def close(self) -> None:
         for port in self.ports.values():
-            try:
+            with contextlib.suppress(OSError, serial.SerialException):
                 port.close()
-            except (OSError, serial.SerialException):
-                pass
 
     def __enter__(self):
         return self

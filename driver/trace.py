@@ -45,7 +45,7 @@ class Trace:
     metadata: dict
 
     @classmethod
-    def from_run(cls, run: RollingRun, calibration: Calibration, **metadata) -> "Trace":
+    def from_run(cls, run: RollingRun, calibration: Calibration, **metadata) -> Trace:
         """Collect the readings of a :class:`RollingRun` with ``metadata`` about how it was made."""
         rows = []
         for k, r in enumerate(run.rolls):
@@ -71,7 +71,7 @@ class Trace:
         np.savez(path, metadata=np.array(json.dumps(self.metadata)), **self.columns)
 
     @classmethod
-    def from_log(cls, path) -> "Trace":
+    def from_log(cls, path) -> Trace:
         """A trace from a run log (JSON Lines, :mod:`driver.runlog`), cut short or not.
 
         Rolls that the log shows begun but without two readings are dropped.
@@ -105,7 +105,7 @@ class Trace:
         return cls(columns, meta)
 
     @classmethod
-    def load(cls, path) -> "Trace":
+    def load(cls, path) -> Trace:
         """Read a trace written by :meth:`save`, or a run log (``.jsonl``).
 
         Raises

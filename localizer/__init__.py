@@ -1,17 +1,17 @@
 """Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
 
-from ._errors import LocalizerError, PartError, QueryError, RolltouchError
-from ._part import UNITS_TO_MM, Part, load_part, part_from_points
 from ._belief import Belief, Mode
-from ._tracks import ModeTracks, tracks_for
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, ContactFilter
+from ._disambiguate import RULES, Candidate, Localization, localize
+from ._errors import LocalizerError, PartError, QueryError, RolltouchError
+from ._march import MarchGrid, MarchResult, march, march_grid
+from ._part import UNITS_TO_MM, Part, load_part, part_from_points
 from ._particle_filter import ParticleFilter
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
-from ._march import MarchGrid, MarchResult, march, march_grid
-from ._disambiguate import RULES, Candidate, Localization, localize
 from ._segment import DIRECTIONS, Segment
 from ._solver import METHODS, feasible_segments
+from ._tracks import ModeTracks, tracks_for
 
 __all__ = ["ContactFilter", "ParticleFilter", "Belief", "Mode", "ModeTracks", "tracks_for",
            "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "RolltouchError", "LocalizerError", "PartError", "QueryError", "Part", "load_part", "part_from_points", "UNITS_TO_MM",

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from collections import OrderedDict
-from typing import Callable, TypeVar
+from collections.abc import Callable
+from typing import TypeVar
 
 T = TypeVar("T")
 
 __all__ = ["per_part"]
 
-_ENTRIES: "OrderedDict[tuple, object]" = OrderedDict()
+_ENTRIES: OrderedDict[tuple, object] = OrderedDict()
 _SIZE = 16
 
 

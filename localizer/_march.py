@@ -150,7 +150,7 @@ def march_grid(part: Part, h: float) -> MarchGrid:
         return cached
     n = part.n_knots
     M = int(round(n / h))
-    if M < 4 * n or abs(M * h - n) > 1e-9 * n:
+    if 4 * n > M or abs(M * h - n) > 1e-9 * n:
         raise QueryError(f"step={h!r} must divide the parameter period {n} into at least {4 * n} cells")
     length = np.empty(M + 1)
     turn = np.empty(M + 1)
@@ -313,7 +313,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
             case_a = psi < target  # the first u with Φ(s, u) = Ω lies beyond tL: ℓ(s, u) > L
             t = tL
             converged = False
-            for it in range(1, max_iterations + 1):
+            for _it in range(1, max_iterations + 1):
                 if case_a:
                     # t_i: Φ(s_i, t_i) = Ω (t increases), s_{i+1}: ℓ(s_{i+1}, t_i) = L
                     base = grid._value(cum_turn, s)
@@ -368,7 +368,7 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
             return
         lo, hi = sa, sb
         iterates = []
-        for it in range(200):
+        for _it in range(200):
             mid = 0.5 * (lo + hi)
             tm = end_of(mid)
             at(s=mid, t=tm)

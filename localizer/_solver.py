@@ -35,10 +35,10 @@ from dataclasses import replace
 import numpy as np
 
 from ._errors import QueryError
-from ._part import Part, _TWO_PI
+from ._march import march
+from ._part import _TWO_PI, Part
 from ._segment import DIRECTIONS, KINDS, Segment
 from ._table import ArcTable, arc_table
-from ._march import march
 
 __all__ = ["feasible_segments", "METHODS"]
 
@@ -211,10 +211,7 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
         K = np.concatenate([K, K])
 
     zeros = np.concatenate(exact_zero)
-    if brackets:
-        brackets = tuple(np.concatenate([x[i] for x in brackets]) for i in range(7))
-    else:
-        brackets = None
+    brackets = tuple(np.concatenate([x[i] for x in brackets]) for i in range(7)) if brackets else None
     doubles = np.concatenate(doubles) if doubles else np.empty(0)
     continua = _merge_flats(np.concatenate(flats) if flats else np.empty((0, 2)), P)
     return zeros, brackets, doubles, continua

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._part import Part, _TWO_PI, _curvature, _wrap
+from ._part import _TWO_PI, Part, _curvature, _wrap
 from ._poly import bernstein_bounds, horner
 
 __all__ = ["ArcTable", "arc_table"]

@@ -14,7 +14,7 @@ from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 __all__ = ["ModeTracks", "tracks_for"]
 
 
-def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> "ModeTracks":
+def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> ModeTracks:
     """The part's :class:`ModeTracks` at ``spacing`` mm for ``jaw``, built once per part, spacing and jaw.
 
     Building them takes most of a second (the dense sample, the jaw's reach, the banded

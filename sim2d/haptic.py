@@ -31,8 +31,8 @@ page, so none of its numbers are known here):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 

@@ -73,7 +73,7 @@ class NoiseModel:
         if self.machining_wavelength <= 0:
             raise SimError(f"noise model: machining_wavelength={self.machining_wavelength!r} must be > 0")
 
-    def scaled(self, **factors) -> "NoiseModel":
+    def scaled(self, **factors) -> NoiseModel:
         """A copy with some fields multiplied, e.g. ``scaled(v2_noise=2.0)``."""
         for k in factors:
             if k not in self.__dataclass_fields__:

@@ -79,9 +79,8 @@ def test_serial_servo_rejects_bad_arguments():
     emu = Emulator(pressed_rig())
     arm, daq = emu.serve_tcp(0)
     try:
-        with SerialRig(arm, daq) as serial_rig:
-            with pytest.raises(RigError, match="refused SERVO"):
-                serial_rig.servo(0.4, -1.0)
+        with SerialRig(arm, daq) as serial_rig, pytest.raises(RigError, match="refused SERVO"):
+            serial_rig.servo(0.4, -1.0)
     finally:
         emu.close()
 

@@ -6,8 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.procedures import (Calibration, Hand, _delta, calibrate, establish_contact, localize_by_rolling,
-                               press, roll)
+from driver.procedures import Calibration, Hand, _delta, calibrate, establish_contact, localize_by_rolling, press, roll
 from driver.rig import Rig, RigError
 from localizer import load_part
 from sim2d import NoiseModel, SimRig

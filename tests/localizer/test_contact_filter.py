@@ -6,8 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import (BRIDGE_MISS, CONTRADICTION, ContactFilter, QueryError, load_part,
-                       part_from_points)
+from localizer import BRIDGE_MISS, CONTRADICTION, ContactFilter, QueryError, load_part, part_from_points
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 STEP = math.radians(0.2)

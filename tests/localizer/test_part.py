@@ -160,7 +160,7 @@ def test_bad_files(tmp_path):
 
 def test_part_is_immutable():
     part = trefoil()
-    with pytest.raises(Exception):
+    with pytest.raises(AttributeError):
         part.perimeter = 1.0
     with pytest.raises(ValueError):
         part.points[0, 0] = 1.0

@@ -158,12 +158,14 @@ def test_near_double_roots_are_found_not_skipped(offset):
 
     part = trefoil()
     L = 20.0
-    dg = lambda s: float(part.curvature_at_arc(s + L) - part.curvature_at_arc(s))
+    def dg(s):
+        return float(part.curvature_at_arc(s + L) - part.curvature_at_arc(s))
     grid = np.linspace(0, part.perimeter, 2000, endpoint=False)
     vals = np.array([dg(s) for s in grid])
     i = int(np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0])
     s_star = brentq(dg, grid[i], grid[i + 1], xtol=1e-13)
-    phi = lambda s: float(part.tangent_angle_at_arc(s + L) - part.tangent_angle_at_arc(s))
+    def phi(s):
+        return float(part.tangent_angle_at_arc(s + L) - part.tangent_angle_at_arc(s))
     # step towards the inside of the extremum so that two roots exist for offset > 0
     curvature_sign = np.sign(phi(s_star + 0.01) + phi(s_star - 0.01) - 2 * phi(s_star))
     w = phi(s_star) + curvature_sign * offset

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from localizer import load_part
-from sim2d.machining import machined_part, machining_slope
 from sim2d import SimError
+from sim2d.machining import machined_part, machining_slope
 from sim2d.noise import PRESETS, NoiseModel, load_noise
 from sim2d.wrist import Wrist, encoder_angle
 

@@ -1,4 +1,5 @@
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -7,8 +8,6 @@ from localizer import load_part
 from sim2d import SimError
 from sim2d.quasistatic import QuasiStaticWorld
 from sim2d.rig import SimRig
-
-from pathlib import Path
 
 PARTS = str(Path(__file__).resolve().parents[2] / "parts") + "/"
 
