@@ -10,9 +10,14 @@ __all__ = ["register", "montecarlo_command"]
 
 def register(sub) -> None:
     """Add ``montecarlo`` to the subparsers ``sub``."""
-    mc = add_command(sub, "montecarlo", montecarlo_command, help="run a Monte Carlo study of localization success",
-                     description="Run the simulated trials of a study file in parallel, appending each to "
-                                 "DIR/trials.csv as it finishes; write DIR/summary.json and plots.")
+    mc = add_command(
+        sub,
+        "montecarlo",
+        montecarlo_command,
+        help="run a Monte Carlo study of localization success",
+        description="Run the simulated trials of a study file in parallel, appending each to "
+        "DIR/trials.csv as it finishes; write DIR/summary.json and plots.",
+    )
     mc.add_argument("study", help="study file (TOML), e.g. bench/studies/paper.toml")
     mc.add_argument("--out", required=True, metavar="DIR", help="output folder")
     mc.add_argument("--trials", type=int, metavar="N", help="trials per level (overrides the study file)")

@@ -36,15 +36,22 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="docs/robustness/budget")
     ap.add_argument("--trials", type=int, default=150)
     ap.add_argument("--workers", type=int, default=None)
-    ap.add_argument("--mode", choices=("without", "only"), default="without",
-                    help="remove one group at a time, or keep only one group")
+    ap.add_argument(
+        "--mode",
+        choices=("without", "only"),
+        default="without",
+        help="remove one group at a time, or keep only one group",
+    )
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     base = load_study(Path(__file__).parent / "studies" / "paper.toml").with_overrides(trials=args.trials)
     paper = PRESETS["paper"]
     every = [n for names in GROUPS.values() for n in names]
-    configs = {"paper (all sources)": {}, "none": {f.name: 0.0 for f in fields(paper) if f.name != "machining_wavelength"}}
+    configs = {
+        "paper (all sources)": {},
+        "none": {f.name: 0.0 for f in fields(paper) if f.name != "machining_wavelength"},
+    }
     if args.mode == "without":
         for label, names in GROUPS.items():
             configs[f"without {label}"] = {n: 0.0 for n in names}
@@ -63,11 +70,20 @@ def main(argv=None) -> int:
             print(f"{label} ...", file=sys.stderr, flush=True)
             s = run_study(study, out / f"config{k}", workers=args.workers, progress=False)
             lv = s["levels"][0]
-            results[label] = {"zeroed": sorted(zeroed), "trials": lv["trials"], "success": lv["success"],
-                              "success_rate": lv["success_rate"], "ci95": list(wilson(lv["success"], lv["trials"])),
-                              "error_median_mm": lv["error_median_mm"]}
-            print(f"  {lv['success']}/{lv['trials']} = {lv['success_rate']:.1%}, median error "
-                  f"{lv['error_median_mm']:.3f} mm", file=sys.stderr, flush=True)
+            results[label] = {
+                "zeroed": sorted(zeroed),
+                "trials": lv["trials"],
+                "success": lv["success"],
+                "success_rate": lv["success_rate"],
+                "ci95": list(wilson(lv["success"], lv["trials"])),
+                "error_median_mm": lv["error_median_mm"],
+            }
+            print(
+                f"  {lv['success']}/{lv['trials']} = {lv['success_rate']:.1%}, median error "
+                f"{lv['error_median_mm']:.3f} mm",
+                file=sys.stderr,
+                flush=True,
+            )
     (out / "summary.json").write_text(json.dumps(results, indent=2) + "\n")
     _plot(results, out / "budget.png", base.trials)
     print(json.dumps(results, indent=2))

@@ -81,8 +81,11 @@ def _superellipse(rng) -> tuple:
     a = np.linspace(0.0, 2 * np.pi, 2000, endpoint=False)
     r = (np.abs(np.cos(a) / ax) ** p + np.abs(np.sin(a) / by) ** p) ** (-1.0 / p)
     # odd harmonics break the two mirror symmetries and the central one
-    r = r * (1.0 + rng.uniform(0.02, 0.05) * np.cos(a + rng.uniform(0, 2 * np.pi))
-             + rng.uniform(0.01, 0.03) * np.cos(3 * a + rng.uniform(0, 2 * np.pi)))
+    r = r * (
+        1.0
+        + rng.uniform(0.02, 0.05) * np.cos(a + rng.uniform(0, 2 * np.pi))
+        + rng.uniform(0.01, 0.03) * np.cos(3 * a + rng.uniform(0, 2 * np.pi))
+    )
     n = int(rng.integers(36, 91))
     pts = _resample(np.r_[np.c_[r * np.cos(a), r * np.sin(a)], [[r[0], 0.0]]], n)
     return pts, f"superellipse p={p:.2f}, {2 * ax:.0f} x {2 * by:.0f} mm, perturbed, {n} points"
@@ -105,7 +108,7 @@ def _glyph(rng) -> tuple:
         outer = np.r_[outer, outer[:1]]
     n = int(rng.integers(36, 91))
     start = int(rng.integers(len(outer) - 1))
-    outer = np.r_[outer[start:-1], outer[:start + 1]]
+    outer = np.r_[outer[start:-1], outer[: start + 1]]
     pts = _resample(outer, n)
     return pts - pts.mean(axis=0), f"glyph {ch!r} (DejaVu Sans) at {height:.0f} mm, {n} points"
 
@@ -116,7 +119,7 @@ def _filleted(rng) -> tuple:
     while np.min(np.diff(np.r_[ang, ang[0] + 2 * np.pi])) < 0.5:
         ang = np.sort(rng.uniform(0, 2 * np.pi, corners))
     rad = rng.uniform(45.0, 90.0, corners)
-    if rng.random() < 0.5:                   # one corner pushed in: a non-convex polygon
+    if rng.random() < 0.5:  # one corner pushed in: a non-convex polygon
         rad[int(rng.integers(corners))] *= 0.45
     v = np.c_[rad * np.cos(ang), rad * np.sin(ang)]
     fillet = rng.uniform(3.0, 10.0, corners)

@@ -69,19 +69,25 @@ def proposition_1(n_parts: int, seed: int, h: float = 1e-4, max_iterations: int 
             for seg in res.segments:
                 e = _nearest(part, exact, seg.start_arc)
                 ks, kt = float(part.curvature(e.start_param)), float(part.curvature(e.end_param))
-                rows.append({
-                    "part": k, "length": L, "turn": w, "start_arc": e.start_arc,
-                    "predicted": min(ks / kt, kt / ks), "measured": measured_ratio(part, seg, e.start_arc),
-                    "iterations": seg.iterations, "kind": seg.kind,
-                    "error": abs(float(part.arc_offset(seg.start_arc, e.start_arc))),
-                })
+                rows.append(
+                    {
+                        "part": k,
+                        "length": L,
+                        "turn": w,
+                        "start_arc": e.start_arc,
+                        "predicted": min(ks / kt, kt / ks),
+                        "measured": measured_ratio(part, seg, e.start_arc),
+                        "iterations": seg.iterations,
+                        "kind": seg.kind,
+                        "error": abs(float(part.arc_offset(seg.start_arc, e.start_arc))),
+                    }
+                )
         _log(f"  proposition 1: part {k + 1}/{n_parts}, {len(rows)} segments")
     rows += near_equal_curvature(max(2, n_parts // 5), seed + 1, h, max_iterations)
     return rows
 
 
-def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int,
-                         deltas=(3e-2, 1e-2, 3e-3, 1e-3, 3e-4)):
+def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int, deltas=(3e-2, 1e-2, 3e-3, 1e-3, 3e-4)):
     """Instances made to have κ(t*)/κ(s*) = 1 + δ: the ratio of Proposition 1 close to 1."""
     from scipy.optimize import brentq
 
@@ -101,17 +107,31 @@ def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int,
                 if hit.size == 0:
                     continue
                 i = int(hit[0])
-                L = brentq(lambda x, part=part, s0=s0, k0=k0, sgn=sgn, d=d:
-                           float(part.curvature_at_arc(s0 + x)) / k0 - (1 + sgn * d), Ls[i], Ls[i + 1])
+                L = brentq(
+                    lambda x, part=part, s0=s0, k0=k0, sgn=sgn, d=d: (
+                        float(part.curvature_at_arc(s0 + x)) / k0 - (1 + sgn * d)
+                    ),
+                    Ls[i],
+                    Ls[i + 1],
+                )
                 w = float(part.tangent_angle_at_arc(s0 + L) - part.tangent_angle_at_arc(s0))
                 res = march(part, L, w, step=h, max_iterations=max_iterations, **TIGHT)
                 seg = _nearest(part, res.segments, s0) if res.segments else None
                 if seg is None or abs(part.arc_offset(seg.start_arc, s0)) > 1.0:
                     continue
-                rows.append({"part": f"near-equal {k}", "length": L, "turn": w, "start_arc": s0,
-                             "predicted": min(1 + sgn * d, 1 / (1 + sgn * d)),
-                             "measured": measured_ratio(part, seg, s0), "iterations": seg.iterations,
-                             "kind": seg.kind, "error": abs(float(part.arc_offset(seg.start_arc, s0)))})
+                rows.append(
+                    {
+                        "part": f"near-equal {k}",
+                        "length": L,
+                        "turn": w,
+                        "start_arc": s0,
+                        "predicted": min(1 + sgn * d, 1 / (1 + sgn * d)),
+                        "measured": measured_ratio(part, seg, s0),
+                        "iterations": seg.iterations,
+                        "kind": seg.kind,
+                        "error": abs(float(part.arc_offset(seg.start_arc, s0))),
+                    }
+                )
                 break
         _log(f"  proposition 1, κ(s*) ≈ κ(t*): part {k + 1}/{n_parts}")
     return rows
@@ -126,8 +146,15 @@ def theorem_2(n_parts: int, seed: int, h: float = 1e-4):
             part = _random_part(rng, convex)
             _, L, w = _query(part, rng)
             res = march(part, L, w, step=h, **PAPER)
-            rows.append({"convex": convex, "steps": res.steps, "grid_cells": res.grid_cells,
-                         "steps_per_period": res.steps / res.grid_cells, "segments": len(res.segments)})
+            rows.append(
+                {
+                    "convex": convex,
+                    "steps": res.steps,
+                    "grid_cells": res.grid_cells,
+                    "steps_per_period": res.steps / res.grid_cells,
+                    "segments": len(res.segments),
+                }
+            )
     return rows
 
 
@@ -145,8 +172,15 @@ def cost_against_step(steps=(1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, 
         t0 = time.perf_counter()
         nsteps = [march(part, L, w, step=h, **PAPER).steps for _, L, w in qs]
         per_query = (time.perf_counter() - t0) / n_queries
-        rows.append({"h": h, "build_s": build, "march_s": per_query, "steps": float(np.mean(nsteps)),
-                     "grid_cells": int(round(part.n_knots / h))})
+        rows.append(
+            {
+                "h": h,
+                "build_s": build,
+                "march_s": per_query,
+                "steps": float(np.mean(nsteps)),
+                "grid_cells": int(round(part.n_knots / h)),
+            }
+        )
         _log(f"  cost: h={h:g} build {build:.3f} s, march {per_query:.3f} s/query")
     return rows
 
@@ -168,11 +202,19 @@ def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int
                     allowed = 2 * PAPER["turn_tol"] / max(slope, 1e-12) + 2 * PAPER["length_tol"] + 0.01
                     d = min((abs(float(part.arc_offset(m.start_arc, e.start_arc))) for m in marched), default=np.inf)
                     if d > allowed:
-                        missed.append({"start_arc": e.start_arc, "distance": d, "allowed": allowed,
-                                       "slope": slope})
-                rows.append({"convex": convex, "part": k, "points": part.points.tolist(), "length": L,
-                             "turn": w, "exact": [e.start_arc for e in exact],
-                             "march": [m.start_arc for m in marched], "missed": missed})
+                        missed.append({"start_arc": e.start_arc, "distance": d, "allowed": allowed, "slope": slope})
+                rows.append(
+                    {
+                        "convex": convex,
+                        "part": k,
+                        "points": part.points.tolist(),
+                        "length": L,
+                        "turn": w,
+                        "exact": [e.start_arc for e in exact],
+                        "march": [m.start_arc for m in marched],
+                        "missed": missed,
+                    }
+                )
             part.__dict__.pop("_march_grid", None)  # free the h-grid (72 MB per million cells)
             _log(f"  completeness: {'convex' if convex else 'non-convex'} part {k + 1}/{n_parts}")
     return rows
@@ -201,12 +243,19 @@ def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
         res = march(part, L, w, step=h, **PAPER)
         t_march = time.perf_counter() - t0
         ma = res.segments
-        rows.append({
-            "length": L, "turn": w, "exact_s": t_exact, "march_s": t_march, "steps": res.steps,
-            "exact_error": abs(float(part.arc_offset(_nearest(part, ex, s0).start_arc, s0))),
-            "march_error": abs(float(part.arc_offset(_nearest(part, ma, s0).start_arc, s0))),
-            "segments_exact": len(ex), "segments_march": len(ma),
-        })
+        rows.append(
+            {
+                "length": L,
+                "turn": w,
+                "exact_s": t_exact,
+                "march_s": t_march,
+                "steps": res.steps,
+                "exact_error": abs(float(part.arc_offset(_nearest(part, ex, s0).start_arc, s0))),
+                "march_error": abs(float(part.arc_offset(_nearest(part, ma, s0).start_arc, s0))),
+                "segments_exact": len(ex),
+                "segments_march": len(ma),
+            }
+        )
     t0 = time.perf_counter()
     trapezoid_perimeter(part, h)
     integration = time.perf_counter() - t0
@@ -294,8 +343,14 @@ def _plots(out: Path, prop1, thm2, cost, compl, versus):
             for k, m in enumerate(r["march"]):
                 ax.plot(*part.point_at_arc(m), "x", color="tab:orange", ms=7, label="march" if k == 0 else None)
             for k, miss in enumerate(r["missed"]):
-                ax.plot(*part.point_at_arc(miss["start_arc"]), "o", mfc="none", mec="tab:red", ms=14,
-                        label="missed" if k == 0 else None)
+                ax.plot(
+                    *part.point_at_arc(miss["start_arc"]),
+                    "o",
+                    mfc="none",
+                    mec="tab:red",
+                    ms=14,
+                    label="missed" if k == 0 else None,
+                )
             miss = r["missed"][0]["start_arc"]
             zoom = ax.inset_axes([0.58, 0.58, 0.4, 0.4])
             arcs = miss + np.linspace(-3, 3, 200)
@@ -311,8 +366,10 @@ def _plots(out: Path, prop1, thm2, cost, compl, versus):
             zoom.set_xticks([])
             zoom.set_yticks([])
             zoom.text(0.03, 0.04, "±3 mm", transform=zoom.transAxes, fontsize=7)
-            ax.set_title(f"{'convex' if r['convex'] else 'non-convex'}, L={r['length']:.1f} mm, "
-                         f"Ω={np.degrees(r['turn']):.1f}°", fontsize=8)
+            ax.set_title(
+                f"{'convex' if r['convex'] else 'non-convex'}, L={r['length']:.1f} mm, Ω={np.degrees(r['turn']):.1f}°",
+                fontsize=8,
+            )
             ax.set_aspect("equal")
             ax.legend(fontsize=7, loc="lower left")
         fig.tight_layout()
@@ -324,7 +381,9 @@ def _plots(out: Path, prop1, thm2, cost, compl, versus):
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
     idx = np.arange(len(rows))
     a1.semilogy(idx, [r["exact_s"] for r in rows], "o", label="exact solver")
-    a1.semilogy(idx, [r["march_paper_cost_s"] for r in rows], "s", label=f"march, h={versus['h']:g}: steps × cost of a step")
+    a1.semilogy(
+        idx, [r["march_paper_cost_s"] for r in rows], "s", label=f"march, h={versus['h']:g}: steps × cost of a step"
+    )
     a1.semilogy(idx, [r["march_s"] for r in rows], "^", label="march on the precomputed h-grid (grid not counted)")
     a1.axhline(versus["integration_s"], color="0.5", lw=1, ls="--", label="one perimeter integration")
     a1.set_xlabel("query")
@@ -351,34 +410,42 @@ def summarize(prop1, thm2, cost, compl, versus):
     for convex in (True, False):
         sel = [r for r in compl if r["convex"] == convex]
         by["convex" if convex else "non_convex"] = {
-            "instances": len(sel), "complete": sum(not r["missed"] for r in sel),
+            "instances": len(sel),
+            "complete": sum(not r["missed"] for r in sel),
             "fraction": sum(not r["missed"] for r in sel) / max(len(sel), 1),
             "exact_segments": sum(len(r["exact"]) for r in sel),
-            "missed_segments": sum(len(r["missed"]) for r in sel)}
+            "missed_segments": sum(len(r["missed"]) for r in sel),
+        }
     inv_h = np.log([1 / c["h"] for c in cost])
-    slopes = {key: float(np.polyfit(inv_h, np.log([c[key] for c in cost]), 1)[0])
-              for key in ("steps", "build_s", "march_s")}
+    slopes = {
+        key: float(np.polyfit(inv_h, np.log([c[key] for c in cost]), 1)[0]) for key in ("steps", "build_s", "march_s")
+    }
     return {
         "proposition_1": {
-            "segments": len(prop1), "with_measured_ratio": len(ok),
+            "segments": len(prop1),
+            "with_measured_ratio": len(ok),
             "abs_dev_median": float(np.median(dev)) if dev.size else None,
             "abs_dev_max": float(dev.max()) if dev.size else None,
             "stalled": sum(r["kind"] == "stalled" for r in prop1),
             "stalled_predicted_min": min((r["predicted"] for r in prop1 if r["kind"] == "stalled"), default=None),
         },
         "theorem_2": {
-            "instances": len(thm2), "max_steps_per_period": max(r["steps_per_period"] for r in thm2),
-            "median_steps_per_period": float(np.median([r["steps_per_period"] for r in thm2])), "bound": 6,
+            "instances": len(thm2),
+            "max_steps_per_period": max(r["steps_per_period"] for r in thm2),
+            "median_steps_per_period": float(np.median([r["steps_per_period"] for r in thm2])),
+            "bound": 6,
         },
         "cost_against_h": {"rows": cost, "loglog_slope_vs_1_over_h": slopes},
         "completeness": by,
         "exact_vs_march": {
-            "h": versus["h"], "queries": len(rows),
+            "h": versus["h"],
+            "queries": len(rows),
             "exact_s_median": float(np.median([r["exact_s"] for r in rows])),
             "march_s_median": float(np.median([r["march_s"] for r in rows])),
             "march_paper_cost_s_median": float(np.median([r["march_paper_cost_s"] for r in rows])),
             "march_steps_median": float(np.median([r["steps"] for r in rows])),
-            "march_grid_build_s": versus["march_grid_build_s"], "integration_s": versus["integration_s"],
+            "march_grid_build_s": versus["march_grid_build_s"],
+            "integration_s": versus["integration_s"],
             "exact_error_max": float(max(r["exact_error"] for r in rows)),
             "march_error_median": float(np.median([r["march_error"] for r in rows])),
             "march_error_max": float(max(r["march_error"] for r in rows)),
@@ -407,8 +474,9 @@ def main(argv=None) -> int:
     versus = exact_vs_march(h=1e-4 if q else 1e-5, n_queries=4 if q else 10)
     summary = summarize(prop1, thm2, cost, compl, versus)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    (out / "completeness.json").write_text(json.dumps(
-        [{k: v for k, v in r.items() if k != "points"} for r in compl], indent=1) + "\n")
+    (out / "completeness.json").write_text(
+        json.dumps([{k: v for k, v in r.items() if k != "points"} for r in compl], indent=1) + "\n"
+    )
     _plots(out, prop1, thm2, cost, compl, versus)
     print(json.dumps(summary, indent=2))
     return 0

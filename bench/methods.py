@@ -48,14 +48,19 @@ def fixed_readings(rolls, part) -> dict:
     for r in rolls:
         sign = 1.0 if r.step > 0 else -1.0
         for i in range(1, len(r.positions)):
-            a = sign * arc_from_jaw_positions(r.positions[i - 1:i + 1], r.step, r.offset)
+            a = sign * arc_from_jaw_positions(r.positions[i - 1 : i + 1], r.step, r.offset)
             steps.append(a)
             z.append(z[-1] + a)
             turns.append(r.angles[i] - phi0)
             truth.append(r.truth[i][0])
             jaw.append(r.positions[i])
-    return {"z": np.array(z), "turn": np.array(turns), "truth": np.array(truth), "steps": np.array(steps),
-            "jaw": np.array(jaw)}
+    return {
+        "z": np.array(z),
+        "turn": np.array(turns),
+        "truth": np.array(truth),
+        "steps": np.array(steps),
+        "jaw": np.array(jaw),
+    }
 
 
 def _err(part, est, truth) -> float:
@@ -85,9 +90,14 @@ def _localize(study, part, rolls, rule: str, cache: dict):
 
     if rule not in cache:
         try:
-            cache[rule] = localize(part, [(r.length, r.turn) for r in rolls], rule=rule,
-                                   direction="ccw" if rolls[0].step > 0 else "cw", sd_length=study.sd_length,
-                                   sd_turn=math.radians(study.sd_turn_deg))
+            cache[rule] = localize(
+                part,
+                [(r.length, r.turn) for r in rolls],
+                rule=rule,
+                direction="ccw" if rolls[0].step > 0 else "cw",
+                sd_length=study.sd_length,
+                sd_turn=math.radians(study.sd_turn_deg),
+            )
         except Exception as exc:  # noqa: BLE001 - the rule's failure is its result
             cache[rule] = exc
     return cache[rule]
@@ -95,23 +105,44 @@ def _localize(study, part, rolls, rule: str, cache: dict):
 
 def _mass(part, candidates, best, radius: float) -> float:
     """Stated probability of the candidates whose present contact is within ``radius`` of the best's."""
-    return float(sum(c.probability for c in candidates
-                     if abs(float(part.arc_offset(c.end_arc, best.end_arc))) < radius))
+    return float(
+        sum(c.probability for c in candidates if abs(float(part.arc_offset(c.end_arc, best.end_arc))) < radius)
+    )
 
 
 def score_rule(study, part, rolls, rule: str, true_arc: float, cache: dict) -> dict:
     """The localizer's ``rule`` on the fixed rolls: the study's own columns, and a method's cells."""
     loc = _localize(study, part, rolls, rule, cache)
     if isinstance(loc, Exception):
-        return {"estimate_arc": math.nan, "error_mm": math.inf, "candidates": 0, "probability": 0.0, "ambiguous": 0,
-                "mass": "", "failure": f"{type(loc).__name__}: {loc}"[:200]}
+        return {
+            "estimate_arc": math.nan,
+            "error_mm": math.inf,
+            "candidates": 0,
+            "probability": 0.0,
+            "ambiguous": 0,
+            "mass": "",
+            "failure": f"{type(loc).__name__}: {loc}"[:200],
+        }
     best = loc.best
     if best is None:
-        return {"estimate_arc": math.nan, "error_mm": math.inf, "candidates": 0, "probability": 0.0,
-                "ambiguous": int(loc.ambiguous), "mass": 0.0, "failure": ""}
-    return {"estimate_arc": best.end_arc, "error_mm": _err(part, best.end_arc, true_arc),
-            "candidates": len(loc.candidates), "probability": best.probability, "ambiguous": int(loc.ambiguous),
-            "mass": _mass(part, loc.candidates, best, study.success_radius), "failure": ""}
+        return {
+            "estimate_arc": math.nan,
+            "error_mm": math.inf,
+            "candidates": 0,
+            "probability": 0.0,
+            "ambiguous": int(loc.ambiguous),
+            "mass": 0.0,
+            "failure": "",
+        }
+    return {
+        "estimate_arc": best.end_arc,
+        "error_mm": _err(part, best.end_arc, true_arc),
+        "candidates": len(loc.candidates),
+        "probability": best.probability,
+        "ambiguous": int(loc.ambiguous),
+        "mass": _mass(part, loc.candidates, best, study.success_radius),
+        "failure": "",
+    }
 
 
 def score_paper(study, part, rolls, seq, rule: str, cache: dict) -> dict:
@@ -129,15 +160,26 @@ def score_paper(study, part, rolls, seq, rule: str, cache: dict) -> dict:
         segs = [(0, k1)] + ([(k1, k)] if k > k1 else [])
         pieces = [(sign * (seq["z"][b] - seq["z"][a]), seq["turn"][b] - seq["turn"][a]) for a, b in segs]
         try:
-            sub = localize(part, pieces, rule=rule, direction="ccw" if sign > 0 else "cw",
-                           sd_length=study.sd_length, sd_turn=math.radians(study.sd_turn_deg)).best
+            sub = localize(
+                part,
+                pieces,
+                rule=rule,
+                direction="ccw" if sign > 0 else "cw",
+                sd_length=study.sd_length,
+                sd_turn=math.radians(study.sd_turn_deg),
+            ).best
             e = _err(part, sub.end_arc, seq["truth"][k]) if sub is not None else math.inf
         except Exception:  # noqa: BLE001 - a prefix the rule cannot take counts as a miss
             e = math.inf
         curve.append((mark, e))
-    return {"estimate_arc": own["estimate_arc"], "error_mm": own["error_mm"],
-            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve, "stopped": "fixed",
-            "mass": own["mass"]}
+    return {
+        "estimate_arc": own["estimate_arc"],
+        "error_mm": own["error_mm"],
+        "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)),
+        "curve": curve,
+        "stopped": "fixed",
+        "mass": own["mass"],
+    }
 
 
 class _MethodError(Exception):
@@ -155,9 +197,14 @@ def _score_sequential(study, part, seq, update, estimate) -> dict:
         if j in marks:
             curve.append((marks[j], _err(part, estimate()[0], seq["truth"][j])))
     est, mass = estimate()
-    return {"estimate_arc": est, "error_mm": _err(part, est, seq["truth"][-1]),
-            "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)), "curve": curve, "stopped": "fixed",
-            "mass": mass}
+    return {
+        "estimate_arc": est,
+        "error_mm": _err(part, est, seq["truth"][-1]),
+        "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)),
+        "curve": curve,
+        "stopped": "fixed",
+        "mass": mass,
+    }
 
 
 def score_particle(study, part, seq, seed: int) -> dict:
@@ -165,8 +212,14 @@ def score_particle(study, part, seq, seed: int) -> dict:
     from localizer import ParticleFilter
 
     o = study.particle
-    pf = ParticleFilter(part, particles=o.particles, sd_position=o.sd_position, process=o.process,
-                        radius=study.success_radius, seed=seed)
+    pf = ParticleFilter(
+        part,
+        particles=o.particles,
+        sd_position=o.sd_position,
+        process=o.process,
+        radius=study.success_radius,
+        seed=seed,
+    )
     return _score_sequential(study, part, seq, lambda z, t, d: pf.update(z, t), pf.estimate)
 
 
@@ -196,8 +249,9 @@ def reactive_filter(study, part, noise, filter_class=None):
     o = study.reactive
     given = {k: getattr(o, k) for k in ("sd_position", "sd_scale", "sd_slope") if getattr(o, k) is not None}
     if given.get("sd_slope") == "auto":
-        given["sd_slope"] = max(5.0 * machining_slope(noise.machining_error, noise.machining_wavelength,
-                                                      part.perimeter), 5e-4)
+        given["sd_slope"] = max(
+            5.0 * machining_slope(noise.machining_error, noise.machining_wavelength, part.perimeter), 5e-4
+        )
     if o.noise_scales is not None:
         given["noise_scales"] = o.noise_scales
     for key in ("temper", "shape_spacing"):
@@ -222,11 +276,19 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
 
     o = study.reactive
     rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine)
-    res = localize_reactively(rig, part, calibration=cal, filter=reactive_filter(study, part, noise, filter_class),
-                              approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
-                              step=math.radians(study.step_deg), confidence=o.confidence,
-                              max_rotation=math.radians(o.max_rotation_deg), check_every=o.check_every,
-                              min_spread=o.min_spread, confirm=CONFIRM if o.confirm is None else o.confirm)
+    res = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=reactive_filter(study, part, noise, filter_class),
+        approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
+        step=math.radians(study.step_deg),
+        confidence=o.confidence,
+        max_rotation=math.radians(o.max_rotation_deg),
+        check_every=o.check_every,
+        min_spread=o.min_spread,
+        confirm=CONFIRM if o.confirm is None else o.confirm,
+    )
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)
     rot = math.degrees(res.rotation)
@@ -235,18 +297,35 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
     hist = res.history
     while mark <= o.max_rotation_deg + 1e-9:
         if rot <= mark + 1e-9:
-            e = final                      # stopped (sure, or out of budget) before this mark
+            e = final  # stopped (sure, or out of budget) before this mark
         else:
             before = [h for h in hist if math.degrees(h[0]) <= mark + 1e-9]
             e = _err(part, before[-1][1], before[-1][3]) if before else math.inf
         curve.append((mark, e))
         mark += MARK_DEG
-    return {"estimate_arc": res.estimate_arc, "error_mm": final, "rotation_deg": rot, "curve": curve,
-            "stopped": reactive_stop(res), "mass": res.belief.mass, "bridges": res.bridges}
+    return {
+        "estimate_arc": res.estimate_arc,
+        "error_mm": final,
+        "rotation_deg": rot,
+        "curve": curve,
+        "stopped": reactive_stop(res),
+        "mass": res.belief.mass,
+        "bridges": res.bridges,
+    }
 
 
-def score_methods(study, part, noise, cal, rolls, start: float, rig_seed: int, true_arc: float,
-                  rules: dict | None = None, filter_class=None) -> dict:
+def score_methods(
+    study,
+    part,
+    noise,
+    cal,
+    rolls,
+    start: float,
+    rig_seed: int,
+    true_arc: float,
+    rules: dict | None = None,
+    filter_class=None,
+) -> dict:
     """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
 
     ``rolls`` are the fixed rolls' :class:`driver.procedures.RollResult`; ``rules`` caches the
@@ -269,10 +348,26 @@ def score_methods(study, part, noise, cal, rolls, start: float, rig_seed: int, t
             r["failure"] = ""
         except Exception as exc:  # noqa: BLE001 - this method failed on this trial; the others still count
             text = str(exc) if isinstance(exc, _MethodError) else f"{type(exc).__name__}: {exc}"
-            r = {"estimate_arc": math.nan, "error_mm": math.inf, "rotation_deg": math.nan, "curve": [],
-                 "stopped": "error", "mass": "", "failure": text[:200]}
-        out.update({f"{m}_success": int(r["error_mm"] < study.success_radius), f"{m}_error_mm": r["error_mm"],
-                    f"{m}_estimate_arc": r["estimate_arc"], f"{m}_rotation_deg": r["rotation_deg"],
-                    f"{m}_curve": _curve(r["curve"]), f"{m}_stopped": r["stopped"], f"{m}_mass": r["mass"],
-                    f"{m}_failure": r["failure"], f"{m}_bridges": r.get("bridges", "")})
+            r = {
+                "estimate_arc": math.nan,
+                "error_mm": math.inf,
+                "rotation_deg": math.nan,
+                "curve": [],
+                "stopped": "error",
+                "mass": "",
+                "failure": text[:200],
+            }
+        out.update(
+            {
+                f"{m}_success": int(r["error_mm"] < study.success_radius),
+                f"{m}_error_mm": r["error_mm"],
+                f"{m}_estimate_arc": r["estimate_arc"],
+                f"{m}_rotation_deg": r["rotation_deg"],
+                f"{m}_curve": _curve(r["curve"]),
+                f"{m}_stopped": r["stopped"],
+                f"{m}_mass": r["mass"],
+                f"{m}_failure": r["failure"],
+                f"{m}_bridges": r.get("bridges", ""),
+            }
+        )
     return out

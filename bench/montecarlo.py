@@ -60,8 +60,15 @@ def _fmt(v):
     return "" if v is None else str(v)
 
 
-def run_study(study: Study, out, *, workers: int | None = None, scheduler: str | None = None,
-              resume: bool = False, progress: bool = True) -> dict:
+def run_study(
+    study: Study,
+    out,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: bool = True,
+) -> dict:
     """Run every (level, trial) of ``study`` not yet in ``out/trials.csv``; write the summary and plots.
 
     Parameters
@@ -91,8 +98,12 @@ def run_study(study: Study, out, *, workers: int | None = None, scheduler: str |
     else:
         with open(table, "w", newline="") as f:
             csv.DictWriter(f, fieldnames=study.columns).writeheader()
-    specs = [TrialSpec(study, level, trial) for level in range(study.levels) for trial in range(study.trials)
-             if (level, trial) not in done]
+    specs = [
+        TrialSpec(study, level, trial)
+        for level in range(study.levels)
+        for trial in range(study.trials)
+        if (level, trial) not in done
+    ]
     total = study.levels * study.trials
     finished = len(done)
     successes = sum(int(r["success"]) for r in read_trials(table)) if done else 0
@@ -107,8 +118,9 @@ def run_study(study: Study, out, *, workers: int | None = None, scheduler: str |
         if progress:
             rate = (finished - len(done)) / max(time.monotonic() - t0, 1e-9)
             bar = "#" * int(30 * finished / total)
-            sys.stderr.write(f"\r[{bar:<30}] {finished}/{total} trials  {rate:.2f}/s  "
-                             f"success {successes / max(finished, 1):.1%} ")
+            sys.stderr.write(
+                f"\r[{bar:<30}] {finished}/{total} trials  {rate:.2f}/s  success {successes / max(finished, 1):.1%} "
+            )
             sys.stderr.flush()
 
     with open(table, "a", newline="") as f:
@@ -171,20 +183,33 @@ def summarize(study: Study, rows) -> dict:
         n = len(sel)
         ok = sum(int(r["success"]) for r in sel)
         err = np.array([float(r["error_mm"]) for r in sel]) if sel else np.array([])
-        levels.append({
-            "level": level, "parameter": study.parameter, "value": study.level_label(level), "trials": n,
-            "success": ok, "success_rate": ok / n if n else None, "ci95": list(wilson(ok, n)),
-            "error_median_mm": float(np.median(err)) if n else None,
-            "error_p90_mm": float(np.quantile(err, 0.9)) if n else None,
-            "ambiguous": sum(int(r["ambiguous"]) for r in sel),
-            "broken": sum(bool(r["failure"]) for r in sel),
-            "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,
-            "mean_restarts": float(np.mean([float(r["restarts"]) for r in sel])) if n else None,
-        })
+        levels.append(
+            {
+                "level": level,
+                "parameter": study.parameter,
+                "value": study.level_label(level),
+                "trials": n,
+                "success": ok,
+                "success_rate": ok / n if n else None,
+                "ci95": list(wilson(ok, n)),
+                "error_median_mm": float(np.median(err)) if n else None,
+                "error_p90_mm": float(np.quantile(err, 0.9)) if n else None,
+                "ambiguous": sum(int(r["ambiguous"]) for r in sel),
+                "broken": sum(bool(r["failure"]) for r in sel),
+                "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,
+                "mean_restarts": float(np.mean([float(r["restarts"]) for r in sel])) if n else None,
+            }
+        )
         if study.methods:
             levels[-1]["methods"] = {m: method_detail(study, m, sel) for m in study.methods}
-    out = {"study": study.name, "method": study.method, "engine": study.engine, "noise": study.noise,
-           "success_radius": study.success_radius, "levels": levels}
+    out = {
+        "study": study.name,
+        "method": study.method,
+        "engine": study.engine,
+        "noise": study.noise,
+        "success_radius": study.success_radius,
+        "levels": levels,
+    }
     if study.methods:
         out.update(summarize_methods(study, rows))
     return out
@@ -204,15 +229,20 @@ def method_detail(study: Study, m: str, rows) -> dict:
         d["trials"] += 1
         d["success"] += int(r[f"{m}_success"])
     wrong = sum(1 - int(r[f"{m}_success"]) for r in confident)
-    return {"success": ok, "trials": n, "ci95": list(wilson(ok, n)),
-            "mean_rotation_deg": float(np.nanmean(rot)) if n and np.isfinite(rot).any() else None,
-            "median_rotation_deg": float(np.nanmedian(rot)) if n and np.isfinite(rot).any() else None,
-            "error_median_mm": float(np.median(err)) if n else None,
-            "confident": len(confident), "confident_wrong": wrong,
-            "confident_wrong_ci95": list(wilson(wrong, len(confident))),
-            "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
-            "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
-            "per_part": dict(sorted(per_part.items()))}
+    return {
+        "success": ok,
+        "trials": n,
+        "ci95": list(wilson(ok, n)),
+        "mean_rotation_deg": float(np.nanmean(rot)) if n and np.isfinite(rot).any() else None,
+        "median_rotation_deg": float(np.nanmedian(rot)) if n and np.isfinite(rot).any() else None,
+        "error_median_mm": float(np.median(err)) if n else None,
+        "confident": len(confident),
+        "confident_wrong": wrong,
+        "confident_wrong_ci95": list(wilson(wrong, len(confident))),
+        "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
+        "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
+        "per_part": dict(sorted(per_part.items())),
+    }
 
 
 def summarize_methods(study: Study, rows) -> dict:
@@ -336,11 +366,16 @@ def _plot_methods(study: Study, summary: dict, out: Path) -> None:
         curve = summary["success_by_rotation_deg"][m]
         x = [float(k) for k in curve]
         d = summary["method_details"][m]
-        label = (f"{m}: {summary['methods'][m]:.1%} at the end, mean rotation {d['mean_rotation_deg']:.0f}°")
+        label = f"{m}: {summary['methods'][m]:.1%} at the end, mean rotation {d['mean_rotation_deg']:.0f}°"
         ax.plot(x, list(curve.values()), "o-", ms=3, label=label)
     ax.axhline(0.45, color="tab:red", lw=1, ls="--", label="the paper's rig: about 45%")
-    ax.axvline(sum(abs(a) for a in study.rolls_deg), color="0.5", lw=1, ls=":",
-               label=f"the fixed rolls: {sum(abs(a) for a in study.rolls_deg):g}°")
+    ax.axvline(
+        sum(abs(a) for a in study.rolls_deg),
+        color="0.5",
+        lw=1,
+        ls=":",
+        label=f"the fixed rolls: {sum(abs(a) for a in study.rolls_deg):g}°",
+    )
     ax.set_ylim(0, 1.02)
     ax.set_xlabel("rotation rolled (degrees)")
     ax.set_ylabel(f"success rate (error < {study.success_radius} mm)")
@@ -365,7 +400,7 @@ def _plot_reliability(study: Study, rows, out: Path) -> None:
     fig, axes = plt.subplots(len(stating), 2, figsize=(10, 4.2 * len(stating)), squeeze=False)
     for row_axes, m in zip(axes, stating):
         if not any(r.get(f"{m}_stopped") == "confident" for r in rows):
-            row_axes[1].set_visible(False)                # it never stops sure: nothing to zoom into
+            row_axes[1].set_visible(False)  # it never stops sure: nothing to zoom into
         for ax, lo in zip(row_axes, (0.0, 0.9)):
             if not ax.get_visible():
                 continue
@@ -396,14 +431,20 @@ def _plot_reliability(study: Study, rows, out: Path) -> None:
 
 
 def print_summary(summary: dict) -> None:
-    print(f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
-          f"noise {Path(str(summary['noise'])).name}")
+    print(
+        f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
+        f"noise {Path(str(summary['noise'])).name}"
+    )
     for lv in summary["levels"]:
         v = "" if lv["value"] is None else f"{lv['parameter']} = {lv['value']}: "
         rate = lv["success_rate"]
-        print(f"  {v}{lv['success']}/{lv['trials']} within {summary['success_radius']} mm = "
-              f"{rate:.1%} (95% CI {lv['ci95'][0]:.1%}–{lv['ci95'][1]:.1%}), median error "
-              f"{lv['error_median_mm']:.3f} mm" if rate is not None else f"  {v}no trials")
+        print(
+            f"  {v}{lv['success']}/{lv['trials']} within {summary['success_radius']} mm = "
+            f"{rate:.1%} (95% CI {lv['ci95'][0]:.1%}–{lv['ci95'][1]:.1%}), median error "
+            f"{lv['error_median_mm']:.3f} mm"
+            if rate is not None
+            else f"  {v}no trials"
+        )
         if len(summary["levels"]) > 1:
             for m, d in lv.get("methods", {}).items():
                 _print_method(m, d, indent="    ")
@@ -415,6 +456,8 @@ def _print_method(m: str, d: dict, indent: str) -> None:
     if not d["trials"]:
         return
     rot = "" if d["mean_rotation_deg"] is None else f"mean rotation {d['mean_rotation_deg']:.1f}°, "
-    print(f"{indent}{m:10s} {d['success']}/{d['trials']} = {d['success'] / d['trials']:.1%} "
-          f"(95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), {rot}median error {d['error_median_mm']:.3f} mm; "
-          f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}")
+    print(
+        f"{indent}{m:10s} {d['success']}/{d['trials']} = {d['success'] / d['trials']:.1%} "
+        f"(95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), {rot}median error {d['error_median_mm']:.3f} mm; "
+        f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}"
+    )

@@ -62,8 +62,10 @@ def wall_study(axis: Axis = Axis(), operator: Operator = Operator()) -> tuple[di
     traces["bare"] = bare
     assumed = simulate_wall(controller("plain", axis.dt, booking="assumed"), axis=axis, operator=operator)
     extra = {
-        "bare_wall": {"max_penetration_mm": float(bare.position.max() * 1e3),
-                      "wall_force_variation": float(np.abs(np.diff(bare.port_force)).sum() / bare.time[-1])},
+        "bare_wall": {
+            "max_penetration_mm": float(bare.position.max() * 1e3),
+            "wall_force_variation": float(np.abs(np.diff(bare.port_force)).sum() / bare.time[-1]),
+        },
         "plain_assumed_booking": {"noise": assumed.noise(), "min_energy": float(assumed.energy.min())},
     }
     return results, {"traces": traces, "extra": extra}
@@ -84,14 +86,18 @@ def servo_study(gains=GAINS, noise: str = "paper", duration: float = 1.0, seed: 
             tr = simulate_servo(servo, pc, axis=axis, seed=seed)
             tail = tr.time >= duration / 2
             cf = tr.contact_force[tail]
-            rows.append({
-                "gain": gain, "guarded": guard,
-                "contact_lost_samples": int((cf == 0).sum()),
-                "force_mean": float(cf.mean()), "force_std": float(cf.std()),
-                "force_variation": float(np.abs(np.diff(cf)).sum() / (duration / 2)),
-                "max_force": float(tr.contact_force.max()),
-                "min_energy": float(tr.energy.min()),
-            })
+            rows.append(
+                {
+                    "gain": gain,
+                    "guarded": guard,
+                    "contact_lost_samples": int((cf == 0).sum()),
+                    "force_mean": float(cf.mean()),
+                    "force_std": float(cf.std()),
+                    "force_variation": float(np.abs(np.diff(cf)).sum() / (duration / 2)),
+                    "max_force": float(tr.contact_force.max()),
+                    "min_energy": float(tr.energy.min()),
+                }
+            )
             if gain == 20.0:
                 traces["guarded" if guard else "bare"] = tr
     return rows, traces
@@ -147,8 +153,11 @@ def _plots(out: Path, wall: dict, servo_traces: dict) -> None:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench.passivity", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--json", action="store_true",
-                        help="print {variant: {noise, min_energy, ...}} for plain, sign_fix, hold_fix, both")
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help="print {variant: {noise, min_energy, ...}} for plain, sign_fix, hold_fix, both",
+    )
     parser.add_argument("--out", type=Path, help="also run the servo study; write summary.json and plots here")
     args = parser.parse_args(argv)
     results, wall = wall_study()
@@ -161,15 +170,21 @@ def main(argv=None) -> int:
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
         rows, servo_traces = servo_study()
-        summary = {"wall": results, **wall["extra"], "servo": rows,
-                   "metric": "noise = total variation of the passivity controller's force per second (N/s)"}
+        summary = {
+            "wall": results,
+            **wall["extra"],
+            "servo": rows,
+            "metric": "noise = total variation of the passivity controller's force per second (N/s)",
+        }
         (args.out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         _plots(args.out, wall, servo_traces)
         if not args.json:
             print(f"\n{'gain':>5s} {'guard':>6s} {'lost':>5s} {'std N':>7s} {'var N/s':>8s}")
             for r in rows:
-                print(f"{r['gain']:5.0f} {str(r['guarded']):>6s} {r['contact_lost_samples']:5d} "
-                      f"{r['force_std']:7.3f} {r['force_variation']:8.1f}")
+                print(
+                    f"{r['gain']:5.0f} {str(r['guarded']):>6s} {r['contact_lost_samples']:5d} "
+                    f"{r['force_std']:7.3f} {r['force_variation']:8.1f}"
+                )
             print(f"wrote {args.out}/summary.json, wall.png, servo.png", file=sys.stderr)
     return 0
 

@@ -41,10 +41,16 @@ def run(part_file: Path, start: float, seed: int):
             w = flt.posterior()
             snaps.append((event["rotation"], part.wrap_arc(flt.current.copy()), w, event["true_arc"], event["mass"]))
 
-    res = localize_reactively(rig, part, calibration=cal, filter=flt, observer=observe,
-                              confidence=study.reactive.confidence,
-                              max_rotation=math.radians(study.reactive.max_rotation_deg),
-                              approach_pose=rig.approach_pose(start, jaw_position=-40.0, standoff=1.0))
+    res = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=flt,
+        observer=observe,
+        confidence=study.reactive.confidence,
+        max_rotation=math.radians(study.reactive.max_rotation_deg),
+        approach_pose=rig.approach_pose(start, jaw_position=-40.0, standoff=1.0),
+    )
     return part, res, snaps, rig.truth()["contact_arc"]
 
 
@@ -60,8 +66,16 @@ def draw(part, snaps, out: Path, title: str) -> None:
     bins = np.linspace(0, part.perimeter, int(part.perimeter / 0.5) + 1)
     image = np.array([np.histogram(present, bins=bins, weights=w)[0] for _, present, w, _, _ in snaps])
     rot = np.degrees([sn[0] for sn in snaps])
-    im = ax.imshow(np.log10(image + 1e-6), aspect="auto", origin="lower", cmap="magma", vmin=-6, vmax=0,
-                   extent=(0, part.perimeter, rot[0], rot[-1]), interpolation="nearest")
+    im = ax.imshow(
+        np.log10(image + 1e-6),
+        aspect="auto",
+        origin="lower",
+        cmap="magma",
+        vmin=-6,
+        vmax=0,
+        extent=(0, part.perimeter, rot[0], rot[-1]),
+        interpolation="nearest",
+    )
     truth = np.array([sn[3] for sn in snaps])
     ax.plot(truth, rot, "c.", ms=2, label="true contact")
     ax.set_xlabel("present contact, arc position on the part (mm)")
@@ -79,8 +93,14 @@ def draw(part, snaps, out: Path, title: str) -> None:
         top = np.argsort(w)[-400:]
         top = top[w[top] > 1e-3 * w.max()]
         p = part.point_at_arc(present[top])
-        ax2.scatter(p[:, 0], p[:, 1], s=4 + 60 * w[top] / w[top].max(), color=cmap(k / max(1, len(pick) - 1)),
-                    alpha=0.5, label=f"{math.degrees(r):.0f}°: {mass:.0%} within 0.3 mm")
+        ax2.scatter(
+            p[:, 0],
+            p[:, 1],
+            s=4 + 60 * w[top] / w[top].max(),
+            color=cmap(k / max(1, len(pick) - 1)),
+            alpha=0.5,
+            label=f"{math.degrees(r):.0f}°: {mass:.0%} within 0.3 mm",
+        )
         q = part.point_at_arc(true_arc)
         ax2.plot(q[0], q[1], "k+", ms=10)
     ax2.set_aspect("equal")
@@ -102,8 +122,10 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     part, res, snaps, truth = run(args.part, args.start, args.seed)
     err = abs(float(part.arc_offset(res.estimate_arc, truth)))
-    title = (f"{part.name}: reactive localization, paper noise — stopped ({res.stopped}) after "
-             f"{math.degrees(res.rotation):.0f}°, error {err:.3f} mm")
+    title = (
+        f"{part.name}: reactive localization, paper noise — stopped ({res.stopped}) after "
+        f"{math.degrees(res.rotation):.0f}°, error {err:.3f} mm"
+    )
     draw(part, snaps, args.out, title)
     print(title)
     return 0

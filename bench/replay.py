@@ -117,10 +117,13 @@ def record_trial(study_path, level: int, trial: int) -> Recorded:
     row = run_trial(TrialSpec(study, level, trial, extra={"filter_class": FilterRecorder}))
     rec = FilterRecorder.last
     if rec is None or row.get("reactive_failure"):
-        raise RuntimeError(f"trial {trial} of level {level} did not run its reactive method: "
-                           f"{row.get('reactive_failure') or row.get('failure')}")
-    return Recorded(part=rec.part, settings=rec.settings, calls=tuple(rec.calls), row=row,
-                    start_arc=float(row["start_arc"]))
+        raise RuntimeError(
+            f"trial {trial} of level {level} did not run its reactive method: "
+            f"{row.get('reactive_failure') or row.get('failure')}"
+        )
+    return Recorded(
+        part=rec.part, settings=rec.settings, calls=tuple(rec.calls), row=row, start_arc=float(row["start_arc"])
+    )
 
 
 def replay(rec: Recorded, **changes) -> VariantResult:
@@ -139,8 +142,9 @@ def replay(rec: Recorded, **changes) -> VariantResult:
     margin = best_near - best_far if np.isfinite(best_far) else math.inf
     i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
     error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(flt.current[i])))))
-    return VariantResult(settings=dict(changes), mass=belief.mass, error_mm=error, margin=margin,
-                         noise_scale=flt.noise_scale())
+    return VariantResult(
+        settings=dict(changes), mass=belief.mass, error_mm=error, margin=margin, noise_scale=flt.noise_scale()
+    )
 
 
 def _value(text: str):
@@ -159,8 +163,13 @@ def main(argv=None) -> int:
     ap.add_argument("study", type=Path)
     ap.add_argument("--level", type=int, required=True, help="level index (0 = the first swept value)")
     ap.add_argument("--trial", type=int, required=True)
-    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="a ContactFilter setting for one variant (repeat for more variants)")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a ContactFilter setting for one variant (repeat for more variants)",
+    )
     args = ap.parse_args(argv)
     variants = [{}]
     for item in args.set:
@@ -170,17 +179,21 @@ def main(argv=None) -> int:
         variants.append({name: _value(value)})
     rec = record_trial(args.study, args.level, args.trial)
     r = rec.row
-    print(f"{r['part']} {r['value']} trial {args.trial}: reactive {r['reactive_stopped']} at mass "
-          f"{r['reactive_mass']}, error {float(r['reactive_error_mm']):.3f} mm after "
-          f"{float(r['reactive_rotation_deg']):.1f} degrees, {len(rec.calls)} filter calls")
+    print(
+        f"{r['part']} {r['value']} trial {args.trial}: reactive {r['reactive_stopped']} at mass "
+        f"{r['reactive_mass']}, error {float(r['reactive_error_mm']):.3f} mm after "
+        f"{float(r['reactive_rotation_deg']):.1f} degrees, {len(rec.calls)} filter calls"
+    )
     for changes in variants:
         try:
             v = replay(rec, **changes)
         except (TypeError, ValueError) as exc:
             print(f"  {changes!s:40s} cannot be built: {exc}", file=sys.stderr)
             continue
-        print(f"  {str(changes) if changes else 'as run':40s} mass {v.mass:.3f}  error {v.error_mm:8.3f} mm  "
-              f"true-start margin {v.margin:+8.2f} nats  noise scale {v.noise_scale:.2f}")
+        print(
+            f"  {str(changes) if changes else 'as run':40s} mass {v.mass:.3f}  error {v.error_mm:8.3f} mm  "
+            f"true-start margin {v.margin:+8.2f} nats  noise scale {v.noise_scale:.2f}"
+        )
     return 0
 
 

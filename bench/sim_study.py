@@ -47,10 +47,18 @@ def fidelity(steps_deg=(0.8, 0.4, 0.2, 0.1), starts=(20.0, 90.0, 160.0, 230.0), 
             r = roll(rig, hand, base, cal, math.radians(angle_deg), step=math.radians(deg))
             true_len = (rig.truth()["contact_arc"] - a0) % part.perimeter
             true_turn = float(part.tangent_angle_at_arc(a0 + true_len) - part.tangent_angle_at_arc(a0))
-            rows.append({"step_deg": deg, "start": start, "true_length": true_len,
-                         "paper_error": r.jaw_travel - true_len,
-                         "paper_offset_error": r.jaw_travel + r.offset * abs(r.turn) - true_len,
-                         "ours_error": r.length - true_len, "turn_error": r.turn - true_turn, "offset": r.offset})
+            rows.append(
+                {
+                    "step_deg": deg,
+                    "start": start,
+                    "true_length": true_len,
+                    "paper_error": r.jaw_travel - true_len,
+                    "paper_offset_error": r.jaw_travel + r.offset * abs(r.turn) - true_len,
+                    "ours_error": r.length - true_len,
+                    "turn_error": r.turn - true_turn,
+                    "offset": r.offset,
+                }
+            )
         _log(f"  fidelity: step {deg}°")
     return rows
 
@@ -68,8 +76,11 @@ def calibration_accuracy(noises=("none", "paper"), seeds=(0, 1, 2)):
                 dv1, dv2 = _delta(rig, base, 32)
                 errs.append(cal.position(dv2 / dv1) - rig.truth()["jaw_position"])
         errs = np.array(errs)
-        out[noise] = {"readings": int(errs.size), "rms_mm": float(np.sqrt(np.mean(errs ** 2))),
-                      "max_mm": float(np.abs(errs).max())}
+        out[noise] = {
+            "readings": int(errs.size),
+            "rms_mm": float(np.sqrt(np.mean(errs**2))),
+            "max_mm": float(np.abs(errs).max()),
+        }
     return out
 
 
@@ -83,14 +94,29 @@ def engines(starts=(20.0, 120.0, 200.0)):
         for engine in ("kinematic", "pymunk"):
             rig = SimRig(part, noise="none", seed=1, engine=engine)
             t0 = time.perf_counter()
-            run = localize_by_rolling(rig, part, [math.radians(30), math.radians(25)], calibration=cal,
-                                      approach_pose=rig.approach_pose(start, jaw_position=-40, standoff=1.0))
+            run = localize_by_rolling(
+                rig,
+                part,
+                [math.radians(30), math.radians(25)],
+                calibration=cal,
+                approach_pose=rig.approach_pose(start, jaw_position=-40, standoff=1.0),
+            )
             truth = rig.truth()["contact_arc"]
-            res[engine] = {"estimates": [list(e) for e in run.estimates], "seconds": time.perf_counter() - t0,
-                           "error_mm": abs(float(part.arc_offset(run.estimate_arc, truth))), "true_arc": truth}
+            res[engine] = {
+                "estimates": [list(e) for e in run.estimates],
+                "seconds": time.perf_counter() - t0,
+                "error_mm": abs(float(part.arc_offset(run.estimate_arc, truth))),
+                "true_arc": truth,
+            }
         d = np.abs(np.array(res["kinematic"]["estimates"]) - np.array(res["pymunk"]["estimates"]))
-        rows.append({"start": start, **res, "length_diff_max_mm": float(d[:, 0].max()),
-                     "turn_diff_max_rad": float(d[:, 1].max())})
+        rows.append(
+            {
+                "start": start,
+                **res,
+                "length_diff_max_mm": float(d[:, 0].max()),
+                "turn_diff_max_rad": float(d[:, 1].max()),
+            }
+        )
         _log(f"  engines: start {start}")
     return rows
 
@@ -114,9 +140,15 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
             start = float(rng.uniform(0, part.perimeter))
             rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=engine)
             try:
-                run = localize_by_rolling(rig, part, [math.radians(a) for a in rolls_deg], calibration=cal,
-                                          approach_pose=rig.approach_pose(start, jaw_position=-40, standoff=1.0),
-                                          sd_length=sd_length, sd_turn=sd_turn)
+                run = localize_by_rolling(
+                    rig,
+                    part,
+                    [math.radians(a) for a in rolls_deg],
+                    calibration=cal,
+                    approach_pose=rig.approach_pose(start, jaw_position=-40, standoff=1.0),
+                    sd_length=sd_length,
+                    sd_turn=sd_turn,
+                )
             except RigError as exc:
                 rows.append({"start": start, "refused": str(exc)[:120]})
                 continue
@@ -127,13 +159,25 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
             truth = rig.truth()["contact_arc"]
             best = run.localization.best
             if best is None:  # no place on the part fits the noisy measurements
-                rows.append({"start": start, "error_mm": math.inf, "ambiguous": True, "top2_error_mm": math.inf,
-                             "no_candidate": True})
+                rows.append(
+                    {
+                        "start": start,
+                        "error_mm": math.inf,
+                        "ambiguous": True,
+                        "top2_error_mm": math.inf,
+                        "no_candidate": True,
+                    }
+                )
                 continue
             top2 = run.localization.candidates[:2]
-            rows.append({"start": start, "error_mm": abs(float(part.arc_offset(best.end_arc, truth))),
-                         "ambiguous": run.localization.ambiguous,
-                         "top2_error_mm": min(abs(float(part.arc_offset(c.end_arc, truth))) for c in top2)})
+            rows.append(
+                {
+                    "start": start,
+                    "error_mm": abs(float(part.arc_offset(best.end_arc, truth))),
+                    "ambiguous": run.localization.ambiguous,
+                    "top2_error_mm": min(abs(float(part.arc_offset(c.end_arc, truth))) for c in top2),
+                }
+            )
         done = [r for r in rows if "error_mm" in r]
         ok = sum(r["error_mm"] < 0.3 for r in done)
         n = len(done)
@@ -142,13 +186,19 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
         p = ok / n if n else float("nan")
         half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n) if n else float("nan")
         centre = (p + z * z / (2 * n)) / (1 + z * z / n) if n else float("nan")
-        out[name] = {"trials": trials, "localized": n, "refused": trials - n, "success": ok,
-                     "success_rate": p, "ci95": [centre - half, centre + half],
-                     "ambiguous": sum(r["ambiguous"] for r in done),
-                     "success_top2": sum(r["top2_error_mm"] < 0.3 for r in done),
-                     "no_candidate": sum(bool(r.get("no_candidate")) for r in done),
-                     "median_error_mm": float(np.median([r["error_mm"] for r in done])) if done else None,
-                     "rows": rows}
+        out[name] = {
+            "trials": trials,
+            "localized": n,
+            "refused": trials - n,
+            "success": ok,
+            "success_rate": p,
+            "ci95": [centre - half, centre + half],
+            "ambiguous": sum(r["ambiguous"] for r in done),
+            "success_top2": sum(r["top2_error_mm"] < 0.3 for r in done),
+            "no_candidate": sum(bool(r.get("no_candidate")) for r in done),
+            "median_error_mm": float(np.median([r["error_mm"] for r in done])) if done else None,
+            "rows": rows,
+        }
         _log(f"  end to end ({noise}): {name}: {ok}/{n} within 0.3 mm, {trials - n} refused")
     return out
 
@@ -161,12 +211,18 @@ def _plot(out: Path, fid, e2e_paper):
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.3))
     steps = sorted({r["step_deg"] for r in fid})
-    for key, label, mark in (("paper_offset_error", "paper: Δu summed (+ edge offset)", "o"),
-                             ("ours_error", "ours: second-order inversion", "s")):
+    for key, label, mark in (
+        ("paper_offset_error", "paper: Δu summed (+ edge offset)", "o"),
+        ("ours_error", "ours: second-order inversion", "s"),
+    ):
         v = [np.mean([abs(r[key]) for r in fid if r["step_deg"] == s]) for s in steps]
         a1.loglog(steps, v, mark + "-", label=label)
-    a1.loglog(steps, [np.mean([abs(r["paper_error"]) for r in fid if r["step_deg"] == s]) for s in steps], "^-",
-              label="Δu summed, no edge offset")
+    a1.loglog(
+        steps,
+        [np.mean([abs(r["paper_error"]) for r in fid if r["step_deg"] == s]) for s in steps],
+        "^-",
+        label="Δu summed, no edge offset",
+    )
     a1.set_xlabel("rolling step θ (degrees)")
     a1.set_ylabel("|L estimate - true arc length| (mm), 40° roll")
     a1.set_title("rolling fidelity, noise none (cam)")
@@ -212,16 +268,25 @@ def main(argv=None) -> int:
     table = {}
     for s in sorted({r["step_deg"] for r in fid}, reverse=True):
         sel = [r for r in fid if r["step_deg"] == s]
-        table[str(s)] = {k: float(np.mean([abs(r[k]) for r in sel]))
-                         for k in ("paper_error", "paper_offset_error", "ours_error", "turn_error")}
-    summary = {"fidelity_mean_abs_error_mm": table, "calibration": calib,
-               "engines": [{k: v for k, v in r.items()} for r in eng],
-               "end_to_end_none": {k: {kk: vv for kk, vv in v.items() if kk != "rows"} for k, v in none.items()},
-               "end_to_end_paper": {k: {kk: vv for kk, vv in v.items() if kk != "rows"} for k, v in paper.items()}}
+        table[str(s)] = {
+            k: float(np.mean([abs(r[k]) for r in sel]))
+            for k in ("paper_error", "paper_offset_error", "ours_error", "turn_error")
+        }
+    summary = {
+        "fidelity_mean_abs_error_mm": table,
+        "calibration": calib,
+        "engines": [{k: v for k, v in r.items()} for r in eng],
+        "end_to_end_none": {k: {kk: vv for kk, vv in v.items() if kk != "rows"} for k, v in none.items()},
+        "end_to_end_paper": {k: {kk: vv for kk, vv in v.items() if kk != "rows"} for k, v in paper.items()},
+    }
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    (out / "end_to_end_rows.json").write_text(json.dumps({"none": {k: v["rows"] for k, v in none.items()},
-                                                          "paper": {k: v["rows"] for k, v in paper.items()}},
-                                                         indent=1) + "\n")
+    (out / "end_to_end_rows.json").write_text(
+        json.dumps(
+            {"none": {k: v["rows"] for k, v in none.items()}, "paper": {k: v["rows"] for k, v in paper.items()}},
+            indent=1,
+        )
+        + "\n"
+    )
     _plot(out, fid, paper)
     print(json.dumps(summary, indent=2))
     return 0

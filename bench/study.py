@@ -73,19 +73,60 @@ from localizer import RolltouchError
 __all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS"]
 
 #: Columns of trials.csv, in order.
-TRIAL_COLUMNS = ("level", "trial", "parameter", "value", "part", "start_arc", "true_arc", "estimate_arc",
-                 "error_mm", "success", "candidates", "probability", "ambiguous", "lengths", "turns",
-                 "restarts", "time_s", "failure")
+TRIAL_COLUMNS = (
+    "level",
+    "trial",
+    "parameter",
+    "value",
+    "part",
+    "start_arc",
+    "true_arc",
+    "estimate_arc",
+    "error_mm",
+    "success",
+    "candidates",
+    "probability",
+    "ambiguous",
+    "lengths",
+    "turns",
+    "restarts",
+    "time_s",
+    "failure",
+)
 
-_KEYS = {"name", "parts", "rolls_deg", "step_deg", "method", "methods", "engine", "trials", "seed",
-         "success_radius", "noise", "sweep", "likelihood", "reactive", "particle"}
+_KEYS = {
+    "name",
+    "parts",
+    "rolls_deg",
+    "step_deg",
+    "method",
+    "methods",
+    "engine",
+    "trials",
+    "seed",
+    "success_radius",
+    "noise",
+    "sweep",
+    "likelihood",
+    "reactive",
+    "particle",
+}
 METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
 #: ``stopped``: confident, budget, ambiguous (the reactive method), fixed (the fixed-roll methods) or
 #: error; ``mass``: the stated probability within the success radius at the end (empty if the method
 #: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met.
-METHOD_COLUMNS = ("success", "error_mm", "estimate_arc", "rotation_deg", "curve", "stopped", "mass", "failure",
-                  "bridges")
+METHOD_COLUMNS = (
+    "success",
+    "error_mm",
+    "estimate_arc",
+    "rotation_deg",
+    "curve",
+    "stopped",
+    "mass",
+    "failure",
+    "bridges",
+)
 
 
 @dataclass(frozen=True)
@@ -95,13 +136,13 @@ class ReactiveOptions:
     confidence: float = 0.95
     max_rotation_deg: float = 180.0
     check_every: int = 5
-    confirm: int | None = None         # None: driver.reactive.CONFIRM (checks in a row at the confidence)
-    sd_position: float | None = None   # None: the filter's default
+    confirm: int | None = None  # None: driver.reactive.CONFIRM (checks in a row at the confidence)
+    sd_position: float | None = None  # None: the filter's default
     sd_scale: float | None = None
-    sd_slope: float | str | None = None   # "auto": from the study's noise model
+    sd_slope: float | str | None = None  # "auto": from the study's noise model
     min_spread: float = 0.05
     noise_scales: tuple | None = None  # None: localizer.NOISE_SCALES
-    temper: float | None = None        # None: the filter's default
+    temper: float | None = None  # None: the filter's default
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
 
 
@@ -218,16 +259,20 @@ def load_study(path) -> Study:
         if not Path(p).is_file():
             raise StudyError(f"study {path}: part file {p} does not exist")
     rolls = data.get("rolls_deg")
-    if (not isinstance(rolls, list) or not rolls or not all(isinstance(r, (int, float)) and r != 0 for r in rolls)
-            or len({r > 0 for r in rolls}) != 1):
-        raise StudyError(f"study {path}: 'rolls_deg' must be a non-empty list of nonzero angles of one sign, "
-                         f"got {rolls!r}")
+    if (
+        not isinstance(rolls, list)
+        or not rolls
+        or not all(isinstance(r, (int, float)) and r != 0 for r in rolls)
+        or len({r > 0 for r in rolls}) != 1
+    ):
+        raise StudyError(
+            f"study {path}: 'rolls_deg' must be a non-empty list of nonzero angles of one sign, got {rolls!r}"
+        )
     method = data.get("method", "paper")
     if method not in ("paper", "likelihood"):
         raise StudyError(f"study {path}: method {method!r}; use 'paper' or 'likelihood'")
     methods = data.get("methods", [])
-    if (not isinstance(methods, list) or not all(m in METHODS for m in methods)
-            or len(set(methods)) != len(methods)):
+    if not isinstance(methods, list) or not all(m in METHODS for m in methods) or len(set(methods)) != len(methods):
         raise StudyError(f"study {path}: methods {methods!r} must be a list of distinct names from {list(METHODS)}")
     if methods and "method" in data:
         raise StudyError(f"study {path}: give 'method' or 'methods', not both")
@@ -272,8 +317,10 @@ def load_study(path) -> Study:
                     raise StudyError(f"study {path}: sweep noise {v!r}: {exc}") from None
             values = tuple(v if v in PRESETS else resolve(v) for v in values)
         elif parameter not in NoiseModel.__dataclass_fields__:
-            raise StudyError(f"study {path}: sweep parameter {parameter!r} is not a noise-model field nor "
-                             f"'noise'; fields: {sorted(NoiseModel.__dataclass_fields__)}")
+            raise StudyError(
+                f"study {path}: sweep parameter {parameter!r} is not a noise-model field nor "
+                f"'noise'; fields: {sorted(NoiseModel.__dataclass_fields__)}"
+            )
         else:
             values = sweep.get("values")
             if not isinstance(values, list) or not values:
@@ -287,13 +334,26 @@ def load_study(path) -> Study:
     lk = data.get("likelihood", {})
     if not isinstance(lk, dict) or set(lk) - {"sd_length", "sd_turn_deg"}:
         raise StudyError(f"study {path}: [likelihood] takes 'sd_length' and 'sd_turn_deg'")
-    return Study(name=str(data.get("name", path.stem)), parts=tuple(parts), rolls_deg=tuple(float(r) for r in rolls),
-                 step_deg=float(data.get("step_deg", 0.2)), method=method, engine=engine,
-                 trials=int(data.get("trials", 100)), seed=int(data.get("seed", 0)),
-                 success_radius=float(data.get("success_radius", 0.3)), noise=str(noise), parameter=parameter,
-                 values=values, sd_length=float(lk.get("sd_length", 0.3)),
-                 sd_turn_deg=float(lk.get("sd_turn_deg", 0.03)), source=str(path), methods=tuple(methods),
-                 reactive=reactive, particle=particle)
+    return Study(
+        name=str(data.get("name", path.stem)),
+        parts=tuple(parts),
+        rolls_deg=tuple(float(r) for r in rolls),
+        step_deg=float(data.get("step_deg", 0.2)),
+        method=method,
+        engine=engine,
+        trials=int(data.get("trials", 100)),
+        seed=int(data.get("seed", 0)),
+        success_radius=float(data.get("success_radius", 0.3)),
+        noise=str(noise),
+        parameter=parameter,
+        values=values,
+        sd_length=float(lk.get("sd_length", 0.3)),
+        sd_turn_deg=float(lk.get("sd_turn_deg", 0.03)),
+        source=str(path),
+        methods=tuple(methods),
+        reactive=reactive,
+        particle=particle,
+    )
 
 
 def _options(path, table, cls, name):
@@ -310,9 +370,14 @@ def _options(path, table, cls, name):
             values[key] = "auto"
             continue
         if key == "noise_scales":
-            if (not isinstance(value, list) or not value
-                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
-                               for v in value)):
+            if (
+                not isinstance(value, list)
+                or not value
+                or not all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+                    for v in value
+                )
+            ):
                 raise StudyError(f"study {path}: [{name}] noise_scales={value!r} must be a list of positive factors")
             values[key] = tuple(float(v) for v in value)
             continue
@@ -387,8 +452,13 @@ def run_trial(spec: TrialSpec) -> dict:
     part_file = s.parts[int(rng.integers(len(s.parts)))]
     part = _part(part_file)
     noise = s.level_noise(spec.level)
-    row = {"level": spec.level, "trial": spec.trial, "parameter": s.parameter or "",
-           "value": s.level_label(spec.level), "part": Path(part_file).name}
+    row = {
+        "level": spec.level,
+        "trial": spec.trial,
+        "parameter": s.parameter or "",
+        "value": s.level_label(spec.level),
+        "part": Path(part_file).name,
+    }
     rolls = [math.radians(r) for r in s.rolls_deg]
     jaw_start = -JAW_START if rolls[0] > 0 else JAW_START
     rule = s.method if s.method in ("paper", "likelihood") else "paper"
@@ -400,13 +470,17 @@ def run_trial(spec: TrialSpec) -> dict:
             raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")
         run = None
         for restarts in range(20):  # noqa: B007 (the count is reported after the loop)
-            start = float(part.wrap_arc(tracks.sigma[int(rng.choice(candidates))]
-                                        + rng.uniform(-0.5, 0.5) * tracks.h))
+            start = float(part.wrap_arc(tracks.sigma[int(rng.choice(candidates))] + rng.uniform(-0.5, 0.5) * tracks.h))
             rig_seed = int(rng.integers(1 << 31))
             rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine)
             try:
-                run = roll_sequence(rig, rolls, calibration=cal, step=math.radians(s.step_deg),
-                                    approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0))
+                run = roll_sequence(
+                    rig,
+                    rolls,
+                    calibration=cal,
+                    step=math.radians(s.step_deg),
+                    approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0),
+                )
             except RigError:
                 continue
             if abs(float(part.arc_offset(run[0].truth[0][0], start))) > 1.0:  # laid off the point
@@ -417,27 +491,68 @@ def run_trial(spec: TrialSpec) -> dict:
             raise RigError("no start out of 20 let the rolls run on the simulated rig")
     except Exception as exc:  # the trial broke before any method could run: every method's failure
         text = f"{type(exc).__name__}: {exc}"[:200]
-        row.update({"start_arc": math.nan, "true_arc": math.nan, "estimate_arc": math.nan, "error_mm": math.inf,
-                    "success": 0, "candidates": 0, "probability": 0.0, "ambiguous": 0, "lengths": "",
-                    "turns": "", "restarts": 0, "failure": text})
+        row.update(
+            {
+                "start_arc": math.nan,
+                "true_arc": math.nan,
+                "estimate_arc": math.nan,
+                "error_mm": math.inf,
+                "success": 0,
+                "candidates": 0,
+                "probability": 0.0,
+                "ambiguous": 0,
+                "lengths": "",
+                "turns": "",
+                "restarts": 0,
+                "failure": text,
+            }
+        )
         for m in s.methods:
-            row.update({f"{m}_success": 0, f"{m}_error_mm": math.inf, f"{m}_estimate_arc": math.nan,
-                        f"{m}_rotation_deg": math.nan, f"{m}_curve": "", f"{m}_stopped": "error", f"{m}_mass": "",
-                        f"{m}_failure": text, f"{m}_bridges": ""})
+            row.update(
+                {
+                    f"{m}_success": 0,
+                    f"{m}_error_mm": math.inf,
+                    f"{m}_estimate_arc": math.nan,
+                    f"{m}_rotation_deg": math.nan,
+                    f"{m}_curve": "",
+                    f"{m}_stopped": "error",
+                    f"{m}_mass": "",
+                    f"{m}_failure": text,
+                    f"{m}_bridges": "",
+                }
+            )
         row["time_s"] = time.perf_counter() - t0
         return row
     true_arc = rig.truth()["contact_arc"]
-    row.update({"start_arc": start, "true_arc": true_arc, "restarts": restarts, "failure": "",
-                "lengths": " ".join(f"{r.length:.6f}" for r in run), "turns": " ".join(f"{r.turn:.8f}" for r in run)})
+    row.update(
+        {
+            "start_arc": start,
+            "true_arc": true_arc,
+            "restarts": restarts,
+            "failure": "",
+            "lengths": " ".join(f"{r.length:.6f}" for r in run),
+            "turns": " ".join(f"{r.turn:.8f}" for r in run),
+        }
+    )
     rules: dict = {}
     own = score_rule(s, part, run, rule, true_arc, rules)
-    row.update({"estimate_arc": own["estimate_arc"], "error_mm": own["error_mm"],
-                "success": int(own["error_mm"] < s.success_radius), "candidates": own["candidates"],
-                "probability": own["probability"], "ambiguous": own["ambiguous"],
-                "failure": "" if s.methods else own["failure"]})
+    row.update(
+        {
+            "estimate_arc": own["estimate_arc"],
+            "error_mm": own["error_mm"],
+            "success": int(own["error_mm"] < s.success_radius),
+            "candidates": own["candidates"],
+            "probability": own["probability"],
+            "ambiguous": own["ambiguous"],
+            "failure": "" if s.methods else own["failure"],
+        }
+    )
     if s.methods:
-        row.update(score_methods(s, part, noise, cal, run, start, rig_seed, true_arc, rules,
-                                 filter_class=spec.extra.get("filter_class")))
+        row.update(
+            score_methods(
+                s, part, noise, cal, run, start, rig_seed, true_arc, rules, filter_class=spec.extra.get("filter_class")
+            )
+        )
         first_method = s.methods[0]
         for key in ("success", "error_mm", "estimate_arc"):
             row[key] = row[f"{first_method}_{key}"]

@@ -32,7 +32,7 @@ def _roll(flt, part, start=40.0, steps=125):
     for k, (a, t) in enumerate(zip(arcs - flt.grid[i], turns)):
         flt.update(float(a), float(t))
         if isinstance(flt, ContactFilter) and k % 5 == 4:
-            flt.belief()          # as the reactive procedure checks every 5 steps (and prunes)
+            flt.belief()  # as the reactive procedure checks every 5 steps (and prunes)
     return float(arcs[-1] - flt.grid[i]), float(turns[-1])
 
 
@@ -91,7 +91,10 @@ def test_reach_build(benchmark, part100, name):
 
     from localizer import Reach, load_part
 
-    part = part100 if name == "egg100" else load_part(
-        Path(__file__).resolve().parent / "parts" / "heldout-a" / "star-16.json")
+    part = (
+        part100
+        if name == "egg100"
+        else load_part(Path(__file__).resolve().parent / "parts" / "heldout-a" / "star-16.json")
+    )
     r = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)
     benchmark.extra_info.update({"perimeter_mm": round(part.perimeter, 1), "grid": int(r.sigma.size)})

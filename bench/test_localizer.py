@@ -46,15 +46,17 @@ def test_exact_query_vs_perimeter_integration(benchmark, part, queries):
     integration = min(_timed(trapezoid_perimeter, part) for _ in range(3))
     per_query = benchmark.stats.stats.min / N_QUERIES
     ratio = integration / per_query
-    benchmark.extra_info.update({
-        "part": "trefoil (90 knots, non-convex)",
-        "query_s": per_query,
-        "trapezoid_perimeter_h1e-5_s": integration,
-        "ratio": ratio,
-        "target_ratio": 1000,
-        "bar_ratio": 100,
-        "mean_candidates": float(np.mean([len(r) for r in results])),
-    })
+    benchmark.extra_info.update(
+        {
+            "part": "trefoil (90 knots, non-convex)",
+            "query_s": per_query,
+            "trapezoid_perimeter_h1e-5_s": integration,
+            "ratio": ratio,
+            "target_ratio": 1000,
+            "bar_ratio": 100,
+            "mean_candidates": float(np.mean([len(r) for r in results])),
+        }
+    )
     print(f"\nexact query {per_query * 1e3:.3f} ms, perimeter integration {integration:.3f} s, ratio {ratio:.0f}x")
     assert ratio >= 100
 

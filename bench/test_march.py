@@ -39,13 +39,19 @@ def test_march_query_at_paper_step(benchmark, part, query):
     t0 = time.perf_counter()
     exact = feasible_segments(part, L, w)
     t_exact = time.perf_counter() - t0
-    benchmark.extra_info.update({
-        "h": H, "steps": res.steps, "steps_per_period": res.steps / res.grid_cells, "bound": 6,
-        "segments_march": len(res.segments), "segments_exact": len(exact),
-        "march_error_mm": nearest,
-        "exact_error_mm": min(abs(part.arc_offset(g.start_arc, s0)) for g in exact),
-        "exact_s": t_exact,
-    })
+    benchmark.extra_info.update(
+        {
+            "h": H,
+            "steps": res.steps,
+            "steps_per_period": res.steps / res.grid_cells,
+            "bound": 6,
+            "segments_march": len(res.segments),
+            "segments_exact": len(exact),
+            "march_error_mm": nearest,
+            "exact_error_mm": min(abs(part.arc_offset(g.start_arc, s0)) for g in exact),
+            "exact_s": t_exact,
+        }
+    )
     if not benchmark.disabled:
         benchmark.extra_info["march_over_exact"] = benchmark.stats.stats.min / t_exact
 
@@ -66,6 +72,12 @@ def test_proposition_1_ratio(benchmark):
     rows = benchmark.pedantic(proposition_1, args=(2, 11), kwargs=dict(h=1e-4), rounds=1, iterations=1)
     ok = [r for r in rows if r["measured"] is not None and r["kind"] == "simple"]
     dev = np.array([abs(r["measured"] - r["predicted"]) for r in ok])
-    benchmark.extra_info.update({"segments": len(rows), "measured": len(ok),
-                                 "abs_dev_median": float(np.median(dev)), "abs_dev_max": float(dev.max())})
+    benchmark.extra_info.update(
+        {
+            "segments": len(rows),
+            "measured": len(ok),
+            "abs_dev_median": float(np.median(dev)),
+            "abs_dev_max": float(dev.max()),
+        }
+    )
     assert len(ok) >= 10 and dev.max() < 0.01

@@ -18,7 +18,7 @@ STUDY = Path(__file__).resolve().parent / "studies" / "paper.toml"
 @pytest.mark.parametrize("engine", ["kinematic", "pymunk"])
 def test_trial_rate(benchmark, engine):
     study = load_study(STUDY).with_overrides(engine=engine)
-    counter = iter(range(10 ** 6))
+    counter = iter(range(10**6))
 
     def one():
         return run_trial(TrialSpec(study, 0, next(counter)))
@@ -41,7 +41,8 @@ def test_two_worker_speedup(benchmark, tmp_path):
     benchmark.pedantic(run, args=(2,), rounds=1, iterations=1)
     run(1)
     speedup = timings[1] / timings[2]
-    benchmark.extra_info.update({"one_worker_s": timings[1], "two_workers_s": timings[2], "speedup": speedup,
-                                 "target": 1.7})
+    benchmark.extra_info.update(
+        {"one_worker_s": timings[1], "two_workers_s": timings[2], "speedup": speedup, "target": 1.7}
+    )
     if not benchmark.disabled:
         assert speedup >= 1.5  # the target is 1.7; a busy machine may lose a little

@@ -110,8 +110,7 @@ class Emulator:
                 r = self.rig.servo(float(target), float(gain), guard=bool(guard), duration=ms / 1000.0)
             except Exception as exc:  # the arm refuses, it does not crash
                 return [encode_reply(seq, "ERR", "FAULT", str(exc).replace(" ", "_")[:80])]
-            return [encode_reply(seq, "OK", r["dv1"], r["dv1_std"], float(r["contact_lost"]),
-                                 r["min_energy"])]
+            return [encode_reply(seq, "OK", r["dv1"], r["dv1_std"], float(r["contact_lost"]), r["min_energy"])]
         return [encode_reply(seq, "OK", "READY")]
 
     def _sample(self, n):
@@ -226,9 +225,11 @@ class Emulator:
             def shutdown(c=conn):
                 with contextlib.suppress(OSError):
                     c.shutdown(socket.SHUT_RDWR)
+
             self._closers.append(shutdown)
-            threading.Thread(target=self._serve, args=(device, lambda c=conn: c.recv(4096), conn.sendall),
-                             daemon=True).start()
+            threading.Thread(
+                target=self._serve, args=(device, lambda c=conn: c.recv(4096), conn.sendall), daemon=True
+            ).start()
 
     def serve_pty(self):
         """Serve on two pseudo-terminals; returns their device paths (arm, DAQ)."""
@@ -239,9 +240,11 @@ class Emulator:
             tty.setraw(slave)
             self._closers.append(lambda m=master: os.close(m))
             self._closers.append(lambda s=slave: os.close(s))
-            threading.Thread(target=self._serve, args=(device, lambda m=master: os.read(m, 4096),
-                                                       lambda data, m=master: os.write(m, data)),
-                             daemon=True).start()
+            threading.Thread(
+                target=self._serve,
+                args=(device, lambda m=master: os.read(m, 4096), lambda data, m=master: os.write(m, data)),
+                daemon=True,
+            ).start()
             paths.append(os.ttyname(slave))
         return tuple(paths)
 

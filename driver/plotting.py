@@ -48,8 +48,14 @@ def plot_localization(part, result, path, *, title: str | None = None):
     ax.plot(*part.point(0.0), "k^", ms=6, label="arc 0 (first point)")
     for k, seg in enumerate(result.segments):
         xy = _arc_points(part, seg.start_arc, seg.length, sign)
-        ax.plot(xy[:, 0], xy[:, 1], color="tab:orange", lw=4, alpha=0.45,
-                label="feasible segments of roll 1" if k == 0 else None)
+        ax.plot(
+            xy[:, 0],
+            xy[:, 1],
+            color="tab:orange",
+            lw=4,
+            alpha=0.45,
+            label="feasible segments of roll 1" if k == 0 else None,
+        )
     cmap = plt.get_cmap("viridis")
     for k, cand in enumerate(result.candidates):
         if cand.probability <= 0:
@@ -60,14 +66,16 @@ def plot_localization(part, result, path, *, title: str | None = None):
             ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=1.6, ls="-" if j == 0 else "--")
         end = part.point_at_arc(cand.end_arc)
         if cand.probability >= 0.01:
-            ax.annotate(f"p={cand.probability:.2f}", end, textcoords="offset points", xytext=(6, 6),
-                        fontsize=8, color=colour)
+            ax.annotate(
+                f"p={cand.probability:.2f}", end, textcoords="offset points", xytext=(6, 6), fontsize=8, color=colour
+            )
     best = result.best
     if best is not None:
         start, end = part.point_at_arc(best.start_arc), part.point_at_arc(best.end_arc)
         ax.plot(*start, "o", color="tab:blue", ms=8, label=f"start {best.start_arc:.2f} mm")
-        ax.plot(*end, "*", color="tab:red", ms=16,
-                label=f"contact now {best.end_arc:.2f} mm (p={best.probability:.2f})")
+        ax.plot(
+            *end, "*", color="tab:red", ms=16, label=f"contact now {best.end_arc:.2f} mm (p={best.probability:.2f})"
+        )
     verdict = "ambiguous" if result.ambiguous else "localized"
     rolls = ", ".join(f"({L:.2f} mm, {np.degrees(w):.2f}°)" for L, w in result.rolls)
     ax.set_title(title or f"{part.name}: {verdict} from rolls {rolls}\nrule: {result.rule}", fontsize=9)
@@ -100,25 +108,42 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
     for k, i in enumerate(boundaries):
         phi = cols["phi"][i]
         e = np.array([np.cos(phi), np.sin(phi)])
-        at = cols["true_arc"][i] if has_truth else (result.best.path[min(k, len(result.best.path) - 1)]
-                                                        if result.best else np.nan)
+        at = (
+            cols["true_arc"][i]
+            if has_truth
+            else (result.best.path[min(k, len(result.best.path) - 1)] if result.best else np.nan)
+        )
         if not np.isfinite(at):
             continue
         c = part.point_at_arc(at)
         u = jaw[i]
         ends = np.array([c - (u + half_span) * e, c + (half_span - u) * e])
-        ax.plot(ends[:, 0], ends[:, 1], color="tab:gray", lw=3, alpha=0.5,
-                label="jaw at the start and end of each roll" if k == 0 else None)
+        ax.plot(
+            ends[:, 0],
+            ends[:, 1],
+            color="tab:gray",
+            lw=3,
+            alpha=0.5,
+            label="jaw at the start and end of each roll" if k == 0 else None,
+        )
     if has_truth:
         arcs = cols["true_arc"]
         xy = part.point_at_arc(arcs)
         ax.plot(xy[:, 0], xy[:, 1], ".", color="tab:green", ms=3, label="true contacts")
-        ax.plot(*part.point_at_arc(arcs[-1]), "*", color="tab:green", ms=16, label=f"true contact now {arcs[-1]:.2f} mm")
+        ax.plot(
+            *part.point_at_arc(arcs[-1]), "*", color="tab:green", ms=16, label=f"true contact now {arcs[-1]:.2f} mm"
+        )
     for j, cand in enumerate(result.candidates[:5]):
         if cand.probability < 0.01:
             continue
-        ax.plot(*part.point_at_arc(cand.end_arc), "x", color="tab:red", ms=10 if j == 0 else 7, mew=2,
-                label=(f"estimate {cand.end_arc:.2f} mm (p={cand.probability:.2f})" if j == 0 else None))
+        ax.plot(
+            *part.point_at_arc(cand.end_arc),
+            "x",
+            color="tab:red",
+            ms=10 if j == 0 else 7,
+            mew=2,
+            label=(f"estimate {cand.end_arc:.2f} mm (p={cand.probability:.2f})" if j == 0 else None),
+        )
     title = f"{part.name}: {trace.metadata.get('engine', '')} rig, noise {trace.metadata.get('noise_name', '')}"
     if has_truth and result.best is not None:
         err = abs(float(part.arc_offset(result.best.end_arc, cols["true_arc"][-1])))

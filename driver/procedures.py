@@ -25,8 +25,21 @@ from localizer import Localization, Part, arc_from_jaw_positions, localize
 
 from .rig import Rig, RigError
 
-__all__ = ["hold_force", "Calibration", "Hand", "RollResult", "RollingRun", "zero", "press", "establish_contact",
-           "calibrate", "edge_offset", "roll", "roll_sequence", "localize_by_rolling"]
+__all__ = [
+    "hold_force",
+    "Calibration",
+    "Hand",
+    "RollResult",
+    "RollingRun",
+    "zero",
+    "press",
+    "establish_contact",
+    "calibrate",
+    "edge_offset",
+    "roll",
+    "roll_sequence",
+    "localize_by_rolling",
+]
 
 
 # ------------------------------------------------------------------ hand
@@ -73,9 +86,21 @@ def _delta(rig: Rig, baseline, n: int):
     return v1 - baseline[0], v2 - baseline[1]
 
 
-def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0.01, n: int = 32,
-          slope: float = 0.4, search_step: float = 0.25, max_travel: float = 15.0,
-          overload: float = 2.0, max_steps: int = 60, servo: dict | None = None) -> tuple:
+def press(
+    rig: Rig,
+    hand: Hand,
+    baseline,
+    *,
+    target: float = 0.4,
+    tol: float = 0.01,
+    n: int = 32,
+    slope: float = 0.4,
+    search_step: float = 0.25,
+    max_travel: float = 15.0,
+    overload: float = 2.0,
+    max_steps: int = 60,
+    servo: dict | None = None,
+) -> tuple:
     """Translate along the jaw normal until Δv1 = ``target`` ± ``tol`` V (the paper's feedback).
 
     Parameters
@@ -101,8 +126,10 @@ def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0
     threshold = 0.1 * target
     while dv1 < threshold:
         if travelled >= max_travel:
-            raise RigError(f"no contact after pressing {travelled:.1f} mm along the jaw normal "
-                           f"(Δv1 = {dv1:.3f} V); start closer to the part")
+            raise RigError(
+                f"no contact after pressing {travelled:.1f} mm along the jaw normal "
+                f"(Δv1 = {dv1:.3f} V); start closer to the part"
+            )
         hand.press_by(search_step)
         travelled += search_step
         dv1, dv2 = _delta(rig, baseline, n)
@@ -127,8 +154,15 @@ def press(rig: Rig, hand: Hand, baseline, *, target: float = 0.4, tol: float = 0
     raise RigError(f"Δv1 did not settle at {target} ± {tol} V in {max_steps} moves (last {dv1:.3f} V)")
 
 
-def hold_force(rig: Rig, *, target: float = 0.4, gain: float = 2.0, guard: bool = True,
-               duration: float = 0.5, max_std: float | None = None) -> dict:
+def hold_force(
+    rig: Rig,
+    *,
+    target: float = 0.4,
+    gain: float = 2.0,
+    guard: bool = True,
+    duration: float = 0.5,
+    max_std: float | None = None,
+) -> dict:
     """Hold Δv1 = ``target`` V with the arm's own sampled force servo, optionally passivity-guarded.
 
     The paper's feedback (translate along the normal until Δv1 ≈ 0.4 V) as a
@@ -157,8 +191,10 @@ def hold_force(rig: Rig, *, target: float = 0.4, gain: float = 2.0, guard: bool 
         raise RigError(f"{type(rig).__name__} has no force servo; use press() (move-and-read)")
     report = servo(target, gain, guard=guard, duration=duration)
     if report["contact_lost"] > 0:
-        raise RigError(f"the force servo lost the part for {report['contact_lost']} samples at gain {gain:g} "
-                       f"(guard {'on' if guard else 'off'}); lower the gain or switch the guard on")
+        raise RigError(
+            f"the force servo lost the part for {report['contact_lost']} samples at gain {gain:g} "
+            f"(guard {'on' if guard else 'off'}); lower the gain or switch the guard on"
+        )
     if max_std is not None and report["dv1_std"] > max_std:
         raise RigError(f"the force servo rings: Δv1 std {report['dv1_std']:.4f} V > {max_std} V at gain {gain:g}")
     return report
@@ -207,8 +243,10 @@ class Calibration:
         steps = np.diff(rg)
         if not (np.all(steps < 0) or np.all(steps > 0)):
             k = int(np.argmax(np.sign(steps) != np.sign(steps[0])))
-            raise RigError(f"calibration is not monotone near {grid[k]:.1f} mm on the jaw: a ratio there "
-                           "matches two contact locations; recalibrate with more averaging")
+            raise RigError(
+                f"calibration is not monotone near {grid[k]:.1f} mm on the jaw: a ratio there "
+                "matches two contact locations; recalibrate with more averaging"
+            )
         order = np.argsort(rg)
         object.__setattr__(self, "_r", rg[order])
         object.__setattr__(self, "_d", grid[order])
@@ -219,17 +257,25 @@ class Calibration:
         lo, hi = self._r[0], self._r[-1]
         margin = 0.02 * (hi - lo)
         if not (lo - margin <= r <= hi + margin):
-            raise RigError(f"ratio Δv2/Δv1 = {r:.5f} is outside the calibrated range [{lo:.5f}, {hi:.5f}]: "
-                           f"the contact is beyond the calibrated span {self.positions[0]:.0f}..{self.positions[-1]:.0f} mm")
+            raise RigError(
+                f"ratio Δv2/Δv1 = {r:.5f} is outside the calibrated range [{lo:.5f}, {hi:.5f}]: "
+                f"the contact is beyond the calibrated span {self.positions[0]:.0f}..{self.positions[-1]:.0f} mm"
+            )
         if r < lo or r > hi:  # a little beyond the ends: extrapolate the end slope
             j = (0, 1) if r < lo else (-2, -1)
-            return float(self._d[j[0]] + (r - self._r[j[0]]) * (self._d[j[1]] - self._d[j[0]]) / (self._r[j[1]] - self._r[j[0]]))
+            return float(
+                self._d[j[0]] + (r - self._r[j[0]]) * (self._d[j[1]] - self._d[j[0]]) / (self._r[j[1]] - self._r[j[0]])
+            )
         return float(np.interp(r, self._r, self._d))
 
     def save(self, path) -> None:
         """Write as JSON."""
-        Path(path).write_text(json.dumps({"positions": list(self.positions), "ratios": list(self.ratios),
-                                          "target": self.target}, indent=2) + "\n")
+        Path(path).write_text(
+            json.dumps(
+                {"positions": list(self.positions), "ratios": list(self.ratios), "target": self.target}, indent=2
+            )
+            + "\n"
+        )
 
     @classmethod
     def load(cls, path) -> Calibration:
@@ -241,8 +287,17 @@ class Calibration:
             raise RigError(f"calibration file {path}: {exc}") from None
 
 
-def calibrate(rig: Rig, approach_pose, *, taps: int = 11, span: float = 50.0, target: float = 0.4,
-              n: int = 256, backoff: float = 2.0, **press_options) -> Calibration:
+def calibrate(
+    rig: Rig,
+    approach_pose,
+    *,
+    taps: int = 11,
+    span: float = 50.0,
+    target: float = 0.4,
+    n: int = 256,
+    backoff: float = 2.0,
+    **press_options,
+) -> Calibration:
     """Tap an immobilized object at ``taps`` jaw positions from -span to +span mm (paper §III-B).
 
     ``approach_pose`` faces the object's contact point with jaw position 0, clear of it.
@@ -350,9 +405,21 @@ def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=Non
     return calibration.position(dv2 / dv1)
 
 
-def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float, *,
-         step: float = math.radians(0.2), n: int = 32, offset: float | None = None,
-         bridge_jump: float | None = 3.0, observer=None, index: int = 0, **press_options) -> RollResult:
+def roll(
+    rig: Rig,
+    hand: Hand,
+    baseline,
+    calibration: Calibration,
+    angle: float,
+    *,
+    step: float = math.radians(0.2),
+    n: int = 32,
+    offset: float | None = None,
+    bridge_jump: float | None = 3.0,
+    observer=None,
+    index: int = 0,
+    **press_options,
+) -> RollResult:
     """Roll by ``angle`` rad (positive: counter-clockwise) in steps of about ``step`` (paper §III-C).
 
     Each step rotates the jaw about the tool axis, then presses along the jaw
@@ -381,15 +448,38 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
     readings, truth = [], []
     k_steps = k
     if observer is not None:
-        observer({"event": "roll", "roll": index, "angle": angle, "step": angle / k_steps, "steps": k_steps,
-                  "offset": float(offset)})
+        observer(
+            {
+                "event": "roll",
+                "roll": index,
+                "angle": angle,
+                "step": angle / k_steps,
+                "steps": k_steps,
+                "offset": float(offset),
+            }
+        )
 
     def observe(j):
         if observer is not None:
             dv1, dv2, phi, tm, x, y, phi_cmd = readings[-1]
-            observer({"event": "reading", "roll": index, "step": j, "time": tm, "x": x, "y": y,
-                      "phi_command": phi_cmd, "phi": phi, "dv1": dv1, "dv2": dv2, "jaw_position": d[-1],
-                      "true_arc": truth[-1][0], "true_jaw_position": truth[-1][1], "steps": k_steps})
+            observer(
+                {
+                    "event": "reading",
+                    "roll": index,
+                    "step": j,
+                    "time": tm,
+                    "x": x,
+                    "y": y,
+                    "phi_command": phi_cmd,
+                    "phi": phi,
+                    "dv1": dv1,
+                    "dv2": dv2,
+                    "jaw_position": d[-1],
+                    "true_arc": truth[-1][0],
+                    "true_jaw_position": truth[-1][1],
+                    "steps": k_steps,
+                }
+            )
 
     d = [_location(rig, baseline, calibration, n, readings, truth, hand)]
     observe(0)
@@ -402,23 +492,35 @@ def roll(rig: Rig, hand: Hand, baseline, calibration: Calibration, angle: float,
         except RigError:
             if bridge_jump is not None and j > 0:  # left the calibrated span in one jump
                 hand.press_by(-5.0)
-                raise RigError(f"step {j + 1} of the roll bridged a concave stretch: the contact left the "
-                               f"calibrated span from {d[-1]:.1f} mm in one step. A straight jaw touches the "
-                               "convex hull there; start where the rolls stay on convex stretches") from None
+                raise RigError(
+                    f"step {j + 1} of the roll bridged a concave stretch: the contact left the "
+                    f"calibrated span from {d[-1]:.1f} mm in one step. A straight jaw touches the "
+                    "convex hull there; start where the rolls stay on convex stretches"
+                ) from None
             raise
         phis.append(rig.pose()[2])
         observe(j + 1)
         if bridge_jump is not None and abs(d[-1] - d[-2]) > bridge_jump:
             hand.press_by(-5.0)
-            raise RigError(f"step {j + 1} of the roll bridged a concave stretch: the contact jumped "
-                           f"{abs(d[-1] - d[-2]):.1f} mm on the jaw (limit {bridge_jump} mm). A straight jaw "
-                           "touches the convex hull there; start where the rolls stay on convex stretches")
+            raise RigError(
+                f"step {j + 1} of the roll bridged a concave stretch: the contact jumped "
+                f"{abs(d[-1] - d[-2]):.1f} mm on the jaw (limit {bridge_jump} mm). A straight jaw "
+                "touches the convex hull there; start where the rolls stay on convex stretches"
+            )
     sign = 1.0 if angle > 0 else -1.0
     du = np.diff(d)
-    return RollResult(length=arc_from_jaw_positions(d, angle / k, offset), turn=phis[-1] - phis[0],
-                      positions=tuple(d), angles=tuple(phis), largest_jump=float(np.abs(du).max()),
-                      jaw_travel=float(sign * (d[-1] - d[0])), offset=float(offset), step=angle / k,
-                      readings=tuple(readings), truth=tuple(truth))
+    return RollResult(
+        length=arc_from_jaw_positions(d, angle / k, offset),
+        turn=phis[-1] - phis[0],
+        positions=tuple(d),
+        angles=tuple(phis),
+        largest_jump=float(np.abs(du).max()),
+        jaw_travel=float(sign * (d[-1] - d[0])),
+        offset=float(offset),
+        step=angle / k,
+        readings=tuple(readings),
+        truth=tuple(truth),
+    )
 
 
 @dataclass(frozen=True)
@@ -447,13 +549,27 @@ class RollingRun:
         return float("nan") if best is None else best.end_arc
 
     def as_dict(self) -> dict:
-        return {"estimates": [list(e) for e in self.estimates], "rolls": [asdict(r) for r in self.rolls],
-                "estimate_arc": self.estimate_arc, "ambiguous": self.localization.ambiguous,
-                "candidates": [c.as_dict() for c in self.localization.candidates]}
+        return {
+            "estimates": [list(e) for e in self.estimates],
+            "rolls": [asdict(r) for r in self.rolls],
+            "estimate_arc": self.estimate_arc,
+            "ambiguous": self.localization.ambiguous,
+            "candidates": [c.as_dict() for c in self.localization.candidates],
+        }
 
 
-def roll_sequence(rig: Rig, rolls, *, calibration: Calibration, approach_pose, step: float = math.radians(0.2),
-                  n: int = 32, bridge_jump: float = 3.0, observer=None, **press_options) -> tuple:
+def roll_sequence(
+    rig: Rig,
+    rolls,
+    *,
+    calibration: Calibration,
+    approach_pose,
+    step: float = math.radians(0.2),
+    n: int = 32,
+    bridge_jump: float = 3.0,
+    observer=None,
+    **press_options,
+) -> tuple:
     """Establish contact and roll by each angle of ``rolls`` (rad), all the same way; no localization.
 
     Returns the tuple of :class:`RollResult`. A roll that bridges a concave stretch is
@@ -468,34 +584,75 @@ def roll_sequence(rig: Rig, rolls, *, calibration: Calibration, approach_pose, s
     results = []
     for k, angle in enumerate(rolls):
         try:
-            results.append(roll(rig, hand, baseline, calibration, angle, step=step, n=n,
-                                bridge_jump=bridge_jump, observer=observer, index=k, **press_options))
+            results.append(
+                roll(
+                    rig,
+                    hand,
+                    baseline,
+                    calibration,
+                    angle,
+                    step=step,
+                    n=n,
+                    bridge_jump=bridge_jump,
+                    observer=observer,
+                    index=k,
+                    **press_options,
+                )
+            )
         except RigError as exc:
             raise RigError(f"roll {k + 1}: {exc}") from None
     return tuple(results)
 
 
-def localize_by_rolling(rig: Rig, part: Part, rolls, *, calibration: Calibration, approach_pose,
-                        step: float = math.radians(0.2), n: int = 32, bridge_jump: float = 3.0,
-                        rule: str = "likelihood", sd_length: float = 0.5,
-                        sd_turn: float = math.radians(0.03), observer=None, **press_options) -> RollingRun:
+def localize_by_rolling(
+    rig: Rig,
+    part: Part,
+    rolls,
+    *,
+    calibration: Calibration,
+    approach_pose,
+    step: float = math.radians(0.2),
+    n: int = 32,
+    bridge_jump: float = 3.0,
+    rule: str = "likelihood",
+    sd_length: float = 0.5,
+    sd_turn: float = math.radians(0.03),
+    observer=None,
+    **press_options,
+) -> RollingRun:
     """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
 
     All rolls turn the same way. Rolls that bridge a concave stretch are
     refused (:func:`roll`, ``bridge_jump``): the pipeline localizes on the part,
     never on its convex hull.
     """
-    results = roll_sequence(rig, rolls, calibration=calibration, approach_pose=approach_pose, step=step, n=n,
-                            bridge_jump=bridge_jump, observer=observer, **press_options)
+    results = roll_sequence(
+        rig,
+        rolls,
+        calibration=calibration,
+        approach_pose=approach_pose,
+        step=step,
+        n=n,
+        bridge_jump=bridge_jump,
+        observer=observer,
+        **press_options,
+    )
     estimates = tuple((r.length, r.turn) for r in results)
     direction = "ccw" if results[0].step > 0 else "cw"
     loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)
-    return RollingRun(rolls=results, estimates=estimates, localization=loc,
-                      samples=list(getattr(rig, "samples", [])))
+    return RollingRun(rolls=results, estimates=estimates, localization=loc, samples=list(getattr(rig, "samples", [])))
 
 
-def run_from_here(rig: Rig, part: Part, rolls, *, calibration: Calibration | None = None,
-                  slide: float = 40.0, observer=None, **options):
+def run_from_here(
+    rig: Rig,
+    part: Part,
+    rolls,
+    *,
+    calibration: Calibration | None = None,
+    slide: float = 40.0,
+    observer=None,
+    **options,
+):
     """The whole job from the arm's present pose, as ``rolltouch run`` does it.
 
     The operator has jogged the jaw's centre to face the start point on the
@@ -513,12 +670,19 @@ def run_from_here(rig: Rig, part: Part, rolls, *, calibration: Calibration | Non
     if calibration is None:
         calibration = calibrate(rig, here)
         if observer is not None:
-            observer({"event": "calibration", "positions": list(calibration.positions),
-                      "ratios": list(calibration.ratios), "target": calibration.target})
+            observer(
+                {
+                    "event": "calibration",
+                    "positions": list(calibration.positions),
+                    "ratios": list(calibration.ratios),
+                    "target": calibration.target,
+                }
+            )
         Hand(rig, here)
     x, y, phi = here
     s = slide if rolls[0] > 0 else -slide
     start = (x + s * math.cos(phi), y + s * math.sin(phi), phi)
-    run = localize_by_rolling(rig, part, rolls, calibration=calibration, approach_pose=start,
-                              observer=observer, **options)
+    run = localize_by_rolling(
+        rig, part, rolls, calibration=calibration, approach_pose=start, observer=observer, **options
+    )
     return run, calibration

@@ -14,8 +14,17 @@ from dataclasses import dataclass
 
 from .rig import ProtocolError, RigError
 
-__all__ = ["Reply", "encode_request", "encode_reply", "parse_reply", "parse_request", "checksum",
-           "ARM_COMMANDS", "DAQ_COMMANDS", "MAX_LINE"]
+__all__ = [
+    "Reply",
+    "encode_request",
+    "encode_reply",
+    "parse_reply",
+    "parse_request",
+    "checksum",
+    "ARM_COMMANDS",
+    "DAQ_COMMANDS",
+    "MAX_LINE",
+]
 
 #: Commands of each device and their argument counts.
 ARM_COMMANDS = {"MOVE": 3, "POSE": 0, "STOP": 0, "STATUS": 0, "SERVO": 4}
@@ -105,7 +114,7 @@ def parse_reply(line: bytes) -> Reply:
     star = text.rfind(b" *")
     if star < 0 or len(text) - star != 4:
         raise RigError(f"reply {text[:40]!r} has no ' *cc' checksum at its end: a garbled line")
-    body, given = text[:star], text[star + 2:]
+    body, given = text[:star], text[star + 2 :]
     try:
         given_s = given.decode("ascii").upper()
         body_s = body.decode("ascii")

@@ -106,8 +106,7 @@ class ReactiveRun:
         return self.belief.map_arc
 
 
-def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = (0.0, 0.0),
-                        starts=None) -> tuple:
+def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = (0.0, 0.0), starts=None) -> tuple:
     """(spread ccw, spread cw) in mm: how far apart hypotheses' predicted arcs move over the next
     ``lookahead`` rad of *unexplored* rotation each way.
 
@@ -151,13 +150,28 @@ def _jaw_now(flt: ContactFilter, idx) -> dict:
     return {"jaw": flt.jaw_position, "at": flt.current[idx]}
 
 
-def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, approach_pose,
-                        filter: ContactFilter | None = None, step: float = math.radians(0.2), n: int = 32,
-                        confidence: float = 0.95, max_rotation: float = math.radians(120.0),
-                        direction: int | None = None, check_every: int = 5, lookahead: float = math.radians(15.0),
-                        bridge_jump: float = 3.0, end_margin: float = 5.0, backoff: float = 2.0,
-                        min_spread: float = 0.05, confirm: int = CONFIRM, observer=None,
-                        **press_options) -> ReactiveRun:
+def localize_reactively(
+    rig: Rig,
+    part: Part,
+    *,
+    calibration: Calibration,
+    approach_pose,
+    filter: ContactFilter | None = None,
+    step: float = math.radians(0.2),
+    n: int = 32,
+    confidence: float = 0.95,
+    max_rotation: float = math.radians(120.0),
+    direction: int | None = None,
+    check_every: int = 5,
+    lookahead: float = math.radians(15.0),
+    bridge_jump: float = 3.0,
+    end_margin: float = 5.0,
+    backoff: float = 2.0,
+    min_spread: float = 0.05,
+    confirm: int = CONFIRM,
+    observer=None,
+    **press_options,
+) -> ReactiveRun:
     """Roll until the contact is known within the filter's radius with ``confidence`` (module notes).
 
     Parameters
@@ -231,7 +245,7 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
         direction = 1  # nothing is known yet: counter-clockwise, like the paper
     stopped = "max_rotation"
     belief = None
-    sure = 0                      # checks in a row at or above the confidence
+    sure = 0  # checks in a row at or above the confidence
     while rotation < max_rotation - 1e-12:
         s = direction * step
         hand.rotate_by(s)
@@ -306,9 +320,17 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             true_arc = truth[-1][0] if truth else math.nan
             history.append((rotation, belief.map_arc, belief.mass, true_arc))
             if observer is not None:
-                observer({"event": "belief", "rotation": rotation, "map_arc": belief.map_arc, "mass": belief.mass,
-                          "modes": [(m.arc, m.mass) for m in belief.modes[:4]], "true_arc": true_arc,
-                          "direction": direction})
+                observer(
+                    {
+                        "event": "belief",
+                        "rotation": rotation,
+                        "map_arc": belief.map_arc,
+                        "mass": belief.mass,
+                        "modes": [(m.arc, m.mass) for m in belief.modes[:4]],
+                        "true_arc": true_arc,
+                        "direction": direction,
+                    }
+                )
             sure = sure + 1 if belief.mass >= confidence else 0
             if sure >= confirm:
                 stopped = "confident"
@@ -318,8 +340,11 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
             # detected and undone all the same, and turning round towards a way that is no better
             # only rocks the jaw in place)
             beyond = explored[0] if direction == 1 else explored[1]
-            if (not blocked[-direction] and clear_ahead(flt, direction, lookahead) < 0.5
-                    and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5):
+            if (
+                not blocked[-direction]
+                and clear_ahead(flt, direction, lookahead) < 0.5
+                and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5
+            ):
                 direction = -direction
                 reversals += 1
                 continue
@@ -331,13 +356,27 @@ def localize_reactively(rig: Rig, part: Part, *, calibration: Calibration, appro
                 continue
             ccw, cw = spread_by_direction(flt, lookahead, tuple(explored), [m.start_arc for m in strong[:2]])
             ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
-            if (ahead < min_spread and behind > 3 * min_spread
-                    and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5):
+            if (
+                ahead < min_spread
+                and behind > 3 * min_spread
+                and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5
+            ):
                 direction = -direction
                 reversals += 1
     if belief is None or belief.steps != flt.steps:
         belief = flt.belief()
         history.append((rotation, belief.map_arc, belief.mass, truth[-1][0] if truth else math.nan))
-    return ReactiveRun(belief=belief, rotation=rotation, steps=steps, stopped=stopped, reversals=reversals,
-                       regrasps=regrasps, bridges=bridges, history=tuple(history), arcs=tuple(arcs), turns=tuple(turns),
-                       true_arcs=tuple(true_arcs), segments=tuple(segments))
+    return ReactiveRun(
+        belief=belief,
+        rotation=rotation,
+        steps=steps,
+        stopped=stopped,
+        reversals=reversals,
+        regrasps=regrasps,
+        bridges=bridges,
+        history=tuple(history),
+        arcs=tuple(arcs),
+        turns=tuple(turns),
+        true_arcs=tuple(true_arcs),
+        segments=tuple(segments),
+    )

@@ -61,9 +61,20 @@ class SerialRig:
         Called with a dict for every command and reading (see :mod:`driver.runlog`).
     """
 
-    def __init__(self, arm_url: str, daq_url: str, *, timeout: float = 2.0, retries: int = 2,
-                 overload: float = 2.0, backoff: float = 5.0, workspace: Workspace = Workspace(),
-                 move_speed: float = 20.0, log=None, baudrate: int = 115200):
+    def __init__(
+        self,
+        arm_url: str,
+        daq_url: str,
+        *,
+        timeout: float = 2.0,
+        retries: int = 2,
+        overload: float = 2.0,
+        backoff: float = 5.0,
+        workspace: Workspace = Workspace(),
+        move_speed: float = 20.0,
+        log=None,
+        baudrate: int = 115200,
+    ):
         self.timeout = float(timeout)
         self.retries = int(retries)
         self.overload = float(overload)
@@ -76,8 +87,9 @@ class SerialRig:
         self.ports = {}
         try:
             for name, url in (("arm", arm_url), ("daq", daq_url)):
-                self.ports[name] = serial.serial_for_url(url, timeout=self.timeout, write_timeout=self.timeout,
-                                                         baudrate=baudrate)
+                self.ports[name] = serial.serial_for_url(
+                    url, timeout=self.timeout, write_timeout=self.timeout, baudrate=baudrate
+                )
         except (serial.SerialException, ValueError) as exc:
             self.close()
             raise RigError(f"cannot open the {name} at {url}: {exc}") from None
@@ -127,8 +139,9 @@ class SerialRig:
                         continue  # a late reply to an earlier try: skip it
                     if reply.status == "ERR":
                         code = reply.fields[0] if reply.fields else "ERR"
-                        raise ProtocolError(code, f"the {device} refused {command}: {' '.join(reply.fields[1:])}",
-                                            reply.seq)
+                        raise ProtocolError(
+                            code, f"the {device} refused {command}: {' '.join(reply.fields[1:])}", reply.seq
+                        )
                     if reply.status == "DATA":
                         continue
                     return reply
@@ -136,8 +149,7 @@ class SerialRig:
                 raise RigError(f"the {device} connection failed during {command}: {exc}") from None
             except OSError as exc:
                 raise RigError(f"the {device} connection failed during {command}: {exc}") from None
-            self._emit({"event": "retry", "device": device, "command": command, "try": attempt + 1,
-                        "problem": problem})
+            self._emit({"event": "retry", "device": device, "command": command, "try": attempt + 1, "problem": problem})
         raise RigError(f"the {device} did not answer {command} after {self.retries + 1} tries: {problem}")
 
     def _emit(self, event: dict) -> None:
@@ -149,8 +161,9 @@ class SerialRig:
         """MOVE to (x, y) mm, φ rad; returns when the arm reports arrival."""
         self.workspace.check(x, y, phi)
         distance = 0.0 if self._commanded is None else math.hypot(x - self._commanded[0], y - self._commanded[1])
-        self._transact("arm", "MOVE", float(x), float(y), math.degrees(phi),
-                       timeout=self.timeout + distance / self.move_speed)
+        self._transact(
+            "arm", "MOVE", float(x), float(y), math.degrees(phi), timeout=self.timeout + distance / self.move_speed
+        )
         self._commanded = (float(x), float(y), float(phi))
 
     def pose(self) -> tuple:
@@ -164,8 +177,10 @@ class SerialRig:
         self._emit({"event": "sample", "v1": v1, "v2": v2, "n": int(n)})
         if max(abs(v1), abs(v2)) >= 0.999 * self.input_range:
             self.safe_stop()
-            raise RigError(f"the sensor saturated (v1 = {v1:.3f} V, v2 = {v2:.3f} V at the DAQ's "
-                           f"±{self.input_range:g} V range): stopped and backed off")
+            raise RigError(
+                f"the sensor saturated (v1 = {v1:.3f} V, v2 = {v2:.3f} V at the DAQ's "
+                f"±{self.input_range:g} V range): stopped and backed off"
+            )
         if v1 > self.overload:
             self.safe_stop()
             raise RigError(f"v1 = {v1:.3f} V is above the overload limit {self.overload} V: stopped and backed off")
@@ -178,8 +193,9 @@ class SerialRig:
         the loop's port. Returns the same dict as :meth:`sim2d.SimRig.servo`.
         """
         ms = int(round(duration * 1000))
-        dv1, std, lost, energy = self._transact("arm", "SERVO", float(target), float(gain), int(bool(guard)), ms,
-                                                timeout=self.timeout + duration).numbers(4)
+        dv1, std, lost, energy = self._transact(
+            "arm", "SERVO", float(target), float(gain), int(bool(guard)), ms, timeout=self.timeout + duration
+        ).numbers(4)
         result = {"dv1": dv1, "dv1_std": std, "contact_lost": int(lost), "min_energy": energy, "guard": bool(guard)}
         self._emit(dict(result, event="servo", target=float(target), gain=float(gain)))
         return result

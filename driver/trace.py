@@ -56,14 +56,19 @@ class Trace:
         columns["roll"] = columns["roll"].astype(np.int64)
         columns["step"] = columns["step"].astype(np.int64)
         meta = dict(metadata)
-        meta.update({
-            "format": FORMAT,
-            "calibration": {"positions": list(calibration.positions), "ratios": list(calibration.ratios),
-                            "target": calibration.target},
-            "steps": [r.step for r in run.rolls],
-            "offsets": [r.offset for r in run.rolls],
-            "estimates": [list(e) for e in run.estimates],
-        })
+        meta.update(
+            {
+                "format": FORMAT,
+                "calibration": {
+                    "positions": list(calibration.positions),
+                    "ratios": list(calibration.ratios),
+                    "target": calibration.target,
+                },
+                "steps": [r.step for r in run.rolls],
+                "offsets": [r.offset for r in run.rolls],
+                "estimates": [list(e) for e in run.estimates],
+            }
+        )
         return cls(columns, meta)
 
     def save(self, path) -> None:
@@ -97,9 +102,15 @@ class Trace:
         cal = [e for e in events if e.get("event") == "calibration"]
         if cal and "calibration" not in meta:
             meta["calibration"] = {k: cal[0][k] for k in ("positions", "ratios", "target")}
-        meta.update({"format": FORMAT, "steps": [rolls[k]["step"] for k in keep],
-                     "offsets": [rolls[k]["offset"] for k in keep], "log": str(path),
-                     "complete": any(e.get("event") == "result" for e in events)})
+        meta.update(
+            {
+                "format": FORMAT,
+                "steps": [rolls[k]["step"] for k in keep],
+                "offsets": [rolls[k]["offset"] for k in keep],
+                "log": str(path),
+                "complete": any(e.get("event") == "result" for e in events),
+            }
+        )
         if "calibration" not in meta:
             raise RigError(f"run log {path}: its start event has no calibration")
         return cls(columns, meta)

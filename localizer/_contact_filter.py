@@ -144,7 +144,7 @@ def _bspline(x: float) -> tuple:
     """(indices, values) of the four uniform cubic B-splines that are nonzero at ``x`` (in knot steps)."""
     i = math.floor(x)
     u = x - i
-    vals = np.array([(1 - u) ** 3, 3 * u ** 3 - 6 * u ** 2 + 4, -3 * u ** 3 + 3 * u ** 2 + 3 * u + 1, u ** 3]) / 6
+    vals = np.array([(1 - u) ** 3, 3 * u**3 - 6 * u**2 + 4, -3 * u**3 + 3 * u**2 + 3 * u + 1, u**3]) / 6
     return i + np.arange(4), vals
 
 
@@ -216,17 +216,39 @@ class ContactFilter:
     False
     """
 
-    def __init__(self, part: Part, *, spacing: float = 0.02, sd_position: float = 0.035, sd_scale: float = 0.003,
-                 sd_slope: float = 0.001, shape_spacing: float = 5.0, radius: float = 0.3, mode_floor: float = 0.05,
-                 confidence: float = 0.95, prune: float = 40.0, refresh: int = 5, jaw: StraightJaw = DEFAULT_JAW,
-                 jaw_margin: float = 2.0, noise_scales=NOISE_SCALES, sd_jaw: float = 0.015,
-                 jaw_spacing: float = 5.0, sd_turn: float = ENCODER_SD, temper: float = TEMPER,
-                 sd_drift: float = 1e-4):
+    def __init__(
+        self,
+        part: Part,
+        *,
+        spacing: float = 0.02,
+        sd_position: float = 0.035,
+        sd_scale: float = 0.003,
+        sd_slope: float = 0.001,
+        shape_spacing: float = 5.0,
+        radius: float = 0.3,
+        mode_floor: float = 0.05,
+        confidence: float = 0.95,
+        prune: float = 40.0,
+        refresh: int = 5,
+        jaw: StraightJaw = DEFAULT_JAW,
+        jaw_margin: float = 2.0,
+        noise_scales=NOISE_SCALES,
+        sd_jaw: float = 0.015,
+        jaw_spacing: float = 5.0,
+        sd_turn: float = ENCODER_SD,
+        temper: float = TEMPER,
+        sd_drift: float = 1e-4,
+    ):
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")
-        for name, value in (("sd_scale", sd_scale), ("sd_slope", sd_slope), ("sd_jaw", sd_jaw), ("sd_turn", sd_turn),
-                            ("sd_drift", sd_drift)):
+        for name, value in (
+            ("sd_scale", sd_scale),
+            ("sd_slope", sd_slope),
+            ("sd_jaw", sd_jaw),
+            ("sd_turn", sd_turn),
+            ("sd_drift", sd_drift),
+        ):
             if not (math.isfinite(value) and value >= 0):
                 raise QueryError(f"{name}={value!r} must be ≥ 0")
         for name, value in (("shape_spacing", shape_spacing), ("jaw_spacing", jaw_spacing)):
@@ -264,7 +286,7 @@ class ContactFilter:
         self._rho_prior = float(np.clip(np.median(1.0 / convex), 5.0, 500.0)) if convex.size else 50.0
         # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
         self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
-        self._segments = 48                   # offsets: one per contact segment (see regrasp)
+        self._segments = 48  # offsets: one per contact segment (see regrasp)
         self._jaw0 = self._segments + (2 * self._k0 + 4 if sd_slope > 0 else 0)
         # then the calibration error's B-splines over the jaw's span and the margin beyond it
         self._jaw_lo = -(jaw.half + self.jaw_margin) - self.jaw_spacing
@@ -292,31 +314,31 @@ class ContactFilter:
     def reset(self) -> None:
         """Back to the prior: every start the jaw can touch equally likely, nothing measured."""
         n = self.grid.size
-        self.current = self.grid.copy()      # present contact of each hypothesis, mm (unwrapped)
+        self.current = self.grid.copy()  # present contact of each hypothesis, mm (unwrapped)
         self.feasible = self.tracks.convex.copy()
         m = self._m
-        self._up = np.zeros((m, n))           # Uᵀp per hypothesis (row 0: Σp)
+        self._up = np.zeros((m, n))  # Uᵀp per hypothesis (row 0: Σp)
         self._spp = np.zeros(n)
         self._szp = np.zeros(n)
-        self._uz = np.zeros(m)                # Uᵀz
-        self._uu = np.zeros((m, m))           # UᵀU
+        self._uz = np.zeros(m)  # Uᵀz
+        self._uu = np.zeros((m, m))  # UᵀU
         self._szz = 0.0
         self._touched = np.zeros(m, dtype=bool)  # basis columns some reading has touched
         self._touched[0] = True
-        self._prior_ref, self._prior_upto = None, 0   # the slope priors' reference and readings done
+        self._prior_ref, self._prior_upto = None, 0  # the slope priors' reference and readings done
         self._segment = 0
-        self._penalty = np.zeros(n)           # log-probability of the reach evidence (touches, bridges)
-        self.jaw_position = math.nan          # the contact's last measured place on the jaw, mm
-        self._live = self.feasible.copy()     # hypotheses still worth evaluating
+        self._penalty = np.zeros(n)  # log-probability of the reach evidence (touches, bridges)
+        self.jaw_position = math.nan  # the contact's last measured place on the jaw, mm
+        self._live = self.feasible.copy()  # hypotheses still worth evaluating
         self._live_idx = np.flatnonzero(self._live)
-        self._ref = None                      # the hypothesis whose radii set the slope term's prior
-        self._slope_var = np.zeros(self._m)   # prior variance of each slope coefficient, mm²
-        self._hist = []                       # (z, turn) of every reading, for the reference's radii
-        self._version = 0                     # changes to the likelihood (its cache's key)
-        self._rows = 0                        # readings added
+        self._ref = None  # the hypothesis whose radii set the slope term's prior
+        self._slope_var = np.zeros(self._m)  # prior variance of each slope coefficient, mm²
+        self._hist = []  # (z, turn) of every reading, for the reference's radii
+        self._version = 0  # changes to the likelihood (its cache's key)
+        self._rows = 0  # readings added
         self._cached = None
         self._last_row = None
-        self._add_row(0.0, np.zeros(n))       # the first reading: z_0 = 0, p_0 = 0
+        self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
         self.arc = 0.0
@@ -375,7 +397,7 @@ class ContactFilter:
             # error at that place too (only UᵀU changes, z and p being 0)
             old_cols, old_vals = self._last_row
             cols, vals = self._basis(0.0, jaw)
-            wt2 = self._row_weight ** 2
+            wt2 = self._row_weight**2
             self._uu[np.ix_(old_cols, old_cols)] -= wt2 * np.outer(old_vals, old_vals)
             self._uu[np.ix_(cols, cols)] += wt2 * np.outer(vals, vals)
             self._touched[cols] = True
@@ -476,17 +498,16 @@ class ContactFilter:
         constant part look measured (it is the segments' offsets' to absorb)."""
         if self.sd_slope <= 0 or self._ref is None or not self._hist:
             return
-        if self._ref != self._prior_ref:            # a new reference: its radii along the whole path
+        if self._ref != self._prior_ref:  # a new reference: its radii along the whole path
             self._prior_ref, self._prior_upto = self._ref, 0
-            self._slope_var[self._segments:self._jaw0] = 0.0
-        new = np.array(self._hist[self._prior_upto:])
+            self._slope_var[self._segments : self._jaw0] = 0.0
+        new = np.array(self._hist[self._prior_upto :])
         self._prior_upto = len(self._hist)
         if new.size == 0:
             return
         z, turn = new.T
         arc, ok = self.tracks.advance(np.full(z.size, self._ref), turn, turn_margin=TURN_MARGIN)
-        land = np.mod(np.rint(np.where(ok, arc, self.grid[self._ref]) / self.tracks.h).astype(np.int64),
-                      self.grid.size)
+        land = np.mod(np.rint(np.where(ok, arc, self.grid[self._ref]) / self.tracks.h).astype(np.int64), self.grid.size)
         kappa = self.tracks.kappa[land]
         rho = np.where(kappa > 0, np.clip(1.0 / np.maximum(kappa, 1e-12), 5.0, SLOPE_RHO_MAX), SLOPE_RHO_MAX)
         # column c (relative) is nonzero for z/spacing in [c - 3, c + 1): the largest radius there
@@ -537,14 +558,14 @@ class ContactFilter:
     def _solve(self) -> dict:
         """The closed-form marginalisation over the live hypotheses (see the module notes)."""
         cols = np.flatnonzero(self._touched)
-        s2 = self.sd_position ** 2
-        prior = self._slope_var[cols].copy()            # the contact's offset ρ·η: (ρ·sd_slope)²
-        prior[cols < self._segments] = 1e6              # the segments' offsets: flat
-        prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw ** 2
-        prior[cols == self._drift] = self.sd_drift ** 2
+        s2 = self.sd_position**2
+        prior = self._slope_var[cols].copy()  # the contact's offset ρ·η: (ρ·sd_slope)²
+        prior[cols < self._segments] = 1e6  # the segments' offsets: flat
+        prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw**2
+        prior[cols == self._drift] = self.sd_drift**2
         g = self._uu[np.ix_(cols, cols)] + np.diag(s2 / prior)
         live = np.flatnonzero(self._live)
-        v = self._up[np.ix_(cols, live)]                # (m, n_live)
+        v = self._up[np.ix_(cols, live)]  # (m, n_live)
         gi_v = np.linalg.solve(g, v)
         wz = self._uz[cols]
         gi_wz = np.linalg.solve(g, wz)
@@ -552,17 +573,16 @@ class ContactFilter:
         qpp = np.maximum(self._spp[live] - np.einsum("ij,ij->j", v, gi_v), 0.0) / s2
         qpz = (self._szp[live] - gi_wz @ v) / s2
         qzz = (self._szz - wz @ gi_wz) / s2
-        return {"cols": cols, "g": g, "live": live, "gi_v": gi_v, "gi_wz": gi_wz, "qpp": qpp, "qpz": qpz,
-                "qzz": qzz}
+        return {"cols": cols, "g": g, "live": live, "gi_v": gi_v, "gi_wz": gi_wz, "qpp": qpp, "qpz": qpz, "qzz": qzz}
 
     def _log_likelihood(self, s: dict) -> np.ndarray:
         """Log-likelihood of each start from a :meth:`_solve`, the noise scale weighed out; prunes the
         hopeless ones. Also leaves in ``s`` each live start's posterior mean of the squared scale."""
         live, qpp, qpz = s["live"], s["qpp"], s["qpz"]
         qrr = s["qzz"] - 2 * qpz + qpp
-        t2 = self.sd_scale ** 2
+        t2 = self.sd_scale**2
         qpr = qpz - qpp
-        quad = qrr - t2 * qpr ** 2 / (1 + t2 * qpp)
+        quad = qrr - t2 * qpr**2 / (1 + t2 * qpp)
         # every standard deviation times λ: the quadratic form scales by 1/λ², the determinant by
         # λ^(2k) with k the readings not absorbed by a flat offset; t2·qpp does not change
         k = max(self._rows - (self._segment + 1), 0)
@@ -621,18 +641,18 @@ class ContactFilter:
         a = np.zeros(cols.size)
         row_cols, row_vals = self._last_row
         a[np.searchsorted(cols, row_cols)] = row_vals
-        a[cols < self._segments] = 0.0                  # the offset is the reading's, not the contact's
-        a[cols >= self._jaw0] = 0.0                     # so are the calibration's error and the drift
-        t2 = self.sd_scale ** 2
+        a[cols < self._segments] = 0.0  # the offset is the reading's, not the contact's
+        a[cols >= self._jaw0] = 0.0  # so are the calibration's error and the drift
+        t2 = self.sd_scale**2
         qpr = s["qpz"] - s["qpp"]
-        d_mean = t2 * qpr / (1 + t2 * s["qpp"])         # the scale's posterior, b = 1 + δ
+        d_mean = t2 * qpr / (1 + t2 * s["qpp"])  # the scale's posterior, b = 1 + δ
         d_var = t2 / (1 + t2 * s["qpp"])
         a_v = a @ s["gi_v"]
         mean[live] = a @ s["gi_wz"] - (1 + d_mean) * a_v
-        var0 = self.sd_position ** 2 * float(a @ np.linalg.solve(s["g"], a))
+        var0 = self.sd_position**2 * float(a @ np.linalg.solve(s["g"], a))
         # the evidence is tempered (TEMPER): so is what it says of the slope term, whose spread
         # grows by 1/TEMPER in variance as the start's does
-        sd[live] = np.sqrt(s["lam2"] * (var0 + d_var * a_v ** 2) / self.temper + var_turn)
+        sd[live] = np.sqrt(s["lam2"] * (var0 + d_var * a_v**2) / self.temper + var_turn)
         return mean, sd
 
     def posterior(self) -> np.ndarray:
@@ -663,8 +683,7 @@ class ContactFilter:
         sel = np.flatnonzero(w > 1e-12 * w[i])
         off, s = np.asarray(part.arc_offset(present[sel], map_arc)), sd[sel]
         spread = np.where(s > 0, s, 1.0)
-        inside = np.where(s > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread),
-                          np.abs(off) <= radius)
+        inside = np.where(s > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius)
         mass = float(np.sum(w[sel] * inside))
         modes = self._modes(w, present, radius)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
@@ -675,8 +694,15 @@ class ContactFilter:
         informative = kl > 0.05
         strong = [m for m in modes if m.mass >= self.mode_floor]
         ambiguous = informative and len(strong) > 1 and modes[0].mass < self.confidence
-        return Belief(map_arc=map_arc, mass=mass, radius=radius, modes=tuple(modes), ambiguous=ambiguous,
-                      informative=informative, steps=self.steps)
+        return Belief(
+            map_arc=map_arc,
+            mass=mass,
+            radius=radius,
+            modes=tuple(modes),
+            ambiguous=ambiguous,
+            informative=informative,
+            steps=self.steps,
+        )
 
     def _modes(self, w, present, radius) -> list:
         """Connected groups of probable present contacts, binned at ``radius``."""
@@ -707,7 +733,6 @@ class ContactFilter:
             if not sel.any():
                 continue
             k = int(np.argmax(np.where(sel, w, -1.0)))
-            out.append(Mode(arc=float(present[k]), mass=float(mass[bins].sum()),
-                            start_arc=float(self.grid[k])))
+            out.append(Mode(arc=float(present[k]), mass=float(mass[bins].sum()), start_arc=float(self.grid[k])))
         out.sort(key=lambda m: -m.mass)
         return out

@@ -164,12 +164,19 @@ def _paper(part, chain, segs, sign, length_tol, turn_tol):
     k = sum(kept)
     out = []
     for (score, pos, res, t), keep in zip(rows, kept):
-        out.append(Candidate(
-            start_arc=float(part.wrap_arc(pos[0])), end_arc=float(part.wrap_arc(pos[-1])),
-            path=tuple(float(x) for x in part.wrap_arc(pos)), lengths=tuple(float(x) for x in lengths),
-            turn_residuals=tuple(float(x) for x in res), probability=(1.0 / k) if keep else 0.0,
-            score=score, start_param=float(np.mod(t[0], part.n_knots)),
-            end_param=float(np.mod(t[-1], part.n_knots))))
+        out.append(
+            Candidate(
+                start_arc=float(part.wrap_arc(pos[0])),
+                end_arc=float(part.wrap_arc(pos[-1])),
+                path=tuple(float(x) for x in part.wrap_arc(pos)),
+                lengths=tuple(float(x) for x in lengths),
+                turn_residuals=tuple(float(x) for x in res),
+                probability=(1.0 / k) if keep else 0.0,
+                score=score,
+                start_param=float(np.mod(t[0], part.n_knots)),
+                end_param=float(np.mod(t[-1], part.n_knots)),
+            )
+        )
     return out
 
 
@@ -200,7 +207,7 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
         dk = kappa[1:] - kappa[:-1]
         J[:n, 0] = dk
         for k in range(n):
-            J[k, 1:k + 1] = sign * dk[k]
+            J[k, 1 : k + 1] = sign * dk[k]
             J[k, k + 1] = sign * kappa[k + 1]
         J[:n] /= sd_turn
         J[n:, 1:] = np.eye(n) / sd_length
@@ -228,19 +235,36 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
     out = []
     for (score, x), prob in zip(kept, w):
         pos, turns, _, t = _chain_turns(part, x[0], x[1:], sign)
-        out.append(Candidate(
-            start_arc=float(part.wrap_arc(pos[0])), end_arc=float(part.wrap_arc(pos[-1])),
-            path=tuple(float(v) for v in part.wrap_arc(pos)), lengths=tuple(float(v) for v in x[1:]),
-            turn_residuals=tuple(float(v) for v in turns - W), probability=float(prob), score=score,
-            start_param=float(np.mod(t[0], part.n_knots)), end_param=float(np.mod(t[-1], part.n_knots))))
+        out.append(
+            Candidate(
+                start_arc=float(part.wrap_arc(pos[0])),
+                end_arc=float(part.wrap_arc(pos[-1])),
+                path=tuple(float(v) for v in part.wrap_arc(pos)),
+                lengths=tuple(float(v) for v in x[1:]),
+                turn_residuals=tuple(float(v) for v in turns - W),
+                probability=float(prob),
+                score=score,
+                start_param=float(np.mod(t[0], part.n_knots)),
+                end_param=float(np.mod(t[-1], part.n_knots)),
+            )
+        )
     out.sort(key=lambda c: -c.probability)
     return out
 
 
-def localize(part: Part, rolls, *, rule: str = "likelihood", direction: str = "ccw",
-             sd_length: float = 0.5, sd_turn: float = float(np.radians(0.03)),
-             length_tol: float = 0.004, turn_tol: float = 0.0004,
-             min_separation: float = 0.5, confidence: float = 0.95) -> Localization:
+def localize(
+    part: Part,
+    rolls,
+    *,
+    rule: str = "likelihood",
+    direction: str = "ccw",
+    sd_length: float = 0.5,
+    sd_turn: float = float(np.radians(0.03)),
+    length_tol: float = 0.004,
+    turn_tol: float = 0.0004,
+    min_separation: float = 0.5,
+    confidence: float = 0.95,
+) -> Localization:
     """Localize the jaw from a chain of consecutive rolls.
 
     Parameters
@@ -292,8 +316,13 @@ def localize(part: Part, rolls, *, rule: str = "likelihood", direction: str = "c
         raise QueryError(f"unknown rule {rule!r}; use one of {list(RULES)}")
     if direction not in DIRECTIONS:
         raise QueryError(f"unknown direction {direction!r}; use one of {list(DIRECTIONS)}")
-    for name, val in (("sd_length", sd_length), ("sd_turn", sd_turn), ("length_tol", length_tol),
-                      ("turn_tol", turn_tol), ("min_separation", min_separation)):
+    for name, val in (
+        ("sd_length", sd_length),
+        ("sd_turn", sd_turn),
+        ("length_tol", length_tol),
+        ("turn_tol", turn_tol),
+        ("min_separation", min_separation),
+    ):
         if not (np.isfinite(val) and val > 0):
             raise QueryError(f"{name}={val!r} must be a positive number")
     if not 0.0 < confidence <= 1.0:
@@ -306,5 +335,11 @@ def localize(part: Part, rolls, *, rule: str = "likelihood", direction: str = "c
         cands.sort(key=lambda c: (-c.probability, c.score))
     else:
         cands = _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation)
-    return Localization(candidates=tuple(cands), segments=tuple(segs), rolls=chain, rule=rule,
-                        direction=direction, confidence=confidence)
+    return Localization(
+        candidates=tuple(cands),
+        segments=tuple(segs),
+        rolls=chain,
+        rule=rule,
+        direction=direction,
+        confidence=confidence,
+    )

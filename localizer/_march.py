@@ -107,7 +107,7 @@ class MarchGrid:
             lap, k0 = divmod(i, M)
             k1 = min(M, k0 + (i_hi - i))
             v = target - lap * cum[-1]
-            seg = cum[k0:k1 + 1]
+            seg = cum[k0 : k1 + 1]
             j = int(np.searchsorted(seg, v, side="left"))
             if j <= k1 - k0:
                 k = max(j - 1, 0)
@@ -210,8 +210,17 @@ def _sign_regions(kappa: np.ndarray, h: float):
     return z[order], sgn[change][order]
 
 
-def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_tol: float = 0.004,
-          turn_tol: float = 0.0004, min_separation: float = 0.5, max_iterations: int = 100_000) -> MarchResult:
+def march(
+    part: Part,
+    length: float,
+    turn: float,
+    *,
+    step: float = 1e-5,
+    length_tol: float = 0.004,
+    turn_tol: float = 0.0004,
+    min_separation: float = 0.5,
+    max_iterations: int = 100_000,
+) -> MarchResult:
     """Counter-clockwise marching over the whole boundary (the paper's algorithm).
 
     Parameters
@@ -392,11 +401,22 @@ def march(part: Part, length: float, turn: float, *, step: float = 1e-5, length_
     arc = part.arc_at_param
     for s, t, iterates, iters, kind in found:
         s_arc = float(part.wrap_arc(arc(s)))
-        segs.append(Segment(
-            start_arc=s_arc, end_arc=float(part.wrap_arc(arc(t))), start_param=float(s % tau),
-            end_param=float(t % tau), length=length, turn=turn, direction="ccw", kind=kind, span=0.0,
-            residual=float(abs(part.total_curvature(s, t) - turn)),
-            iterates=tuple(float(v) for v in part.wrap_arc(arc(np.array(iterates)))), iterations=int(iters)))
+        segs.append(
+            Segment(
+                start_arc=s_arc,
+                end_arc=float(part.wrap_arc(arc(t))),
+                start_param=float(s % tau),
+                end_param=float(t % tau),
+                length=length,
+                turn=turn,
+                direction="ccw",
+                kind=kind,
+                span=0.0,
+                residual=float(abs(part.total_curvature(s, t) - turn)),
+                iterates=tuple(float(v) for v in part.wrap_arc(arc(np.array(iterates)))),
+                iterations=int(iters),
+            )
+        )
     # a root found at the end of one mode and the start of the next is one root
     segs.sort(key=lambda g: g.start_arc)
     out = []

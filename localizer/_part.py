@@ -132,13 +132,14 @@ class Part:
                     raise PartError(
                         f"part {self.name!r}: the spline stops (zero speed, a cusp) near "
                         f"parameter {piece[bad] + fine.argmin() / 256 / m + u0[bad] - piece[bad]:.3f}; "
-                        "space the points more evenly")
+                        "space the points more evenly"
+                    )
                 if m >= 256:
                     raise PartError(f"part {self.name!r}: speed bound failed near parameter {j[bad] / m:.3f}")
                 m *= 2
                 continue
             nlo, nhi = bernstein_bounds(self._num[piece], u0, u1)
-            kappa_abs = np.maximum(np.abs(nlo), np.abs(nhi)) / dlo ** 1.5
+            kappa_abs = np.maximum(np.abs(nlo), np.abs(nhi)) / dlo**1.5
             # cell arc lengths
             uu = u0[:, None] + (u1 - u0)[:, None] * _GL16_X
             sp = self._speed_piece(piece[:, None], uu)
@@ -297,7 +298,7 @@ class Part:
         d1 = self._dtds_nodes[cell + 1] * h
         # cubic Hermite in x on [0, 1] for t(sigma)
         x2, x3 = x * x, x * x * x
-        t = (t0 + dt * (3 * x2 - 2 * x3) + d0 * (x3 - 2 * x2 + x) + d1 * (x3 - x2))
+        t = t0 + dt * (3 * x2 - 2 * x3) + d0 * (x3 - 2 * x2 + x) + d1 * (x3 - x2)
         piece = cell // m
         lo, hi = t0, t0 + dt
         target = ss - s0
@@ -361,7 +362,8 @@ def _check_points(points, source: str) -> np.ndarray:
         i = int(dup[0])
         raise PartError(
             f"{source}: points {i} and {(i + 1) % len(pts)} coincide at {pts[i].tolist()}; "
-            "remove the repeated point (do not close the list by repeating the first point)")
+            "remove the repeated point (do not close the list by repeating the first point)"
+        )
     return pts
 
 
@@ -376,7 +378,7 @@ def _segments_cross(poly: np.ndarray):
     for idx in range(n):
         i = order[idx]
         # candidates: edges whose x-range overlaps, later in the sort order
-        cand = order[idx + 1:]
+        cand = order[idx + 1 :]
         cand = cand[lo[cand, 0] <= hi[i, 0]]
         if cand.size == 0:
             continue
@@ -437,7 +439,8 @@ def part_from_points(points, *, name: str = "part", units: str = "mm", source: s
     if abs(abs(turning) - 2 * np.pi) > 1e-6:
         raise PartError(
             f"{source}: the spline through the points crosses itself (its tangent turns "
-            f"{turning / (2 * np.pi):.2f} times, a simple closed curve turns once); check the point order")
+            f"{turning / (2 * np.pi):.2f} times, a simple closed curve turns once); check the point order"
+        )
     if turning < 0:  # clockwise: reverse, keeping the first point first
         pts = np.vstack([pts[:1], pts[:0:-1]])
         part = Part(pts, name=name)
@@ -446,7 +449,8 @@ def part_from_points(points, *, name: str = "part", units: str = "mm", source: s
         i, j = sorted(crossing)
         raise PartError(
             f"{source}: the spline through the points crosses itself between parameters "
-            f"{i / 16:.2f} and {j / 16:.2f} (near points {i // 16} and {j // 16}); check the point order")
+            f"{i / 16:.2f} and {j / 16:.2f} (near points {i // 16} and {j // 16}); check the point order"
+        )
     return part
 
 

@@ -45,8 +45,17 @@ class ParticleFilter:
     seed : int
     """
 
-    def __init__(self, part: Part, *, particles: int = 2000, sd_position: float = 0.04, process: float = 0.005,
-                 radius: float = 0.3, seed: int = 0, spacing: float = 0.02):
+    def __init__(
+        self,
+        part: Part,
+        *,
+        particles: int = 2000,
+        sd_position: float = 0.04,
+        process: float = 0.005,
+        radius: float = 0.3,
+        seed: int = 0,
+        spacing: float = 0.02,
+    ):
         if particles < 2:
             raise QueryError(f"particles={particles!r} must be at least 2")
         for name, value in (("sd_position", sd_position), ("radius", radius)):
@@ -99,7 +108,7 @@ class ParticleFilter:
         if not total > 0:  # every particle ruled out: keep the prior weights (a known PF failure)
             return
         self.w = w / total
-        if 1.0 / np.sum(self.w ** 2) < self.n / 2:
+        if 1.0 / np.sum(self.w**2) < self.n / 2:
             u = (self.rng.random() + np.arange(self.n)) / self.n
             idx = np.minimum(np.searchsorted(np.cumsum(self.w), u), self.n - 1)
             self.x, self.rolled, self.offset = self.x[idx], self.rolled[idx], self.offset[idx]

@@ -24,7 +24,7 @@ def poly_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     p, q = a.shape[-1], b.shape[-1]
     out = np.zeros(a.shape[:-1] + (p + q - 1,))
     for i in range(p):
-        out[..., i:i + q] += a[..., i:i + 1] * b
+        out[..., i : i + q] += a[..., i : i + 1] * b
     return out
 
 

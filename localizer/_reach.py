@@ -109,8 +109,7 @@ class Reach:
     (True, True)
     """
 
-    def __init__(self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2,
-                 clearance: float = 0.1):
+    def __init__(self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2, clearance: float = 0.1):
         if not (math.isfinite(spacing) and spacing > 0):
             raise QueryError(f"spacing={spacing!r} mm must be a positive number")
         if not (math.isfinite(clearance) and clearance >= 0):
@@ -124,25 +123,25 @@ class Reach:
         t = part.param_at_arc(self.sigma)
         pts = np.asarray(part.point(t))
         tan = np.asarray(part.tangent(t))
-        eq = ConvexHull(pts).equations                       # n·x + d ≤ 0 inside
+        eq = ConvexHull(pts).equations  # n·x + d ≤ 0 inside
         depth = np.full(n, -np.inf)
         for c in range(0, len(eq), 256):
-            e = eq[c:c + 256]
+            e = eq[c : c + 256]
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
         self.hull_depth = np.maximum(-depth, 0.0)
         half = jaw.half
         c = self.clearance
-        tiny = 1e-9 * max(1.0, float(np.ptp(pts)))                     # rounding of the depth
+        tiny = 1e-9 * max(1.0, float(np.ptp(pts)))  # rounding of the depth
         lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
         lo_sure, hi_sure = np.full(n, -np.inf), np.full(n, np.inf)
         k = np.arange(n)
         for start in range(0, n, 128):
             i = np.arange(start, min(start + 128, n))
             # the boundary in arc order from each P: column k is the point k grid steps ahead of P
-            q = pts[(i[:, None] + k[None, :]) % n] - pts[i, None, :]    # (b, n, 2): Q − P
+            q = pts[(i[:, None] + k[None, :]) % n] - pts[i, None, :]  # (b, n, 2): Q − P
             e = tan[i, None, :]
-            w = np.einsum("bnk,bnk->bn", q, e)                           # along the tangent
-            dep = q[..., 0] * e[..., 1] - q[..., 1] * e[..., 0]          # −(Q−P)·m, m the inner normal
+            w = np.einsum("bnk,bnk->bn", q, e)  # along the tangent
+            dep = q[..., 0] * e[..., 1] - q[..., 1] * e[..., 0]  # −(Q−P)·m, m the inner normal
             # generous: blocked by a point deeper than the clearance
             block = dep > c
             lo[i], hi[i] = self._interval(w, block, half)
@@ -152,7 +151,7 @@ class Reach:
             ahead = np.where(clear_of[:, 1:].any(axis=1), np.argmax(clear_of[:, 1:], axis=1) + 1, n)
             behind = np.where(clear_of[:, :0:-1].any(axis=1), np.argmax(clear_of[:, :0:-1], axis=1) + 1, n)
             cap = (k[None, :] < ahead[:, None]) | (k[None, :] > n - behind[:, None])
-            cap &= dep <= tiny                                           # rising above the edge blocks
+            cap &= dep <= tiny  # rising above the edge blocks
             lo_sure[i], hi_sure[i] = self._interval(w, (dep > -c) & ~cap, half)
         self.lo, self.hi = lo, hi
         self.lo_sure, self.hi_sure = np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
@@ -218,8 +217,12 @@ class Reach:
 
 def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, clearance: float = 0.1) -> Reach:
     """The part's :class:`Reach` for ``jaw``, built once per part, jaw, spacing and clearance (shared, read-only)."""
-    return per_part("reach", part, (jaw, float(spacing), float(clearance)),
-                    lambda: Reach(part, jaw, spacing=spacing, clearance=clearance))
+    return per_part(
+        "reach",
+        part,
+        (jaw, float(spacing), float(clearance)),
+        lambda: Reach(part, jaw, spacing=spacing, clearance=clearance),
+    )
 
 
 def calibration_arc(part: Part, jaw: StraightJaw = DEFAULT_JAW) -> float:
@@ -233,7 +236,8 @@ def calibration_arc(part: Part, jaw: StraightJaw = DEFAULT_JAW) -> float:
     r = reach_for(part, jaw)
     ok = np.flatnonzero(r.full)
     if ok.size == 0:
-        raise QueryError(f"no point of {part.name} can be touched along the whole {jaw} jaw: "
-                         "calibrate on another object")
+        raise QueryError(
+            f"no point of {part.name} can be touched along the whole {jaw} jaw: calibrate on another object"
+        )
     kappa = np.asarray(part.curvature_at_arc(r.sigma[ok]))
     return float(r.sigma[ok[int(np.argmax(kappa))]])

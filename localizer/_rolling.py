@@ -50,5 +50,5 @@ def arc_from_jaw_positions(positions, step: float, offset: float = 0.0) -> float
     sign = -1.0 if step < 0 else 1.0
     theta = abs(float(step))
     mid = 0.5 * (u[1:] + u[:-1])
-    arcs = (sign * np.diff(u) + offset * theta + sign * mid * theta ** 2 / 2) / (1 - theta ** 2 / 6)
+    arcs = (sign * np.diff(u) + offset * theta + sign * mid * theta**2 / 2) / (1 - theta**2 / 6)
     return float(arcs.sum())

@@ -91,7 +91,6 @@ def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
     return lam[:k], both[:k], both[k:], step <= tol, np.abs(f2)
 
 
-
 # ------------------------------------------------------------------ checks
 def _check_query(part: Part, length, turn, direction: str, method: str):
     if not isinstance(part, Part):
@@ -110,13 +109,15 @@ def _check_query(part: Part, length, turn, direction: str, method: str):
     if not 0.0 < length < part.perimeter:
         raise QueryError(
             f"length={length!r} mm is out of range: the contact travel must be in "
-            f"(0, perimeter={part.perimeter:.6g}) mm on part {part.name!r}")
+            f"(0, perimeter={part.perimeter:.6g}) mm on part {part.name!r}"
+        )
     return length, turn
 
 
 # ------------------------------------------------------------------- solver
-def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: float,
-               double_width: float, max_cells: int):
+def _solve_ccw(
+    part: Part, length: float, turn: float, *, tol: float, flat_tol: float, double_width: float, max_cells: int
+):
     """Roots of g on [0, P) for counter-clockwise travel.
 
     Returns (simple_roots, double_roots, continua): arrays of start arc
@@ -125,8 +126,8 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
     table = arc_table(part)
     P = part.perimeter
     nodes = table.sig[:-1]
-    margin = 4.0 * table.theta_error + 1e-14   # |g - g_table| <= 2 theta_error
-    dmargin = 1e-9                             # slack on g' (tabulated κ is ~1e-11 off)
+    margin = 4.0 * table.theta_error + 1e-14  # |g - g_table| <= 2 theta_error
+    dmargin = 1e-9  # slack on g' (tabulated κ is ~1e-11 off)
     # Breakpoints: the table nodes (their θ, κ are the table's constants) and the
     # starts whose end falls on a node; one table evaluation covers both.
     J = nodes.size
@@ -165,15 +166,15 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
             raise QueryError(
                 f"the query length={length!r} mm, turn={turn!r} rad is degenerate on part "
                 f"{part.name!r}: g stays near zero on too many cells ({processed}); the part is "
-                "nearly a circular arc there. Raise flat_tol or max_cells")
+                "nearly a circular arc there. Raise flat_tol or max_cells"
+            )
         w = b - a
         s = da + db
         mono = (s > K * w + dmargin) | (s < -(K * w + dmargin))
-        change = (ga * gb < 0.0)
+        change = ga * gb < 0.0
         take = mono & change
         if take.any():
-            brackets.append((a[take], b[take], ga[take], gb[take], da[take], db[take],
-                             np.zeros(int(take.sum()), bool)))
+            brackets.append((a[take], b[take], ga[take], gb[take], da[take], db[take], np.zeros(int(take.sum()), bool)))
         rest = ~mono
         # same-sign cells: no root if the quadratic envelopes' zero crossings overlap
         sg = np.where(ga != 0.0, np.sign(ga), np.sign(gb))
@@ -183,7 +184,7 @@ def _solve_ccw(part: Part, length: float, turn: float, *, tol: float, flat_tol: 
             rb = (-Db + np.sqrt(np.maximum(Db * Db + 2 * K * Gb, 0.0))) / K
         excluded = (~change) & (Ga > 0) & (Gb > 0) & (ra + rb > w)
         M = 0.5 * (np.abs(s) + K * w)
-        flat = (np.maximum(np.abs(ga), np.abs(gb)) + 0.5 * M * w + margin <= flat_tol)
+        flat = np.maximum(np.abs(ga), np.abs(gb)) + 0.5 * M * w + margin <= flat_tol
         rest &= ~excluded
         fl = rest & flat
         if fl.any():
@@ -332,11 +333,22 @@ def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
     return order[keep]
 
 
-def feasible_segments(part: Part, length: float, turn: float, *, method: str = "exact",
-                      direction: str = "ccw", tol: float = 1e-10, flat_tol: float = 1e-10,
-                      double_width: float = 1e-7, max_cells: int = 2_000_000, step: float = 1e-5,
-                      length_tol: float = 0.004, turn_tol: float = 0.0004,
-                      min_separation: float = 0.5) -> list[Segment]:
+def feasible_segments(
+    part: Part,
+    length: float,
+    turn: float,
+    *,
+    method: str = "exact",
+    direction: str = "ccw",
+    tol: float = 1e-10,
+    flat_tol: float = 1e-10,
+    double_width: float = 1e-7,
+    max_cells: int = 2_000_000,
+    step: float = 1e-5,
+    length_tol: float = 0.004,
+    turn_tol: float = 0.0004,
+    min_separation: float = 0.5,
+) -> list[Segment]:
     """Every boundary segment with arc length ``length`` and total curvature ``turn``.
 
     Parameters
@@ -399,17 +411,30 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
     P = part.perimeter
     omega = turn if direction == "ccw" else -turn
     if method == "march":
-
-        res = march(part, length, omega, step=step, length_tol=length_tol, turn_tol=turn_tol,
-                    min_separation=min_separation)
+        res = march(
+            part, length, omega, step=step, length_tol=length_tol, turn_tol=turn_tol, min_separation=min_separation
+        )
         if direction == "ccw":
             return [replace(g, turn=turn) for g in res.segments]
         # the ccw stretch was travelled from its far end
-        return sorted((replace(g, start_arc=g.end_arc, end_arc=g.start_arc, start_param=g.end_param,
-                               end_param=g.start_param, turn=turn, direction="cw")
-                       for g in res.segments), key=lambda g: g.start_arc)
-    zeros, brackets, doubles, continua = _solve_ccw(part, length, omega, tol=tol, flat_tol=flat_tol,
-                                                    double_width=double_width, max_cells=max_cells)
+        return sorted(
+            (
+                replace(
+                    g,
+                    start_arc=g.end_arc,
+                    end_arc=g.start_arc,
+                    start_param=g.end_param,
+                    end_param=g.start_param,
+                    turn=turn,
+                    direction="cw",
+                )
+                for g in res.segments
+            ),
+            key=lambda g: g.start_arc,
+        )
+    zeros, brackets, doubles, continua = _solve_ccw(
+        part, length, omega, tol=tol, flat_tol=flat_tol, double_width=double_width, max_cells=max_cells
+    )
     table = arc_table(part)
     # columns, ccw sense: start arc, kind code, span, residual, start param, end param
     found = []
@@ -450,6 +475,18 @@ def feasible_segments(part: Part, length: float, turn: float, *, method: str = "
     cols = (part.wrap_arc(sa), part.wrap_arc(ea), np.mod(sp, n), np.mod(ep, n), span, res)
     sa, ea, sp, ep, span, res = (c[order].tolist() for c in cols)
     kinds = [KINDS[k] for k in code[order]]
-    return [Segment(start_arc=sa[i], end_arc=ea[i], start_param=sp[i], end_param=ep[i], length=length,
-                    turn=turn, direction=direction, kind=kinds[i], span=span[i], residual=res[i])
-            for i in range(len(sa))]
+    return [
+        Segment(
+            start_arc=sa[i],
+            end_arc=ea[i],
+            start_param=sp[i],
+            end_param=ep[i],
+            length=length,
+            turn=turn,
+            direction=direction,
+            kind=kinds[i],
+            span=span[i],
+            residual=res[i],
+        )
+        for i in range(len(sa))
+    ]

@@ -20,14 +20,16 @@ __all__ = ["ArcTable", "arc_table"]
 
 # Quintic Hermite basis on [0, 1] (ascending coefficients) for
 # (f0, f0', f0'', f1, f1', f1'').
-_H5 = np.array([
-    [1, 0, 0, -10, 15, -6],
-    [0, 1, 0, -6, 8, -3],
-    [0, 0, 0.5, -1.5, 1.5, -0.5],
-    [0, 0, 0, 10, -15, 6],
-    [0, 0, 0, -4, 7, -3],
-    [0, 0, 0, 0.5, -1, 0.5],
-])
+_H5 = np.array(
+    [
+        [1, 0, 0, -10, 15, -6],
+        [0, 1, 0, -6, 8, -3],
+        [0, 0, 0.5, -1.5, 1.5, -0.5],
+        [0, 0, 0, 10, -15, 6],
+        [0, 0, 0, -4, 7, -3],
+        [0, 0, 0, 0.5, -1, 0.5],
+    ]
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -168,8 +170,16 @@ def arc_table(part: Part, *, max_theta_error: float = 1e-9) -> ArcTable:
     d2 = (dtheta[:, 1:] * np.arange(1, 5)) / h[:, None]
     lo, hi = bernstein_bounds(d2, np.zeros(J), np.ones(J))
     slope = np.maximum(np.abs(lo), np.abs(hi))
-    table = ArcTable(perimeter=part.perimeter, sig=np.append(sig0, part.perimeter), h=h,
-                     theta=theta, dtheta=dtheta, param=param, kappa_slope=slope * (1 + 1e-9),
-                     theta_error=float(err_th), param_error=float(err_t))
+    table = ArcTable(
+        perimeter=part.perimeter,
+        sig=np.append(sig0, part.perimeter),
+        h=h,
+        theta=theta,
+        dtheta=dtheta,
+        param=param,
+        kappa_slope=slope * (1 + 1e-9),
+        theta_error=float(err_th),
+        param_error=float(err_t),
+    )
     part.__dict__["_arc_table"] = table
     return table

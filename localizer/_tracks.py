@@ -65,8 +65,8 @@ class ModeTracks:
         at = 0
         for r, (lo, hi) in enumerate(zip(a, b)):
             offsets.append(at)
-            pieces_s.append(arcs[lo:hi + 1])
-            vals = th[lo:hi + 1] if rising[lo] else np.full(hi + 1 - lo, th[lo])
+            pieces_s.append(arcs[lo : hi + 1])
+            vals = th[lo : hi + 1] if rising[lo] else np.full(hi + 1 - lo, th[lo])
             pieces_b.append(vals + r * span)
             at += hi + 1 - lo
         self._s = np.concatenate(pieces_s)
@@ -82,9 +82,22 @@ class ModeTracks:
         self.lo_sure, self.hi_sure = (np.array(v) for v in self.reach.interval(sigma, sure=True))
         self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
         self.convex = rising[a][self._run] & (kappa > 0) & self.touchable
-        for arr in (self.sigma, self.theta, self.kappa, self.lo, self.hi, self.lo_sure, self.hi_sure, self.touchable,
-                    self.convex, self._s,
-                    self._banded, self._first, self._last, self._run):
+        for arr in (
+            self.sigma,
+            self.theta,
+            self.kappa,
+            self.lo,
+            self.hi,
+            self.lo_sure,
+            self.hi_sure,
+            self.touchable,
+            self.convex,
+            self._s,
+            self._banded,
+            self._first,
+            self._last,
+            self._run,
+        ):
             arr.setflags(write=False)
 
     def advance(self, index: np.ndarray, turn, *, turn_margin: float = 0.0) -> tuple:
@@ -134,8 +147,9 @@ class ModeTracks:
         d = np.asarray(jaw, dtype=float)
         return finite & (lo[land] - margin < d) & (d < hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
 
-    def roll(self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0,
-             turn_margin: float = 0.0) -> tuple:
+    def roll(
+        self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0, turn_margin: float = 0.0
+    ) -> tuple:
         """:meth:`advance`, and the landing must be touchable.
 
         ``jaw`` (mm) is the contact's place on the jaw at arc ``at`` (mm, default the grid
@@ -150,7 +164,6 @@ class ModeTracks:
             jaw = np.asarray(jaw, dtype=float) + (arc - base)
         ok = ok & self.touches(arc, jaw, margin)
         return np.where(ok, arc, np.nan), ok
-
 
     def rollable(self, turns, jaw: float, margin: float = 0.0) -> np.ndarray:
         """Grid points from which the jaw, laid with the contact at ``jaw`` (mm on it), can roll through

@@ -99,8 +99,15 @@ class PassivityController:
     -2e-05
     """
 
-    def __init__(self, dt: float, *, sign_fix: bool = False, hold_fix: bool = False,
-                 force_limit: float | None = None, booking: str = "assumed"):
+    def __init__(
+        self,
+        dt: float,
+        *,
+        sign_fix: bool = False,
+        hold_fix: bool = False,
+        force_limit: float | None = None,
+        booking: str = "assumed",
+    ):
         if not (math.isfinite(dt) and dt > 0):
             raise ControlError(f"dt={dt!r} s must be a positive number")
         if force_limit is not None and not force_limit > 0:
@@ -138,7 +145,7 @@ class PassivityController:
         dt = self.dt
         if self.booking == "assumed":
             # the previous sample's dissipation, now booked
-            self.energy += dt * self._prev_alpha * self._prev_v ** 2
+            self.energy += dt * self._prev_alpha * self._prev_v**2
             step = dt * f * v
         else:
             # the output held over the last interval, against the motion over it
@@ -162,5 +169,4 @@ class PassivityController:
             self._held = control
         self._prev_alpha, self._prev_v = alpha, v
         self._prev_out = f + control
-        return PassivityStep(force=f + control, control=control, alpha=alpha,
-                             energy=self.energy + dt * alpha * v * v)
+        return PassivityStep(force=f + control, control=control, alpha=alpha, energy=self.energy + dt * alpha * v * v)

@@ -6,4 +6,14 @@ from .noise import PRESETS, NoiseModel, load_noise
 from .rig import SimRig
 from .wrist import Wrist, encoder_angle
 
-__all__ = ["SimError", "NoiseModel", "PRESETS", "load_noise", "SimRig", "Wrist", "encoder_angle", "machined_part", "machining_slope"]
+__all__ = [
+    "SimError",
+    "NoiseModel",
+    "PRESETS",
+    "load_noise",
+    "SimRig",
+    "Wrist",
+    "encoder_angle",
+    "machined_part",
+    "machining_slope",
+]

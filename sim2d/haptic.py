@@ -227,12 +227,21 @@ def _run(axis: Axis, n: int, x0: float, physical: Callable, sampled: Callable) -
             if not math.isfinite(x):
                 raise SimError(f"the axis diverged at t = {t:.3f} s")
     a = np.array(rows)
-    return {"time": a[:, 0], "position": a[:, 1], "encoder": a[:, 2], "velocity": a[:, 3],
-            "port_force": a[:, 4], "control": a[:, 5], "energy": a[:, 6], "contact_force": a[:, 7]}
+    return {
+        "time": a[:, 0],
+        "position": a[:, 1],
+        "encoder": a[:, 2],
+        "velocity": a[:, 3],
+        "port_force": a[:, 4],
+        "control": a[:, 5],
+        "energy": a[:, 6],
+        "contact_force": a[:, 7],
+    }
 
 
-def simulate_wall(controller=None, *, axis: Axis = Axis(), operator: Operator = Operator(),
-                  wall_stiffness: float = 20000.0) -> AxisTrace:
+def simulate_wall(
+    controller=None, *, axis: Axis = Axis(), operator: Operator = Operator(), wall_stiffness: float = 20000.0
+) -> AxisTrace:
     """The seed's experiment: an operator presses slowly into a stiff virtual wall and out again.
 
     The wall at x = 0 pushes back with K·x_enc(n) (N) while the encoder reads
@@ -267,8 +276,7 @@ def simulate_wall(controller=None, *, axis: Axis = Axis(), operator: Operator = 
     return AxisTrace(**_run(axis, n, operator.start, physical, sampled), phases=phases)
 
 
-def simulate_servo(servo: Servo, controller=None, *, axis: Axis = Axis(damping=5.0),
-                   seed: int = 0) -> AxisTrace:
+def simulate_servo(servo: Servo, controller=None, *, axis: Axis = Axis(damping=5.0), seed: int = 0) -> AxisTrace:
     """The contact-force servo pressing the jaw on the part (see :class:`Servo`).
 
     The part is a one-sided spring of ``servo.contact_stiffness`` at x = 0
@@ -301,5 +309,4 @@ def simulate_servo(servo: Servo, controller=None, *, axis: Axis = Axis(damping=5
         step = controller.update(f, v)
         return servo.target - step.force, (f, step.control, step.energy, true)
 
-    return AxisTrace(**_run(axis, n, servo.start, physical, sampled),
-                     phases=(("servo", 0.0, servo.duration),))
+    return AxisTrace(**_run(axis, n, servo.start, physical, sampled), phases=(("servo", 0.0, servo.duration),))

@@ -30,7 +30,7 @@ def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Pa
     dev = np.zeros(part.n_knots)
     for k in range(1, kmax + 1):
         dev += rng.normal() / k * np.cos(2 * np.pi * k * sigma / P + rng.uniform(0, 2 * np.pi))
-    dev *= noise.machining_error / max(np.sqrt(np.mean(dev ** 2)), 1e-300)
+    dev *= noise.machining_error / max(np.sqrt(np.mean(dev**2)), 1e-300)
     pts = part.points + dev[:, None] * part.normal(knots)
     return part_from_points(pts, name=f"{part.name} (machined)")
 
@@ -41,4 +41,4 @@ def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
     if rms <= 0:
         return 0.0
     k = np.arange(1, max(1, int(perimeter / wavelength)) + 1)
-    return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k ** 2)))
+    return float(rms * 2 * np.pi / perimeter * math.sqrt(len(k) / np.sum(1.0 / k**2)))

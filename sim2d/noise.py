@@ -91,9 +91,20 @@ class NoiseModel:
 PRESETS = {
     "none": NoiseModel(),
     "paper": NoiseModel(
-        v1_noise=0.0007, v2_noise=0.0001, v1_offset=0.05, v2_offset=-0.02, v1_drift=3.5e-6, v2_drift=3.5e-7,
-        adc_step=20.0 / 2 ** 18, crosstalk=0.003, nonlinearity=0.08, gain_error=0.05,
-        encoder_step=math.radians(0.03), machining_error=0.009, machining_wavelength=20.0),
+        v1_noise=0.0007,
+        v2_noise=0.0001,
+        v1_offset=0.05,
+        v2_offset=-0.02,
+        v1_drift=3.5e-6,
+        v2_drift=3.5e-7,
+        adc_step=20.0 / 2**18,
+        crosstalk=0.003,
+        nonlinearity=0.08,
+        gain_error=0.05,
+        encoder_step=math.radians(0.03),
+        machining_error=0.009,
+        machining_wavelength=20.0,
+    ),
 }
 
 
@@ -131,6 +142,7 @@ def load_noise(spec) -> NoiseModel:
         raise SimError(f"noise file {text}: unknown preset {base!r}; use one of {sorted(PRESETS)}")
     unknown = sorted(set(data) - set(NoiseModel.__dataclass_fields__))
     if unknown:
-        raise SimError(f"noise file {text}: unknown key(s) {unknown}; valid keys: "
-                       f"{sorted(NoiseModel.__dataclass_fields__)}")
+        raise SimError(
+            f"noise file {text}: unknown key(s) {unknown}; valid keys: {sorted(NoiseModel.__dataclass_fields__)}"
+        )
     return replace(PRESETS[base], **data)

@@ -84,13 +84,24 @@ class PymunkWorld:
         Steps run after the hand reaches a commanded pose.
     """
 
-    def __init__(self, part: Part, *, stiffness: float = 1.0, half_span: float = 50.0,
-                 chord_tolerance: float = 1e-4, friction: float = 0.3, dt: float = 1e-3,
-                 linear_speed: float = 20.0, angular_speed: float = math.radians(30.0),
-                 settle_steps: int = 150):
+    def __init__(
+        self,
+        part: Part,
+        *,
+        stiffness: float = 1.0,
+        half_span: float = 50.0,
+        chord_tolerance: float = 1e-4,
+        friction: float = 0.3,
+        dt: float = 1e-3,
+        linear_speed: float = 20.0,
+        angular_speed: float = math.radians(30.0),
+        settle_steps: int = 150,
+    ):
         if not (stiffness > 0 and half_span > 0 and dt > 0 and friction >= 0):
-            raise SimError(f"stiffness={stiffness!r}, half_span={half_span!r}, dt={dt!r} must be positive "
-                           f"and friction={friction!r} >= 0")
+            raise SimError(
+                f"stiffness={stiffness!r}, half_span={half_span!r}, dt={dt!r} must be positive "
+                f"and friction={friction!r} >= 0"
+            )
         self.part = part
         self.stiffness = float(stiffness)
         self.half_span = float(half_span)

@@ -52,10 +52,20 @@ class SimRig:
         Further arguments of the world (e.g. ``chord_tolerance``, ``friction``).
     """
 
-    def __init__(self, part: Part, *, noise="none", seed: int = 0, engine: str = "kinematic",
-                 wrist: Wrist = Wrist(), stiffness: float = 1.0, linear_speed: float = 20.0,
-                 angular_speed: float = math.radians(30.0), sample_period: float = 1e-3,
-                 world_options: dict | None = None):
+    def __init__(
+        self,
+        part: Part,
+        *,
+        noise="none",
+        seed: int = 0,
+        engine: str = "kinematic",
+        wrist: Wrist = Wrist(),
+        stiffness: float = 1.0,
+        linear_speed: float = 20.0,
+        angular_speed: float = math.radians(30.0),
+        sample_period: float = 1e-3,
+        world_options: dict | None = None,
+    ):
         if engine not in ENGINES:
             raise SimError(f"unknown engine {engine!r}; use one of {list(ENGINES)}")
         self.model = part
@@ -65,8 +75,13 @@ class SimRig:
         if engine == "pymunk":
             from .pymunk_world import PymunkWorld
 
-            self.world = PymunkWorld(self.part, stiffness=stiffness, linear_speed=linear_speed,
-                                     angular_speed=angular_speed, **(world_options or {}))
+            self.world = PymunkWorld(
+                self.part,
+                stiffness=stiffness,
+                linear_speed=linear_speed,
+                angular_speed=angular_speed,
+                **(world_options or {}),
+            )
         else:
             self.world = QuasiStaticWorld(self.part, stiffness=stiffness, **(world_options or {}))
         self.wrist = wrist
@@ -83,8 +98,9 @@ class SimRig:
         if not all(math.isfinite(v) for v in pose):
             raise SimError(f"move to {pose!r}: the pose must be finite")
         x0, y0, p0 = self.world.hand or pose
-        self.time += max(math.hypot(pose[0] - x0, pose[1] - y0) / self.linear_speed,
-                         abs(pose[2] - p0) / self.angular_speed)
+        self.time += max(
+            math.hypot(pose[0] - x0, pose[1] - y0) / self.linear_speed, abs(pose[2] - p0) / self.angular_speed
+        )
         self.world.set_hand(*pose)
 
     def pose(self) -> tuple:
@@ -101,17 +117,29 @@ class SimRig:
         self.time = float(times[-1])
         out = (float(np.mean(v1)), float(np.mean(v2)))
         x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
-        self.samples.append({
-            "time": self.time, "x": x, "y": y, "phi": phi, "phi_measured": self.pose()[2],
-            "v1": out[0], "v2": out[1], "force": c.force, "jaw_position": c.jaw_position,
-            "contact_arc": float(self.model.wrap_arc(self.model.arc_at_param(c.param))) if c.force > 0 else float("nan"),
-            "at_edge": c.at_edge,
-        })
+        self.samples.append(
+            {
+                "time": self.time,
+                "x": x,
+                "y": y,
+                "phi": phi,
+                "phi_measured": self.pose()[2],
+                "v1": out[0],
+                "v2": out[1],
+                "force": c.force,
+                "jaw_position": c.jaw_position,
+                "contact_arc": float(self.model.wrap_arc(self.model.arc_at_param(c.param)))
+                if c.force > 0
+                else float("nan"),
+                "at_edge": c.at_edge,
+            }
+        )
         return out
 
     # ------------------------------------------------ Rig: force servo
-    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5,
-              seed: int | None = None) -> dict:
+    def servo(
+        self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5, seed: int | None = None
+    ) -> dict:
         """Hold the contact force with the arm's 1 kHz servo along the jaw normal.
 
         The arm pushes with the target force plus ``gain`` times the force
@@ -152,24 +180,34 @@ class SimRig:
             raise SimError("servo: the jaw is not touching the part; press into contact first")
         vpn = self.wrist.volts_per_newton
         stiffness = float(getattr(self.world, "stiffness", 1.0))  # N/mm
-        start = c.force / stiffness * 1e-3                          # m of press
+        start = c.force / stiffness * 1e-3  # m of press
         axis = Axis(damping=5.0)
-        spec = Servo(target=target / vpn, gain=gain, contact_stiffness=stiffness * 1e3, start=start,
-                     sensor_noise=self.noise.v1_noise / vpn, sensor_resolution=self.noise.adc_step / vpn,
-                     duration=duration)
+        spec = Servo(
+            target=target / vpn,
+            gain=gain,
+            contact_stiffness=stiffness * 1e3,
+            start=start,
+            sensor_noise=self.noise.v1_noise / vpn,
+            sensor_resolution=self.noise.adc_step / vpn,
+            duration=duration,
+        )
         pc = PassivityController(axis.dt, sign_fix=True, hold_fix=True, booking="observed") if guard else None
         if seed is None:
-            seed = int(self.rng.integers(2 ** 31))
+            seed = int(self.rng.integers(2**31))
         tr = simulate_servo(spec, pc, axis=axis, seed=seed)
-        moved = (tr.position[-1] - start) * 1e3                  # mm further along the normal
+        moved = (tr.position[-1] - start) * 1e3  # mm further along the normal
         x, y, phi = hand
         self.world.set_hand(x - moved * math.sin(phi), y + moved * math.cos(phi), phi)
         self.time += duration
         tail = tr.time >= duration / 2
         force = tr.contact_force[tail]
-        return {"dv1": float(force.mean() * vpn), "dv1_std": float(force.std() * vpn),
-                "contact_lost": int((force == 0).sum()), "min_energy": float(tr.energy.min()),
-                "guard": bool(guard)}
+        return {
+            "dv1": float(force.mean() * vpn),
+            "dv1_std": float(force.std() * vpn),
+            "contact_lost": int((force == 0).sum()),
+            "min_energy": float(tr.energy.min()),
+            "guard": bool(guard),
+        }
 
     def truth(self) -> dict:
         """Ground truth of the present contact (simulation only)."""

@@ -48,7 +48,7 @@ class Wrist:
         force = np.asarray(force, dtype=float)
         mb = force * self.height
         mt = force * np.asarray(d, dtype=float)
-        return -6.0 * mb / (self.w1 * self.delta ** 2), 3.0 * mt / (self.w2 ** 2 * self.delta)
+        return -6.0 * mb / (self.w1 * self.delta**2), 3.0 * mt / (self.w2**2 * self.delta)
 
     def ideal_voltages(self, force, d):
         """Noise-free (Δv1, Δv2), V: both channels have the same volts per MPa."""

@@ -23,8 +23,16 @@ def _exported_errors():
 
 def test_packages_export_their_errors():
     names = {attr for _, attr, _ in _exported_errors()}
-    assert {"RolltouchError", "PartError", "QueryError", "SimError", "RigError", "ProtocolError",
-            "ControlError", "StudyError"} <= names
+    assert {
+        "RolltouchError",
+        "PartError",
+        "QueryError",
+        "SimError",
+        "RigError",
+        "ProtocolError",
+        "ControlError",
+        "StudyError",
+    } <= names
 
 
 @pytest.mark.parametrize("package, name, cls", _exported_errors(), ids=lambda v: v if isinstance(v, str) else "")

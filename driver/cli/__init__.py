@@ -45,7 +45,7 @@ def _registrars() -> list:
     for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
         try:
             found.append(ep.load())
-        except Exception as exc:   # a broken add-on must not take the rig's commands with it
+        except Exception as exc:  # a broken add-on must not take the rig's commands with it
             print(f"rolltouch: warning: command group {ep.name!r} ({ep.value}) not loaded: {exc}", file=sys.stderr)
     return found
 
@@ -67,7 +67,7 @@ def main(argv=None) -> int:
     try:
         return int(args.run(args))
     except UsageError as exc:
-        args.parser.error(str(exc))     # exits with status 2
+        args.parser.error(str(exc))  # exits with status 2
     except RolltouchError as exc:
         print(f"rolltouch: error: {exc}", file=sys.stderr)
         return 2

@@ -8,8 +8,16 @@ import math
 
 from localizer import RolltouchError
 
-__all__ = ["UsageError", "add_command", "positive", "probability", "rig_arguments", "servo_arguments",
-           "reactive_arguments", "servo_option"]
+__all__ = [
+    "UsageError",
+    "add_command",
+    "positive",
+    "probability",
+    "rig_arguments",
+    "servo_arguments",
+    "reactive_arguments",
+    "servo_option",
+]
 
 
 class UsageError(RolltouchError, ValueError):
@@ -54,22 +62,38 @@ def rig_arguments(p) -> None:
 
 def servo_arguments(p) -> None:
     """--servo-gain and --no-guard: hold the force with the arm's servo after every press."""
-    p.add_argument("--servo-gain", type=positive, metavar="G",
-                   help="after every press, hold Δv1 with the arm's 1 kHz force servo at this gain (N/N) "
-                        "for 0.3 s, refusing a loop that loses the part or rings above 0.05 V (docs/passivity.md); default: no servo")
-    p.add_argument("--no-guard", action="store_true",
-                   help="run that servo without its passivity observer/controller")
+    p.add_argument(
+        "--servo-gain",
+        type=positive,
+        metavar="G",
+        help="after every press, hold Δv1 with the arm's 1 kHz force servo at this gain (N/N) "
+        "for 0.3 s, refusing a loop that loses the part or rings above 0.05 V (docs/passivity.md); default: no servo",
+    )
+    p.add_argument("--no-guard", action="store_true", help="run that servo without its passivity observer/controller")
 
 
 def reactive_arguments(p) -> None:
     """--reactive and its options: roll until the belief is sure (driver.reactive)."""
-    p.add_argument("--reactive", action="store_true",
-                   help="instead of fixed rolls, roll step by step until the contact is known within 0.3 mm "
-                        "with --confidence, or --max-rotation is rolled (docs/robustness.md)")
-    p.add_argument("--confidence", type=probability, default=0.95, metavar="P",
-                   help="reactive: probability within 0.3 mm that stops the rolling (default 0.95)")
-    p.add_argument("--max-rotation", type=positive, default=240.0, metavar="DEG",
-                   help="reactive: rotation budget, both directions counted (default 240°)")
+    p.add_argument(
+        "--reactive",
+        action="store_true",
+        help="instead of fixed rolls, roll step by step until the contact is known within 0.3 mm "
+        "with --confidence, or --max-rotation is rolled (docs/robustness.md)",
+    )
+    p.add_argument(
+        "--confidence",
+        type=probability,
+        default=0.95,
+        metavar="P",
+        help="reactive: probability within 0.3 mm that stops the rolling (default 0.95)",
+    )
+    p.add_argument(
+        "--max-rotation",
+        type=positive,
+        default=240.0,
+        metavar="DEG",
+        help="reactive: rotation budget, both directions counted (default 240°)",
+    )
 
 
 def servo_option(args) -> dict:

@@ -17,15 +17,33 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
     """Run the reactive localization on ``rig``; the JSON object of 'simulate|run --reactive'."""
     from driver.reactive import localize_reactively
 
-    res = localize_reactively(rig, part, calibration=calibration, filter=ContactFilter(part),
-                              approach_pose=approach_pose, step=math.radians(args.step),
-                              confidence=args.confidence, max_rotation=math.radians(args.max_rotation),
-                              observer=observer, **servo_option(args))
+    res = localize_reactively(
+        rig,
+        part,
+        calibration=calibration,
+        filter=ContactFilter(part),
+        approach_pose=approach_pose,
+        step=math.radians(args.step),
+        confidence=args.confidence,
+        max_rotation=math.radians(args.max_rotation),
+        observer=observer,
+        **servo_option(args),
+    )
     b = res.belief
-    doc = {"part": part.name, "method": "reactive", "estimate_arc": b.map_arc, "mass": b.mass,
-           "ambiguous": b.ambiguous, "informative": b.informative, "stopped": res.stopped,
-           "rotation_deg": math.degrees(res.rotation), "steps": res.steps, "reversals": res.reversals,
-           "regrasps": res.regrasps, "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]]}
+    doc = {
+        "part": part.name,
+        "method": "reactive",
+        "estimate_arc": b.map_arc,
+        "mass": b.mass,
+        "ambiguous": b.ambiguous,
+        "informative": b.informative,
+        "stopped": res.stopped,
+        "rotation_deg": math.degrees(res.rotation),
+        "steps": res.steps,
+        "reversals": res.reversals,
+        "regrasps": res.regrasps,
+        "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+    }
     truth = getattr(rig, "truth", None)
     if truth is not None:
         true_arc = truth()["contact_arc"]
@@ -36,14 +54,18 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
 
 def print_reactive(doc) -> None:
     verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
-    print(f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
-          f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)")
+    print(
+        f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
+        f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)"
+    )
     print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within 0.3 mm")
     for m in doc["modes"][1:3]:
         print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")
     if doc.get("error_mm") is not None:
         err = doc["error_mm"]
-        print(f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)")
+        print(
+            f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)"
+        )
 
 
 def run_summary(part, trace, loc) -> dict:
@@ -88,9 +110,12 @@ def print_run(doc) -> None:
         print("no place on the part fits these rolls")
     else:
         verdict = "AMBIGUOUS" if doc["ambiguous"] else "localized"
-        print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm "
-              f"(p={doc['candidates'][0]['probability']:.3f})")
+        print(
+            f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm (p={doc['candidates'][0]['probability']:.3f})"
+        )
     if "true_arc" in doc:
         err = doc["error_mm"]
-        print(f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
-              f"({'success' if err is not None and err < 0.3 else 'failure'} at 0.3 mm)")
+        print(
+            f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
+            f"({'success' if err is not None and err < 0.3 else 'failure'} at 0.3 mm)"
+        )

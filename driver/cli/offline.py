@@ -18,32 +18,73 @@ __all__ = ["register", "localize_command", "locate_command"]
 
 def register(sub) -> None:
     """Add ``localize`` and ``locate`` to the subparsers ``sub``."""
-    loc = add_command(sub, "localize", localize_command, help="find where the jaw rolled from measured (length, turn) rolls",
-                         description="Find every place on the part where the measured rolls could have "
-                                     "happened and rank them.")
+    loc = add_command(
+        sub,
+        "localize",
+        localize_command,
+        help="find where the jaw rolled from measured (length, turn) rolls",
+        description="Find every place on the part where the measured rolls could have happened and rank them.",
+    )
     loc.add_argument("part", help="part file (JSON of DESIGN.md, or CSV of x,y in mm)")
     loc.add_argument("--length", type=float, required=True, metavar="MM", help="contact travel of the first roll, mm")
-    loc.add_argument("--turn", type=float, required=True, metavar="DEG",
-                     help="jaw rotation of the first roll, degrees (counter-clockwise positive)")
-    loc.add_argument("--then", nargs=2, type=float, action="append", default=[], metavar=("MM", "DEG"),
-                     help="a following roll: contact travel (mm) and rotation (deg); repeat for more")
+    loc.add_argument(
+        "--turn",
+        type=float,
+        required=True,
+        metavar="DEG",
+        help="jaw rotation of the first roll, degrees (counter-clockwise positive)",
+    )
+    loc.add_argument(
+        "--then",
+        nargs=2,
+        type=float,
+        action="append",
+        default=[],
+        metavar=("MM", "DEG"),
+        help="a following roll: contact travel (mm) and rotation (deg); repeat for more",
+    )
     loc.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
-    loc.add_argument("--direction", choices=DIRECTIONS, default="ccw",
-                     help="direction the contact moved on the part (default ccw)")
-    loc.add_argument("--sd-length", type=positive, default=0.5, metavar="MM",
-                     help="std. dev. of a measured contact travel (likelihood rule, default 0.5 mm)")
-    loc.add_argument("--sd-turn", type=positive, default=0.03, metavar="DEG",
-                     help="std. dev. of a measured rotation (likelihood rule, default 0.03 deg)")
-    loc.add_argument("--length-tol", type=positive, default=0.004, metavar="MM",
-                     help="paper rule: length tolerance (default 0.004 mm)")
-    loc.add_argument("--turn-tol", type=positive, default=float(np.degrees(0.0004)), metavar="DEG",
-                     help="paper rule: turn tolerance (default 0.0004 rad = 0.0229 deg)")
+    loc.add_argument(
+        "--direction", choices=DIRECTIONS, default="ccw", help="direction the contact moved on the part (default ccw)"
+    )
+    loc.add_argument(
+        "--sd-length",
+        type=positive,
+        default=0.5,
+        metavar="MM",
+        help="std. dev. of a measured contact travel (likelihood rule, default 0.5 mm)",
+    )
+    loc.add_argument(
+        "--sd-turn",
+        type=positive,
+        default=0.03,
+        metavar="DEG",
+        help="std. dev. of a measured rotation (likelihood rule, default 0.03 deg)",
+    )
+    loc.add_argument(
+        "--length-tol",
+        type=positive,
+        default=0.004,
+        metavar="MM",
+        help="paper rule: length tolerance (default 0.004 mm)",
+    )
+    loc.add_argument(
+        "--turn-tol",
+        type=positive,
+        default=float(np.degrees(0.0004)),
+        metavar="DEG",
+        help="paper rule: turn tolerance (default 0.0004 rad = 0.0229 deg)",
+    )
     loc.add_argument("--json", action="store_true", help="print the result as JSON")
     loc.add_argument("--plot", metavar="FILE.png", help="draw the part, the candidate segments and the contact")
 
-
-    lct = add_command(sub, "locate", locate_command, help="localize from a saved trace",
-                         description="Recompute the rolls' (L, Ω) from a trace's readings and localize.")
+    lct = add_command(
+        sub,
+        "locate",
+        locate_command,
+        help="localize from a saved trace",
+        description="Recompute the rolls' (L, Ω) from a trace's readings and localize.",
+    )
     lct.add_argument("trace", help="trace file (.npz) from 'rolltouch simulate'")
     lct.add_argument("--part", required=True, help="part file (the model the localizer is given)")
     lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
@@ -54,9 +95,16 @@ def register(sub) -> None:
 def localize_command(args) -> int:
     part = load_part(args.part)
     rolls = [(args.length, np.radians(args.turn))] + [(L, np.radians(d)) for L, d in args.then]
-    result = localize(part, rolls, rule=args.rule, direction=args.direction, sd_length=args.sd_length,
-                      sd_turn=float(np.radians(args.sd_turn)), length_tol=args.length_tol,
-                      turn_tol=float(np.radians(args.turn_tol)))
+    result = localize(
+        part,
+        rolls,
+        rule=args.rule,
+        direction=args.direction,
+        sd_length=args.sd_length,
+        sd_turn=float(np.radians(args.sd_turn)),
+        length_tol=args.length_tol,
+        turn_tol=float(np.radians(args.turn_tol)),
+    )
 
     def xy(arc):
         return [float(v) for v in part.point_at_arc(arc)]
@@ -69,8 +117,9 @@ def localize_command(args) -> int:
             "direction": result.direction,
             "rolls": [{"length": L, "turn": w, "turn_deg": float(np.degrees(w))} for L, w in result.rolls],
             "segments": [dict(s.as_dict(), start_xy=xy(s.start_arc), end_xy=xy(s.end_arc)) for s in result.segments],
-            "candidates": [dict(c.as_dict(), start_xy=xy(c.start_arc), end_xy=xy(c.end_arc))
-                           for c in result.candidates],
+            "candidates": [
+                dict(c.as_dict(), start_xy=xy(c.start_arc), end_xy=xy(c.end_arc)) for c in result.candidates
+            ],
             "best": 0 if result.best is not None else None,
             "ambiguous": result.ambiguous,
         }
@@ -78,8 +127,7 @@ def localize_command(args) -> int:
         sys.stdout.write("\n")
     else:
         print(f"part {part.name}: perimeter {part.perimeter:.3f} mm, {part.n_knots} knots")
-        print(f"roll 1 (L={rolls[0][0]:.4g} mm, turn={args.turn:.4g} deg): "
-              f"{len(result.segments)} feasible segment(s)")
+        print(f"roll 1 (L={rolls[0][0]:.4g} mm, turn={args.turn:.4g} deg): {len(result.segments)} feasible segment(s)")
         if not result.candidates:
             print("no place on the part fits these rolls")
         else:
@@ -88,8 +136,10 @@ def localize_command(args) -> int:
                 x, y = xy(c.end_arc)
                 print(f"{k:>3} {c.start_arc:>10.3f} {c.end_arc:>15.3f} {x:>9.3f} {y:>9.3f} {c.probability:>6.3f}")
             verdict = "AMBIGUOUS" if result.ambiguous else "localized"
-            print(f"{verdict}: contact now at arc {result.best.end_arc:.3f} mm "
-                  f"(p={result.best.probability:.3f}, rule {result.rule})")
+            print(
+                f"{verdict}: contact now at arc {result.best.end_arc:.3f} mm "
+                f"(p={result.best.probability:.3f}, rule {result.rule})"
+            )
     if args.plot:
         from driver.plotting import plot_localization
 

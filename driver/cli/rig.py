@@ -19,22 +19,36 @@ __all__ = ["register", "calibrate_command", "run_command"]
 
 def register(sub) -> None:
     """Add ``calibrate`` and ``run`` to the subparsers ``sub``."""
-    cal = add_command(sub, "calibrate", calibrate_command, help="calibrate the wrist sensor on a rig (paper §III-B)",
-                         description="With the jaw's centre facing an immobilized object, clear of it: tap it "
-                                     "at 11 jaw positions from -50 to 50 mm and save the ratio spline.")
+    cal = add_command(
+        sub,
+        "calibrate",
+        calibrate_command,
+        help="calibrate the wrist sensor on a rig (paper §III-B)",
+        description="With the jaw's centre facing an immobilized object, clear of it: tap it "
+        "at 11 jaw positions from -50 to 50 mm and save the ratio spline.",
+    )
     rig_arguments(cal)
     cal.add_argument("--out", required=True, metavar="CAL.json", help="calibration file to write")
 
-
-    run = add_command(sub, "run", run_command, help="roll on a rig and localize",
-                         description="From the present pose (the jaw's centre facing the start point, clear "
-                                     "of the part): calibrate if no calibration is given, slide 40 mm, "
-                                     "establish contact, roll, localize.")
+    run = add_command(
+        sub,
+        "run",
+        run_command,
+        help="roll on a rig and localize",
+        description="From the present pose (the jaw's centre facing the start point, clear "
+        "of the part): calibrate if no calibration is given, slide 40 mm, "
+        "establish contact, roll, localize.",
+    )
     run.add_argument("part", help="part file")
     rig_arguments(run)
     run.add_argument("--calibration", metavar="CAL.json", help="calibration from 'rolltouch calibrate'")
-    run.add_argument("--roll", type=float, action="append", metavar="DEG",
-                     help="a roll's rotation in degrees; repeat (default 20 then 15)")
+    run.add_argument(
+        "--roll",
+        type=float,
+        action="append",
+        metavar="DEG",
+        help="a roll's rotation in degrees; repeat (default 20 then 15)",
+    )
     run.add_argument("--step", type=positive, default=0.2, metavar="DEG", help="rolling step (default 0.2°)")
     servo_arguments(run)
     reactive_arguments(run)
@@ -50,15 +64,19 @@ def calibrate_command(args) -> int:
     with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
         calibration = calibrate(rig, rig.pose())
     calibration.save(args.out)
-    print(f"calibration written to {args.out}: ratio {calibration.ratios[0]:.5f} at -50 mm to "
-          f"{calibration.ratios[-1]:.5f} at +50 mm")
+    print(
+        f"calibration written to {args.out}: ratio {calibration.ratios[0]:.5f} at -50 mm to "
+        f"{calibration.ratios[-1]:.5f} at +50 mm"
+    )
     return 0
 
 
 def _progress(event) -> None:
     if event.get("event") == "reading":
-        sys.stderr.write(f"\rroll {event['roll'] + 1}  step {event['step']:>4}/{event['steps']}  "
-                         f"Δv1 {event['dv1']:.3f} V  contact {event['jaw_position']:+7.2f} mm ")
+        sys.stderr.write(
+            f"\rroll {event['roll'] + 1}  step {event['step']:>4}/{event['steps']}  "
+            f"Δv1 {event['dv1']:.3f} V  contact {event['jaw_position']:+7.2f} mm "
+        )
         sys.stderr.flush()
 
 
@@ -71,11 +89,19 @@ def run_command(args) -> int:
     part = load_part(args.part)
     rolls = args.roll or [20.0, 15.0]
     calibration = Calibration.load(args.calibration) if args.calibration else None
-    header = {"part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
-              "arm": args.arm, "daq": args.daq, "rolls_deg": rolls, "step_deg": args.step}
+    header = {
+        "part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        "arm": args.arm,
+        "daq": args.daq,
+        "rolls_deg": rolls,
+        "step_deg": args.step,
+    }
     if calibration is not None:
-        header["calibration"] = {"positions": list(calibration.positions), "ratios": list(calibration.ratios),
-                                 "target": calibration.target}
+        header["calibration"] = {
+            "positions": list(calibration.positions),
+            "ratios": list(calibration.ratios),
+            "target": calibration.target,
+        }
     log = RunLog(args.log, header) if args.log else None
 
     def observer(event):
@@ -86,11 +112,25 @@ def run_command(args) -> int:
     if args.reactive:
         return _run_reactively(args, part, calibration, log, observer)
     with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
-        run, calibration = run_from_here(rig, part, [math.radians(r) for r in rolls], calibration=calibration,
-                                         step=math.radians(args.step), observer=observer,
-                                         **servo_option(args))
-    trace = Trace.from_run(run, calibration, part=header["part"], arm=args.arm, daq=args.daq,
-                           rolls_deg=rolls, step_deg=args.step, engine="serial")
+        run, calibration = run_from_here(
+            rig,
+            part,
+            [math.radians(r) for r in rolls],
+            calibration=calibration,
+            step=math.radians(args.step),
+            observer=observer,
+            **servo_option(args),
+        )
+    trace = Trace.from_run(
+        run,
+        calibration,
+        part=header["part"],
+        arm=args.arm,
+        daq=args.daq,
+        rolls_deg=rolls,
+        step_deg=args.step,
+        engine="serial",
+    )
     doc = run_summary(part, trace, run.localization)
     if log is not None:
         log({"event": "result", **doc})
@@ -121,8 +161,10 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
     def progress(event):
         observer(event)
         if event.get("event") == "belief":
-            sys.stderr.write(f"\rrolled {math.degrees(event['rotation']):6.1f}°  best {event['map_arc']:8.2f} mm  "
-                             f"{event['mass']:6.1%} within 0.3 mm ")
+            sys.stderr.write(
+                f"\rrolled {math.degrees(event['rotation']):6.1f}°  best {event['map_arc']:8.2f} mm  "
+                f"{event['mass']:6.1%} within 0.3 mm "
+            )
             sys.stderr.flush()
 
     with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:

@@ -20,19 +20,42 @@ __all__ = ["register", "simulate_command", "emulate_command"]
 
 def register(sub) -> None:
     """Add ``simulate`` and ``emulate`` to the subparsers ``sub``."""
-    sim = add_command(sub, "simulate", simulate_command, help="roll a simulated jaw on a part and save the trace",
-                         description="Calibrate a simulated rig, establish contact at --start, roll, "
-                                     "localize, and save the readings with their ground truth.")
+    sim = add_command(
+        sub,
+        "simulate",
+        simulate_command,
+        help="roll a simulated jaw on a part and save the trace",
+        description="Calibrate a simulated rig, establish contact at --start, roll, "
+        "localize, and save the readings with their ground truth.",
+    )
     sim.add_argument("part", help="part file")
-    sim.add_argument("--start", type=float, required=True, metavar="MM",
-                     help="arc position of the first contact, mm counter-clockwise from the part's first point")
-    sim.add_argument("--roll", type=float, action="append", metavar="DEG",
-                     help="a roll's rotation, degrees (positive: counter-clockwise); repeat for more rolls "
-                          "(required unless --reactive)")
-    sim.add_argument("--noise", default="paper", metavar="none|paper|FILE.toml",
-                     help="noise model: a preset or a TOML file (default paper)")
-    sim.add_argument("--engine", choices=("pymunk", "kinematic"), default="pymunk",
-                     help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk)")
+    sim.add_argument(
+        "--start",
+        type=float,
+        required=True,
+        metavar="MM",
+        help="arc position of the first contact, mm counter-clockwise from the part's first point",
+    )
+    sim.add_argument(
+        "--roll",
+        type=float,
+        action="append",
+        metavar="DEG",
+        help="a roll's rotation, degrees (positive: counter-clockwise); repeat for more rolls "
+        "(required unless --reactive)",
+    )
+    sim.add_argument(
+        "--noise",
+        default="paper",
+        metavar="none|paper|FILE.toml",
+        help="noise model: a preset or a TOML file (default paper)",
+    )
+    sim.add_argument(
+        "--engine",
+        choices=("pymunk", "kinematic"),
+        default="pymunk",
+        help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk)",
+    )
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     sim.add_argument("--step", type=positive, default=0.2, metavar="DEG", help="rolling step, degrees (default 0.2)")
     servo_arguments(sim)
@@ -41,23 +64,36 @@ def register(sub) -> None:
     sim.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
     sim.add_argument("--json", action="store_true", help="print the result as JSON")
 
-
-    emu = add_command(sub, "emulate", emulate_command, help="serve the arm and DAQ protocols, backed by a simulated rig",
-                         description="Emulate the arm controller and the DAQ of docs/protocol.md on "
-                                     "loopback TCP (arm on PORT, DAQ on PORT+1) or on two pseudo-terminals, "
-                                     "until killed.")
+    emu = add_command(
+        sub,
+        "emulate",
+        emulate_command,
+        help="serve the arm and DAQ protocols, backed by a simulated rig",
+        description="Emulate the arm controller and the DAQ of docs/protocol.md on "
+        "loopback TCP (arm on PORT, DAQ on PORT+1) or on two pseudo-terminals, "
+        "until killed.",
+    )
     emu.add_argument("part", help="part file")
     emu.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
-    emu.add_argument("--start", type=float, metavar="MM",
-                     help="the hand starts with the jaw's centre facing this arc position, 1 mm off "
-                          "(default: the part's most curved point that the whole jaw reaches)")
+    emu.add_argument(
+        "--start",
+        type=float,
+        metavar="MM",
+        help="the hand starts with the jaw's centre facing this arc position, 1 mm off "
+        "(default: the part's most curved point that the whole jaw reaches)",
+    )
     emu.add_argument("--noise", default="paper", metavar="none|paper|FILE.toml", help="noise model (default paper)")
-    emu.add_argument("--engine", choices=("pymunk", "kinematic"), default="kinematic",
-                     help="the simulated world (default kinematic)")
+    emu.add_argument(
+        "--engine", choices=("pymunk", "kinematic"), default="kinematic", help="the simulated world (default kinematic)"
+    )
     emu.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    emu.add_argument("--fault", action="append", default=[], metavar="NAME=VALUE",
-                     help="inject a fault: drop=P, garble=P, delay=S, disconnect-after=N, saturate=V; repeatable")
-
+    emu.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="inject a fault: drop=P, garble=P, delay=S, disconnect-after=N, saturate=V; repeatable",
+    )
 
 
 def simulate_command(args) -> int:
@@ -79,29 +115,55 @@ def simulate_command(args) -> int:
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
     _check_reach(part, args.start, jaw_start)
     if args.reactive:
-        doc, res = run_reactive(args, rig, part, calibration,
-                             rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0))
-        np.savez(args.out, arcs=np.array(res.arcs), turns=np.array(res.turns), true_arcs=np.array(res.true_arcs),
-                 segments=np.array(res.segments), history=np.array(res.history, dtype=float).reshape(-1, 4),
-                 metadata=np.array(json.dumps({**doc, "noise": str(args.noise), "seed": args.seed,
-                                               "engine": args.engine, "start_arc": args.start})))
+        doc, res = run_reactive(
+            args, rig, part, calibration, rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0)
+        )
+        np.savez(
+            args.out,
+            arcs=np.array(res.arcs),
+            turns=np.array(res.turns),
+            true_arcs=np.array(res.true_arcs),
+            segments=np.array(res.segments),
+            history=np.array(res.history, dtype=float).reshape(-1, 4),
+            metadata=np.array(
+                json.dumps(
+                    {**doc, "noise": str(args.noise), "seed": args.seed, "engine": args.engine, "start_arc": args.start}
+                )
+            ),
+        )
         doc["trace"] = str(args.out)
         print(json.dumps(doc, indent=2) if args.json else "", end="\n" if args.json else "")
         if not args.json:
             print_reactive(doc)
             print(f"readings written to {args.out}")
         return 0
-    run = localize_by_rolling(rig, part, rolls, calibration=calibration, step=math.radians(args.step),
-                              approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0),
-                              **servo_option(args))
+    run = localize_by_rolling(
+        rig,
+        part,
+        rolls,
+        calibration=calibration,
+        step=math.radians(args.step),
+        approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0),
+        **servo_option(args),
+    )
     first = run.rolls[0].truth[0][0]
     if math.isfinite(first) and abs(float(part.arc_offset(first, args.start))) > 1.0:
-        raise RigError(f"--start {args.start} mm is not on the part's convex hull: a straight jaw laid there "
-                       f"touches at {first:.2f} mm instead")
-    trace = Trace.from_run(run, calibration, part={"name": part.name, "file": str(args.part),
-                                                   "perimeter": part.perimeter},
-                           engine=args.engine, noise_name=str(args.noise), noise=asdict(noise), seed=args.seed,
-                           start_arc=args.start, rolls_deg=list(args.roll), step_deg=args.step)
+        raise RigError(
+            f"--start {args.start} mm is not on the part's convex hull: a straight jaw laid there "
+            f"touches at {first:.2f} mm instead"
+        )
+    trace = Trace.from_run(
+        run,
+        calibration,
+        part={"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        engine=args.engine,
+        noise_name=str(args.noise),
+        noise=asdict(noise),
+        seed=args.seed,
+        start_arc=args.start,
+        rolls_deg=list(args.roll),
+        step_deg=args.step,
+    )
     trace.save(args.out)
     doc = run_summary(part, trace, run.localization)
     doc["trace"] = str(args.out)
@@ -118,11 +180,15 @@ def _check_reach(part, start: float, jaw: float) -> None:
         return
     lo, hi = (float(v) for v in reach.interval(start))
     lo, hi = max(lo, -DEFAULT_JAW.half), min(hi, DEFAULT_JAW.half)
-    where = (f"it touches there only with the contact between {lo:+.1f} and {hi:+.1f} mm on the jaw"
-             if lo < hi else "no place on the jaw touches there (a concave stretch, or a concavity narrower "
-                             "than the jaw)")
-    raise RigError(f"--start {start} mm: a {DEFAULT_JAW} jaw laid there with the contact at {jaw:+.0f} mm on it "
-                   f"would touch the part elsewhere; {where}. Pick another start")
+    where = (
+        f"it touches there only with the contact between {lo:+.1f} and {hi:+.1f} mm on the jaw"
+        if lo < hi
+        else "no place on the jaw touches there (a concave stretch, or a concavity narrower than the jaw)"
+    )
+    raise RigError(
+        f"--start {start} mm: a {DEFAULT_JAW} jaw laid there with the contact at {jaw:+.0f} mm on it "
+        f"would touch the part elsewhere; {where}. Pick another start"
+    )
 
 
 def emulate_command(args) -> int:

@@ -21,8 +21,10 @@ def test_a_family_is_a_function_of_its_seed(tmp_path):
         assert 36 <= part.n_knots <= 90 and part.perimeter > 100.0
 
 
-@pytest.mark.parametrize("folder, seed, count", [("tuning", TUNING_SEED, 24), ("heldout-a", HELDOUT_A_SEED, 24),
-                                                 ("heldout-b", HELDOUT_SEED, 24)])
+@pytest.mark.parametrize(
+    "folder, seed, count",
+    [("tuning", TUNING_SEED, 24), ("heldout-a", HELDOUT_A_SEED, 24), ("heldout-b", HELDOUT_SEED, 24)],
+)
 def test_the_shipped_families_are_what_their_seed_gives(folder, seed, count):
     shipped = sorted((ROOT / "bench" / "parts" / folder).glob("*.json"))
     assert len(shipped) == count

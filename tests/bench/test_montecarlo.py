@@ -20,7 +20,7 @@ def study_file(tmp_path, trials=4, extra=""):
     f = tmp_path / "s.toml"
     f.write_text(f'''
 name = "small"
-parts = ["{ROOT / 'parts' / 'cam.json'}"]
+parts = ["{ROOT / "parts" / "cam.json"}"]
 rolls_deg = [20.0, 15.0]
 method = "paper"
 trials = {trials}
@@ -33,8 +33,9 @@ noise = "paper"
 
 def table(out):
     rows = read_trials(Path(out) / "trials.csv")
-    return sorted(({k: v for k, v in r.items() if k != "time_s"} for r in rows),
-                  key=lambda r: (int(r["level"]), int(r["trial"])))
+    return sorted(
+        ({k: v for k, v in r.items() if k != "time_s"} for r in rows), key=lambda r: (int(r["level"]), int(r["trial"]))
+    )
 
 
 @pytest.fixture(scope="module")
@@ -89,30 +90,36 @@ def test_resume_after_a_killed_run(tmp_path):
 def test_dask_local_cluster_gives_the_same_table(reference):
     distributed = pytest.importorskip("distributed")
     study, ref, tmp = reference
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None,
-                                  processes=True) as cluster:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None, processes=True) as cluster:
         run_study(study, tmp / "dask", scheduler=cluster.scheduler_address, progress=False)
     assert table(tmp / "dask") == ref
 
 
-@pytest.mark.parametrize("text, match", [
-    ('parts = ["nope.json"]\nrolls_deg = [20.0]', "part file .*nope.json does not exist"),
-    ('parts = []\nrolls_deg = [20.0]', "'parts' must be a non-empty list"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0, -15.0]', "one sign"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "guess"', "method 'guess'"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\ntrials = 0', "trials=0 must be an integer >= 1"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\ncolour = 3', r"unknown key\(s\) \['colour'\]"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v9"\nvalues = [1.0]', "not a noise-model field"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v2_noise"\nvalues = [-1.0]', "must be >= 0"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nnoise = "lab"', "noise"),
-    ('parts = [', "not valid TOML"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["paper", "oracle"]', "methods .* distinct names"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "paper"\nmethods = ["paper"]', "not both"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\nconfidence = 1.5',
-     "confidence=1.5 must be below 1"),
-    ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2',
-     r"unknown key\(s\) \['speed'\]"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ('parts = ["nope.json"]\nrolls_deg = [20.0]', "part file .*nope.json does not exist"),
+        ("parts = []\nrolls_deg = [20.0]", "'parts' must be a non-empty list"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0, -15.0]', "one sign"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "guess"', "method 'guess'"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\ntrials = 0', "trials=0 must be an integer >= 1"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\ncolour = 3', r"unknown key\(s\) \['colour'\]"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v9"\nvalues = [1.0]', "not a noise-model field"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v2_noise"\nvalues = [-1.0]', "must be >= 0"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\nnoise = "lab"', "noise"),
+        ("parts = [", "not valid TOML"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["paper", "oracle"]', "methods .* distinct names"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "paper"\nmethods = ["paper"]', "not both"),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\nconfidence = 1.5',
+            "confidence=1.5 must be below 1",
+        ),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2',
+            r"unknown key\(s\) \['speed'\]",
+        ),
+    ],
+)
 def test_bad_study_files(tmp_path, text, match):
     f = tmp_path / "bad.toml"
     f.write_text(text.replace("{cam}", str(ROOT / "parts" / "cam.json")))
@@ -134,8 +141,17 @@ def test_wilson_interval():
 
 
 def test_shipped_studies_load():
-    for name in ("paper", "arc_length", "rotation", "machining", "reactive", "filters", "tuning", "heldout",
-                 "heldout-a"):
+    for name in (
+        "paper",
+        "arc_length",
+        "rotation",
+        "machining",
+        "reactive",
+        "filters",
+        "tuning",
+        "heldout",
+        "heldout-a",
+    ):
         s = load_study(ROOT / "bench" / "studies" / f"{name}.toml")
         assert s.trials > 0
     paper = load_study(ROOT / "bench" / "studies" / "paper.toml")
@@ -146,8 +162,23 @@ def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
     from driver.cli import main
 
     out = tmp_path / "r"
-    assert main(["montecarlo", str(ROOT / "bench" / "studies" / "reactive.toml"), "--out", str(out),
-                 "--trials", "2", "--engine", "kinematic", "--workers", "1"]) == 0
+    assert (
+        main(
+            [
+                "montecarlo",
+                str(ROOT / "bench" / "studies" / "reactive.toml"),
+                "--out",
+                str(out),
+                "--trials",
+                "2",
+                "--engine",
+                "kinematic",
+                "--workers",
+                "1",
+            ]
+        )
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     assert set(summary["methods"]) == {"paper", "particle", "reactive"}
     assert all(0.0 <= r <= 1.0 for r in summary["methods"].values())
@@ -173,7 +204,7 @@ def test_grid_method_scores_the_filter_on_the_fixed_readings(tmp_path):
     rows = read_trials(out / "trials.csv")
     for r in rows:
         assert float(r["grid_rotation_deg"]) == pytest.approx(35.0)
-        assert len(r["grid_curve"].split()) == 7                       # every 5° of the 35°
+        assert len(r["grid_curve"].split()) == 7  # every 5° of the 35°
         # the filter was fed the same readings as the paper's rule: it lands where the truth is
         # or fails like a method, never as a broken trial
         assert r["failure"] == "" and math.isfinite(float(r["grid_error_mm"]))
@@ -183,7 +214,7 @@ def small_methods_study(tmp_path, extra=""):
     f = tmp_path / "m.toml"
     f.write_text(f'''
 name = "methods"
-parts = ["{ROOT / 'parts' / 'cam.json'}"]
+parts = ["{ROOT / "parts" / "cam.json"}"]
 rolls_deg = [20.0, 15.0]
 methods = ["paper", "particle", "grid"]
 trials = 2
@@ -210,7 +241,7 @@ def test_one_methods_error_is_that_methods_failure_only(tmp_path, monkeypatch):
 
     monkeypatch.setattr(localizer, "localize", paper_breaks)
     row = run_trial(TrialSpec(study, 0, 0))
-    assert row["failure"] == ""                                   # the trial itself did not break
+    assert row["failure"] == ""  # the trial itself did not break
     assert row["paper_stopped"] == "error" and row["paper_success"] == 0
     assert row["paper_failure"].startswith("QueryError: length=-15.875")
     for m in ("particle", "grid"):
@@ -228,7 +259,7 @@ def test_summary_is_strict_json_with_the_per_method_record(tmp_path):
     summary = json.loads((tmp_path / "out" / "summary.json").read_text(), parse_constant=refuse)
     for m in study.methods:
         d = summary["method_details"][m]
-        assert d["confident"] == 0 and d["confident_wrong"] == 0        # fixed rolls never stop sure
+        assert d["confident"] == 0 and d["confident_wrong"] == 0  # fixed rolls never stop sure
         assert d["per_part"] == {"cam.json": {"success": d["success"], "trials": 2}}
     rows = read_trials(tmp_path / "out" / "trials.csv")
     for r in rows:
@@ -260,7 +291,7 @@ def test_a_reactive_table_without_standard_deviations_uses_the_filters_own(tmp_p
     default = ContactFilter(flt.part)
     assert (flt.sd_position, flt.sd_scale, flt.sd_slope) == (default.sd_position, default.sd_scale, default.sd_slope)
     assert flt.noise_scales == NOISE_SCALES and flt.confidence == 0.9
-    pinned = small_methods_study(tmp_path, extra="[reactive]\nnoise_scales = [1.0]\nsd_slope = \"auto\"")
+    pinned = small_methods_study(tmp_path, extra='[reactive]\nnoise_scales = [1.0]\nsd_slope = "auto"')
     assert reactive_filter(pinned, flt.part, load_noise("paper")).noise_scales == (1.0,)
     with pytest.raises(StudyError, match="noise_scales"):
         small_methods_study(tmp_path, extra="[reactive]\nnoise_scales = [-1.0]")

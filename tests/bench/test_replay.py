@@ -14,7 +14,7 @@ def recorded(tmp_path_factory):
     f = tmp_path_factory.mktemp("replay") / "s.toml"
     f.write_text(f'''
 name = "replay"
-parts = ["{ROOT / 'parts' / 'trefoil.json'}"]
+parts = ["{ROOT / "parts" / "trefoil.json"}"]
 rolls_deg = [20.0, 15.0]
 methods = ["reactive"]
 trials = 1
@@ -33,7 +33,7 @@ def test_the_recorded_calls_give_back_the_run_belief(recorded):
     as_run = replay(rec)
     assert as_run.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
     assert as_run.error_mm == pytest.approx(float(rec.row["reactive_error_mm"]), abs=0.06)
-    assert as_run.margin > 0                 # it localized: the true start leads
+    assert as_run.margin > 0  # it localized: the true start leads
 
 
 def test_a_variant_changes_only_the_filter(recorded):

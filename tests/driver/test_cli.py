@@ -14,8 +14,22 @@ def test_localize_json_names_the_truth(capsys):
     part = load_part(PARTS / "trefoil.json")
     pos = 120.0 + np.cumsum([0.0, 25.0, 20.0])
     turns = np.degrees(np.diff(part.tangent_angle_at_arc(pos)))
-    rc = main(["localize", str(PARTS / "trefoil.json"), "--length", "25", "--turn", repr(float(turns[0])),
-               "--then", "20", repr(float(turns[1])), "--json", "--rule", "paper"])
+    rc = main(
+        [
+            "localize",
+            str(PARTS / "trefoil.json"),
+            "--length",
+            "25",
+            "--turn",
+            repr(float(turns[0])),
+            "--then",
+            "20",
+            repr(float(turns[1])),
+            "--json",
+            "--rule",
+            "paper",
+        ]
+    )
     assert rc == 0
     doc = json.loads(capsys.readouterr().out)
     best = doc["candidates"][doc["best"]]
@@ -29,8 +43,21 @@ def test_localize_json_names_the_truth(capsys):
 
 def test_localize_text_and_plot(tmp_path, capsys):
     png = tmp_path / "loc.png"
-    rc = main(["localize", str(PARTS / "cam.json"), "--length", "25", "--turn", "35.89",
-               "--then", "20", "23.59", "--plot", str(png)])
+    rc = main(
+        [
+            "localize",
+            str(PARTS / "cam.json"),
+            "--length",
+            "25",
+            "--turn",
+            "35.89",
+            "--then",
+            "20",
+            "23.59",
+            "--plot",
+            str(png),
+        ]
+    )
     assert rc == 0
     out = capsys.readouterr().out
     assert "contact now at arc" in out and "feasible segment" in out

@@ -50,8 +50,11 @@ def test_servo_needs_contact():
 def test_hold_force_on_a_rig_without_a_servo():
     class Bare:
         def move(self, x, y, phi): ...
-        def pose(self): return (0.0, 0.0, 0.0)
-        def read(self, n=32): return (0.0, 0.0)
+        def pose(self):
+            return (0.0, 0.0, 0.0)
+
+        def read(self, n=32):
+            return (0.0, 0.0)
 
     with pytest.raises(RigError, match="Bare has no force servo"):
         hold_force(Bare())
@@ -88,8 +91,23 @@ def test_serial_servo_rejects_bad_arguments():
 def test_simulate_with_an_aggressive_servo_needs_the_guard(tmp_path, capsys):
     from driver.cli import main
 
-    args = ["simulate", str(ROOT / "parts" / "trefoil.json"), "--start", "120", "--roll", "20", "--roll", "15",
-            "--engine", "kinematic", "--servo-gain", "20", "--out", str(tmp_path / "t.npz"), "--json"]
+    args = [
+        "simulate",
+        str(ROOT / "parts" / "trefoil.json"),
+        "--start",
+        "120",
+        "--roll",
+        "20",
+        "--roll",
+        "15",
+        "--engine",
+        "kinematic",
+        "--servo-gain",
+        "20",
+        "--out",
+        str(tmp_path / "t.npz"),
+        "--json",
+    ]
     assert main(args + ["--no-guard"]) == 2
     assert "lost the part" in capsys.readouterr().err
     assert main(args) == 0
@@ -109,8 +127,13 @@ def test_a_serial_run_holds_every_press_with_the_guarded_servo(tmp_path):
     log = RunLog(tmp_path / "run.jsonl", {})
     try:
         with SerialRig(arm, daq, log=log) as serial_rig:
-            run, _ = run_from_here(serial_rig, PART, [math.radians(10)], observer=log,
-                                   servo={"gain": 20.0, "guard": True, "duration": 0.3, "max_std": 0.05})
+            run, _ = run_from_here(
+                serial_rig,
+                PART,
+                [math.radians(10)],
+                observer=log,
+                servo={"gain": 20.0, "guard": True, "duration": 0.3, "max_std": 0.05},
+            )
     finally:
         emu.close()
         log.close()

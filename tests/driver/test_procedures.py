@@ -48,7 +48,7 @@ def test_calibration_recovers_contact_location(cam, noise, rms_limit, max_limit)
         dv1, dv2 = _delta(rig, base, 32)
         errs.append(cal.position(dv2 / dv1) - rig.truth()["jaw_position"])
     errs = np.array(errs)
-    assert np.sqrt(np.mean(errs ** 2)) < rms_limit and np.abs(errs).max() < max_limit
+    assert np.sqrt(np.mean(errs**2)) < rms_limit and np.abs(errs).max() < max_limit
 
 
 def roll_errors(part, cal, step_deg, starts, noise="none", offset=None):
@@ -88,8 +88,8 @@ def test_turn_matches_to_the_encoder_quantization(cam, cam_cal):
 
 def test_tool_axis_offset_correction(cam, cam_cal):
     """Without the edge-offset term, L is short by the wrist's give times the turn."""
-    (with_err, _, r), = roll_errors(cam, cam_cal, 0.2, [90.0])
-    (without_err, _, _), = roll_errors(cam, cam_cal, 0.2, [90.0], offset=0.0)
+    ((with_err, _, r),) = roll_errors(cam, cam_cal, 0.2, [90.0])
+    ((without_err, _, _),) = roll_errors(cam, cam_cal, 0.2, [90.0], offset=0.0)
     assert r.offset == pytest.approx(1.0, rel=0.02)  # 1 N at 1 N/mm
     assert without_err == pytest.approx(with_err - r.offset * abs(r.turn), abs=0.01)
     assert abs(with_err) < 0.05
@@ -97,8 +97,13 @@ def test_tool_axis_offset_correction(cam, cam_cal):
 
 def localize_from(part, cal, start, noise="none", seed=3, rolls=(30.0, 25.0)):
     rig = SimRig(part, noise=noise, seed=seed)
-    run = localize_by_rolling(rig, part, [math.radians(a) for a in rolls], calibration=cal,
-                              approach_pose=rig.approach_pose(start, jaw_position=-40, standoff=1.0))
+    run = localize_by_rolling(
+        rig,
+        part,
+        [math.radians(a) for a in rolls],
+        calibration=cal,
+        approach_pose=rig.approach_pose(start, jaw_position=-40, standoff=1.0),
+    )
     truth = rig.truth()["contact_arc"]
     return run, truth, abs(float(part.arc_offset(run.estimate_arc, truth)))
 

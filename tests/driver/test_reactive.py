@@ -36,8 +36,14 @@ def test_it_stops_when_sure_and_is_right(trefoil):
     part, cal = trefoil
     rig = SimRig(part, noise="none", seed=1)
     flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
-    run = localize_reactively(rig, part, calibration=cal, filter=flt, confidence=0.95,
-                              approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
+    run = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=flt,
+        confidence=0.95,
+        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+    )
     assert run.stopped == "confident" and run.belief.mass >= 0.95
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
     assert run.rotation < math.radians(120)
@@ -50,25 +56,38 @@ def test_it_stops_only_after_the_confidence_held_at_confirm_checks_in_a_row(tref
     for confirm in (1, 4):
         rig = SimRig(part, noise="none", seed=1)
         flt = ContactFilter(part)
-        runs[confirm] = localize_reactively(rig, part, calibration=cal, filter=flt, confidence=0.95, confirm=confirm,
-                                            approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
+        runs[confirm] = localize_reactively(
+            rig,
+            part,
+            calibration=cal,
+            filter=flt,
+            confidence=0.95,
+            confirm=confirm,
+            approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+        )
     for confirm, run in runs.items():
         masses = [h[2] for h in run.history]
         assert run.stopped == "confident"
         assert all(m >= 0.95 for m in masses[-confirm:])
         # it did not stop earlier: no earlier run of confirm checks in a row at the confidence
         for k in range(len(masses) - confirm):
-            assert not all(m >= 0.95 for m in masses[k:k + confirm])
+            assert not all(m >= 0.95 for m in masses[k : k + confirm])
     # the same rig and readings up to the first stop: the longer rule rolls on from there
-    assert runs[4].history[:len(runs[1].history)] == runs[1].history
+    assert runs[4].history[: len(runs[1].history)] == runs[1].history
     assert len(runs[4].history) >= len(runs[1].history) + 3
 
 
 def test_the_rotation_budget_stops_it(trefoil):
     part, cal = trefoil
     rig = SimRig(part, noise="none", seed=1)
-    run = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(2.0), confidence=1 - 1e-9,
-                              approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0))
+    run = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        max_rotation=math.radians(2.0),
+        confidence=1 - 1e-9,
+        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+    )
     assert run.stopped == "max_rotation" and run.rotation == pytest.approx(math.radians(2.0), abs=1e-9)
     assert run.steps == 10
 
@@ -78,8 +97,14 @@ def test_on_an_ellipse_it_stays_ambiguous_and_says_so():
     cal = calibration(part)
     rig = SimRig(part, noise="none", seed=2)
     flt = ContactFilter(part, sd_position=0.02, sd_scale=0.0, sd_slope=0.0)
-    run = localize_reactively(rig, part, calibration=cal, filter=flt, max_rotation=math.radians(30.0),
-                              approach_pose=rig.approach_pose(40.0, jaw_position=-40.0, standoff=1.0))
+    run = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=flt,
+        max_rotation=math.radians(30.0),
+        approach_pose=rig.approach_pose(40.0, jaw_position=-40.0, standoff=1.0),
+    )
     assert run.stopped == "max_rotation"
     assert run.belief.ambiguous and len(run.belief.modes) >= 2
     m1, m2 = run.belief.modes[:2]
@@ -91,19 +116,24 @@ def test_direction_helpers_on_a_symmetric_belief():
     flt = ContactFilter(part)
     a = part.perimeter / 4
     ccw, cw = spread_by_direction(flt, math.radians(15), starts=[a, a + part.perimeter / 2])
-    assert ccw < 0.005 and cw < 0.005                     # symmetric modes: grid rounding only
+    assert ccw < 0.005 and cw < 0.005  # symmetric modes: grid rounding only
     ccw, cw = spread_by_direction(flt, math.radians(15), starts=[a, a + 10.0])
     assert ccw > 0.1 and cw > 0.1
-    assert clear_ahead(flt, 1, math.radians(15)) == pytest.approx(1.0)                 # convex all round
+    assert clear_ahead(flt, 1, math.radians(15)) == pytest.approx(1.0)  # convex all round
 
 
 def test_bad_arguments(trefoil):
     part, cal = trefoil
     rig = SimRig(part, seed=0)
     pose = rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0)
-    for kwargs, match in (({"max_rotation": 0}, "max_rotation=0"), ({"direction": 2}, "direction=2"),
-                          ({"confidence": 1.0}, "confidence=1.0"), ({"step": -1}, "step=-1"),
-                          ({"confirm": 0}, "confirm=0"), ({"confirm": 1.5}, "confirm=1.5")):
+    for kwargs, match in (
+        ({"max_rotation": 0}, "max_rotation=0"),
+        ({"direction": 2}, "direction=2"),
+        ({"confidence": 1.0}, "confidence=1.0"),
+        ({"step": -1}, "step=-1"),
+        ({"confirm": 0}, "confirm=0"),
+        ({"confirm": 1.5}, "confirm=1.5"),
+    ):
         with pytest.raises(RigError, match=match):
             localize_reactively(rig, part, calibration=cal, approach_pose=pose, **kwargs)
 
@@ -131,8 +161,23 @@ def test_cli_simulate_and_run_reactive(tmp_path, capsys):
     from driver.cli import main
 
     part_file = str(PARTS / "trefoil.json")
-    assert main(["simulate", part_file, "--start", "211.1", "--reactive", "--engine", "kinematic",
-                 "--out", str(tmp_path / "r.npz"), "--json"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                part_file,
+                "--start",
+                "211.1",
+                "--reactive",
+                "--engine",
+                "kinematic",
+                "--out",
+                str(tmp_path / "r.npz"),
+                "--json",
+            ]
+        )
+        == 0
+    )
     doc = json.loads(capsys.readouterr().out)
     for key in ("estimate_arc", "mass", "stopped", "rotation_deg", "modes", "true_arc", "error_mm"):
         assert key in doc
@@ -143,8 +188,22 @@ def test_cli_simulate_and_run_reactive(tmp_path, capsys):
     emu = Emulator(rig, start_pose=rig.approach_pose(211.1, jaw_position=0.0, standoff=1.0))
     arm, daq = emu.serve_tcp(0)
     try:
-        rc = main(["run", part_file, "--arm", arm, "--daq", daq, "--reactive", "--max-rotation", "3",
-                   "--log", str(tmp_path / "run.jsonl"), "--json"])
+        rc = main(
+            [
+                "run",
+                part_file,
+                "--arm",
+                arm,
+                "--daq",
+                daq,
+                "--reactive",
+                "--max-rotation",
+                "3",
+                "--log",
+                str(tmp_path / "run.jsonl"),
+                "--json",
+            ]
+        )
     finally:
         emu.close()
     assert rc == 0
@@ -164,9 +223,15 @@ def test_the_two_turning_rules_do_not_rock_the_jaw():
     cal = calibration_with(part, "paper", seed=2140531231)
     rig = SimRig(part, noise="paper", seed=568606712)
     flt = ContactFilter(part, sd_position=0.04, sd_scale=0.003, sd_slope=0.002, confidence=0.99)
-    run = localize_reactively(rig, part, calibration=cal, filter=flt, confidence=0.99,
-                              max_rotation=math.radians(120.0),
-                              approach_pose=rig.approach_pose(203.584, jaw_position=-40.0, standoff=1.0))
+    run = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=flt,
+        confidence=0.99,
+        max_rotation=math.radians(120.0),
+        approach_pose=rig.approach_pose(203.584, jaw_position=-40.0, standoff=1.0),
+    )
     assert run.reversals <= 4
     assert run.stopped == "confident"
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
@@ -181,7 +246,7 @@ def test_a_start_deep_in_a_wide_concavity_is_not_localized_elsewhere_and_sure():
     from localizer import part_from_points, tracks_for
 
     a = np.linspace(0, 2 * np.pi, 60, endpoint=False)
-    r = 80 * (1 + 0.3 * np.cos(3 * a) + 0.04 * np.cos(a + 0.5) + 0.03 * np.cos(2 * a + 1.0))   # no symmetry
+    r = 80 * (1 + 0.3 * np.cos(3 * a) + 0.04 * np.cos(a + 0.5) + 0.03 * np.cos(2 * a + 1.0))  # no symmetry
     part = part_from_points(np.c_[r * np.cos(a), r * np.sin(a)], name="star")
     t = tracks_for(part, 0.02)
     depth = t.reach.hull_depth[np.rint(t.sigma / t.reach.h).astype(int) % t.reach.sigma.size]
@@ -190,7 +255,12 @@ def test_a_start_deep_in_a_wide_concavity_is_not_localized_elsewhere_and_sure():
     cal = calibration_with(part)
     for start in t.sigma[ok[:: max(1, ok.size // 3)]][:3]:
         rig = SimRig(part, noise="none", seed=1)
-        run = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(90.0),
-                                  approach_pose=rig.approach_pose(float(start), jaw_position=-40.0, standoff=1.0))
+        run = localize_reactively(
+            rig,
+            part,
+            calibration=cal,
+            max_rotation=math.radians(90.0),
+            approach_pose=rig.approach_pose(float(start), jaw_position=-40.0, standoff=1.0),
+        )
         err = abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))
         assert run.stopped == "confident" and err < 0.3, (start, run.stopped, err)

@@ -142,8 +142,10 @@ def test_ctrl_c_backs_off_the_jaw(tmp_path):
 def test_workspace_and_unreachable_device():
     emu = emulator()
     arm, daq = emu.serve_tcp(0)
-    with (SerialRig(arm, daq, workspace=Workspace(x=(-10.0, 10.0))) as rig,
-          pytest.raises(RigError, match=r"x=50.0 is outside the workspace \[-10.0, 10.0\]")):
+    with (
+        SerialRig(arm, daq, workspace=Workspace(x=(-10.0, 10.0))) as rig,
+        pytest.raises(RigError, match=r"x=50.0 is outside the workspace \[-10.0, 10.0\]"),
+    ):
         rig.move(50.0, 0.0, 0.0)
     emu.close()
     with pytest.raises(RigError, match="cannot open the arm"):
@@ -173,9 +175,17 @@ def test_replies_round_trip(seq, values):
     assert r.seq == seq and r.numbers(len(values)) == tuple(values)
 
 
-@pytest.mark.parametrize("line, code, seq", [(b"7 FLY 1 2 3", "BADCMD", 7), (b"9 MOVE 1 2", "BADARG", 9),
-                                             (b"4 MOVE 1 x 3", "BADARG", 4), (b"4 MOVE 1 nan 3", "BADARG", 4),
-                                             (b"MOVE 1 2 3", "BADCMD", 0), (b"\xff\xfe", "BADCMD", 0)])
+@pytest.mark.parametrize(
+    "line, code, seq",
+    [
+        (b"7 FLY 1 2 3", "BADCMD", 7),
+        (b"9 MOVE 1 2", "BADARG", 9),
+        (b"4 MOVE 1 x 3", "BADARG", 4),
+        (b"4 MOVE 1 nan 3", "BADARG", 4),
+        (b"MOVE 1 2 3", "BADCMD", 0),
+        (b"\xff\xfe", "BADCMD", 0),
+    ],
+)
 def test_bad_requests_carry_their_code_and_sequence(line, code, seq):
     with pytest.raises(ProtocolError) as info:
         parse_request(line, ARM_COMMANDS)
@@ -193,38 +203,86 @@ def test_cli_emulate_and_run(tmp_path):
     port = 47000 + os.getpid() % 1000
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     exe = [sys.executable, "-m", "driver.cli"]
-    emu = subprocess.Popen(exe + ["emulate", str(ROOT / "parts" / "trefoil.json"), "--tcp", str(port),
-                                  "--start", "120", "--seed", "3"], stdout=subprocess.PIPE, text=True, env=env)
+    emu = subprocess.Popen(
+        exe + ["emulate", str(ROOT / "parts" / "trefoil.json"), "--tcp", str(port), "--start", "120", "--seed", "3"],
+        stdout=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert emu.stdout.readline().startswith("arm socket://127.0.0.1:")
         emu.stdout.readline()
-        out = subprocess.run(exe + ["run", str(ROOT / "parts" / "trefoil.json"), "--arm",
-                                    f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}",
-                                    "--json", "--log", str(tmp_path / "r.jsonl")],
-                             capture_output=True, text=True, timeout=120, env=env)
+        out = subprocess.run(
+            exe
+            + [
+                "run",
+                str(ROOT / "parts" / "trefoil.json"),
+                "--arm",
+                f"socket://127.0.0.1:{port}",
+                "--daq",
+                f"socket://127.0.0.1:{port + 1}",
+                "--json",
+                "--log",
+                str(tmp_path / "r.jsonl"),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env=env,
+        )
     finally:
         emu.terminate()
         emu.wait(10)
     assert out.returncode == 0, out.stderr
     doc = json.loads(out.stdout)
     assert "estimate_arc" in doc and "candidates" in doc
-    loc = subprocess.run(exe + ["locate", str(tmp_path / "r.jsonl"), "--part", str(ROOT / "parts" / "trefoil.json"),
-                                "--json"], capture_output=True, text=True, timeout=60, env=env)
+    loc = subprocess.run(
+        exe + ["locate", str(tmp_path / "r.jsonl"), "--part", str(ROOT / "parts" / "trefoil.json"), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
     assert loc.returncode == 0 and json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"])
 
 
 def test_cli_run_fails_with_one_line_on_disconnect(tmp_path):
     port = 48000 + os.getpid() % 1000
     exe = [sys.executable, "-m", "driver.cli"]
-    emu = subprocess.Popen(exe + ["emulate", str(ROOT / "parts" / "trefoil.json"), "--tcp", str(port),
-                                  "--start", "120", "--fault", "disconnect-after=50"], stdout=subprocess.PIPE,
-                           text=True)
+    emu = subprocess.Popen(
+        exe
+        + [
+            "emulate",
+            str(ROOT / "parts" / "trefoil.json"),
+            "--tcp",
+            str(port),
+            "--start",
+            "120",
+            "--fault",
+            "disconnect-after=50",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
         emu.stdout.readline()
         emu.stdout.readline()
-        out = subprocess.run(exe + ["run", str(ROOT / "parts" / "trefoil.json"), "--arm",
-                                    f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}",
-                                    "--timeout", "0.5"], capture_output=True, text=True, timeout=60)
+        out = subprocess.run(
+            exe
+            + [
+                "run",
+                str(ROOT / "parts" / "trefoil.json"),
+                "--arm",
+                f"socket://127.0.0.1:{port}",
+                "--daq",
+                f"socket://127.0.0.1:{port + 1}",
+                "--timeout",
+                "0.5",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
     finally:
         emu.terminate()
         emu.wait(10)

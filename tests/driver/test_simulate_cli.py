@@ -16,8 +16,24 @@ PARTS = Path(__file__).resolve().parents[2] / "parts"
 @pytest.fixture(scope="module")
 def trace_file(tmp_path_factory):
     out = tmp_path_factory.mktemp("sim") / "t.npz"
-    rc = main(["simulate", str(PARTS / "trefoil.json"), "--start", "120", "--roll", "20", "--roll", "15",
-               "--noise", "none", "--engine", "kinematic", "--out", str(out)])
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "trefoil.json"),
+            "--start",
+            "120",
+            "--roll",
+            "20",
+            "--roll",
+            "15",
+            "--noise",
+            "none",
+            "--engine",
+            "kinematic",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     return out
 
@@ -46,9 +62,29 @@ def test_trace_roundtrip_and_recomputed_estimates(trace_file):
 
 def test_simulate_json_and_plot(tmp_path, capsys):
     out, png = tmp_path / "t.npz", tmp_path / "t.png"
-    rc = main(["simulate", str(PARTS / "cam.json"), "--start", "60", "--roll", "25", "--roll", "20",
-               "--noise", "paper", "--engine", "kinematic", "--seed", "3", "--out", str(out), "--plot", str(png),
-               "--json"])
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "cam.json"),
+            "--start",
+            "60",
+            "--roll",
+            "25",
+            "--roll",
+            "20",
+            "--noise",
+            "paper",
+            "--engine",
+            "kinematic",
+            "--seed",
+            "3",
+            "--out",
+            str(out),
+            "--plot",
+            str(png),
+            "--json",
+        ]
+    )
     assert rc == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["trace"] == str(out) and "error_mm" in doc
@@ -56,11 +92,39 @@ def test_simulate_json_and_plot(tmp_path, capsys):
 
 
 def test_simulate_errors(tmp_path, capsys):
-    rc = main(["simulate", str(PARTS / "cam.json"), "--start", "9999", "--roll", "20", "--noise", "none",
-               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "cam.json"),
+            "--start",
+            "9999",
+            "--roll",
+            "20",
+            "--noise",
+            "none",
+            "--engine",
+            "kinematic",
+            "--out",
+            str(tmp_path / "x.npz"),
+        ]
+    )
     assert rc == 2 and "--start 9999.0 mm must be in" in capsys.readouterr().err
-    rc = main(["simulate", str(PARTS / "cam.json"), "--start", "10", "--roll", "20", "--noise", "lab",
-               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "cam.json"),
+            "--start",
+            "10",
+            "--roll",
+            "20",
+            "--noise",
+            "lab",
+            "--engine",
+            "kinematic",
+            "--out",
+            str(tmp_path / "x.npz"),
+        ]
+    )
     assert rc == 2 and "use a preset" in capsys.readouterr().err
     # a start in a concavity: refused before anything moves (the jaw's reach)
     from localizer import load_part
@@ -68,8 +132,22 @@ def test_simulate_errors(tmp_path, capsys):
     part = load_part(PARTS / "trefoil.json")
     t = np.linspace(0, part.n_knots, 9000, endpoint=False)
     concave = float(part.arc_at_param(t[np.argmin(part.curvature(t))]))
-    rc = main(["simulate", str(PARTS / "trefoil.json"), "--start", f"{concave:.3f}", "--roll", "10", "--noise", "none",
-               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "trefoil.json"),
+            "--start",
+            f"{concave:.3f}",
+            "--roll",
+            "10",
+            "--noise",
+            "none",
+            "--engine",
+            "kinematic",
+            "--out",
+            str(tmp_path / "x.npz"),
+        ]
+    )
     err = capsys.readouterr().err
     assert rc == 2 and "no place on the jaw touches there" in err
 
@@ -88,9 +166,23 @@ def test_a_start_the_jaw_cannot_be_laid_on_is_refused_before_anything_moves(tmp_
 
     kidney = load_part(PARTS / "kidney.csv")
     s = np.arange(0, kidney.perimeter, 0.5)
-    deepest = float(s[np.argmin(np.asarray(kidney.curvature_at_arc(s)))])    # inside the concavity
-    rc = main(["simulate", str(PARTS / "kidney.csv"), "--start", f"{deepest}", "--roll", "20", "--noise", "none",
-               "--engine", "kinematic", "--out", str(tmp_path / "x.npz")])
+    deepest = float(s[np.argmin(np.asarray(kidney.curvature_at_arc(s)))])  # inside the concavity
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "kidney.csv"),
+            "--start",
+            f"{deepest}",
+            "--roll",
+            "20",
+            "--noise",
+            "none",
+            "--engine",
+            "kinematic",
+            "--out",
+            str(tmp_path / "x.npz"),
+        ]
+    )
     assert rc == 2
     err = capsys.readouterr().err
     assert f"--start {deepest} mm" in err and "no place on the jaw touches there" in err

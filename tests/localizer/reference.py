@@ -57,8 +57,10 @@ class DenseCurve:
         g = self.theta_at(s + length) - self.theta_at(s) - turn
         idx = np.flatnonzero(np.sign(g) != np.sign(np.roll(g, -1)))
         roots = []
+
         def f(x):
             return float(self.theta_at(x + length) - self.theta_at(x) - turn)
+
         for i in idx:
             a, b = s[i], (s[i + 1] if i + 1 < len(s) else self.perimeter)
             if g[i] == 0:

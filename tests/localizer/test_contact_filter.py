@@ -36,7 +36,7 @@ def feed(flt, z, turns):
 
 def test_noise_free_posterior_concentrates_at_the_truth(cam):
     flt = ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0)
-    turns = STEP * np.arange(1, 176)                      # 35°, the paper's total
+    turns = STEP * np.arange(1, 176)  # 35°, the paper's total
     z, arcs = readings(flt, 57.3, turns)
     feed(flt, z, turns)
     b = flt.belief()
@@ -48,7 +48,7 @@ def test_noise_free_posterior_concentrates_at_the_truth(cam):
 def test_noisy_posterior_covers_the_truth_and_sharpens_with_rotation(cam):
     rng = np.random.default_rng(4)
     flt = ContactFilter(cam, sd_position=0.035, sd_scale=0.0, sd_slope=0.0)
-    turns = STEP * np.arange(1, 451)                      # 90°
+    turns = STEP * np.arange(1, 451)  # 90°
     z, arcs = readings(flt, 140.0, turns, rng, 0.035)
     masses = []
     for k, (a, t) in enumerate(zip(z, turns)):
@@ -65,12 +65,12 @@ def test_on_a_circle_the_belief_stays_flat_and_says_so():
     circle = part_from_points(np.c_[25 * np.cos(a), 25 * np.sin(a)], name="circle")
     flt = ContactFilter(circle, sd_position=0.02)
     turns = STEP * np.arange(1, 101)
-    z = 25.0 * turns                                      # what any start gives on a circle
+    z = 25.0 * turns  # what any start gives on a circle
     feed(flt, z, turns)
     b = flt.belief()
     assert not b.informative and not b.ambiguous
     w = flt.posterior()
-    assert w.max() / w[w > 0].min() < 1.05                # uniform
+    assert w.max() / w[w > 0].min() < 1.05  # uniform
     assert b.mass < 0.01
 
 
@@ -100,12 +100,12 @@ def test_a_regrasp_offset_is_absorbed(cam):
         flt = ContactFilter(cam, sd_position=0.02, sd_slope=0.0)
         z, _ = readings(flt, 90.0, turns)
         feed(flt, z[:50], turns[:50])
-        flt.regrasp(z[49] + jump, turns[49])              # the arc across a lift is unknown
+        flt.regrasp(z[49] + jump, turns[49])  # the arc across a lift is unknown
         feed(flt, z[50:] + jump, turns[50:])
         lls.append(flt.log_likelihood())
     fin = np.isfinite(lls[0])
     assert np.array_equal(fin, np.isfinite(lls[1]))
-    assert np.allclose(lls[0][fin], lls[1][fin], atol=1e-3)   # the offsets' prior is flat to 1e6 mm²
+    assert np.allclose(lls[0][fin], lls[1][fin], atol=1e-3)  # the offsets' prior is flat to 1e6 mm²
 
 
 def test_a_start_off_the_hull_is_not_a_hypothesis():
@@ -120,10 +120,15 @@ def test_a_start_off_the_hull_is_not_a_hypothesis():
     assert flt.feasible.mean() < 1.0 and flt.feasible.mean() > 0.5
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"spacing": 0}, "spacing=0"), ({"sd_position": -1}, "sd_position=-1"),
-    ({"sd_slope": float("nan")}, "sd_slope=nan"), ({"confidence": 1.0}, "confidence=1.0"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"spacing": 0}, "spacing=0"),
+        ({"sd_position": -1}, "sd_position=-1"),
+        ({"sd_slope": float("nan")}, "sd_slope=nan"),
+        ({"confidence": 1.0}, "confidence=1.0"),
+    ],
+)
 def test_bad_filter_parameters(cam, kwargs, match):
     with pytest.raises(QueryError, match=match):
         ContactFilter(cam, **kwargs)
@@ -154,7 +159,7 @@ def test_the_slope_term_does_not_fit_the_reading_noise(kidney):
     # Readings with only white noise, on the kidney's convex stretch where a reading-derived
     # radius once moved the belief 0.5 mm off the truth while stating 99% (docs/robustness.md):
     # with the slope-error model on, the truth must stay inside the stated belief.
-    turns = -STEP * np.arange(1, 551)                     # 110° clockwise
+    turns = -STEP * np.arange(1, 551)  # 110° clockwise
     start = 29.3
     travel = exact_travel(kidney, start, turns)
     misses, overconfident = 0, 0
@@ -176,7 +181,7 @@ def test_the_shift_recovers_a_known_slope_error(cam):
     # The posterior of that term at the last reading must find it, within its stated spread.
     # (no drift term: on one monotone roll a drift rate trades off against the start)
     flt = ContactFilter(cam, sd_position=0.01, sd_scale=0.0, sd_slope=0.002, sd_drift=0.0)
-    turns = STEP * np.arange(1, 451)                      # 90°
+    turns = STEP * np.arange(1, 451)  # 90°
     z_model, arcs = readings(flt, 57.3, turns)
     rho = 1.0 / np.asarray(cam.curvature_at_arc(cam.wrap_arc(arcs)))
     true_shift = rho * 0.002 * np.sin(2 * np.pi * z_model / 30.0)
@@ -186,7 +191,7 @@ def test_the_shift_recovers_a_known_slope_error(cam):
     assert abs(cam.arc_offset(flt.grid[i], 57.3)) < 0.05
     assert abs(mean[i] - true_shift[-1]) < 3 * sd[i] + 0.005
     assert 0 < sd[i] < rho[-1] * 0.002
-    assert abs(true_shift[-1]) > 0.02                     # the test would see a shift ignored
+    assert abs(true_shift[-1]) > 0.02  # the test would see a shift ignored
     nothing = ContactFilter(cam, sd_slope=0.0, sd_turn=0.0)
     feed(nothing, z_model[:10], turns[:10])
     assert not np.any(nothing.shift()[0]) and not np.any(nothing.shift()[1])
@@ -208,7 +213,7 @@ def stop_rule(flt, z, turns, confidence=0.95, every=5):
             if k % every == 0 and flt.belief().mass >= confidence:
                 return True, flt.belief().map_arc, k
         return False, flt.belief().map_arc, len(z)
-    except QueryError:                                    # every start ruled out: an honest "no"
+    except QueryError:  # every start ruled out: an honest "no"
         return False, math.nan, k
 
 

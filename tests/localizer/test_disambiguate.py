@@ -72,16 +72,19 @@ def test_clockwise_chain():
     assert arc_err(res.best.end_arc, pos[-1], part.perimeter) < 1e-6
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(rolls=[]), "rolls is empty"),
-    (dict(rolls=[(10.0,)]), "sequence of"),
-    (dict(rolls=[(10.0, 0.1), (-2.0, 0.1)]), r"roll 2: length=-2.0 mm"),
-    (dict(rolls=[(10.0, float("nan"))]), "roll 1: .* must be finite"),
-    (dict(rolls=[(10.0, 0.1)], rule="best"), r"unknown rule 'best'; use one of \['likelihood', 'paper'\]"),
-    (dict(rolls=[(10.0, 0.1)], sd_length=0.0), "sd_length=0.0 must be a positive number"),
-    (dict(rolls=[(10.0, 0.1)], confidence=2.0), "confidence=2.0"),
-    (dict(rolls=[(10.0, 0.1)], direction="left"), "unknown direction 'left'"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(rolls=[]), "rolls is empty"),
+        (dict(rolls=[(10.0,)]), "sequence of"),
+        (dict(rolls=[(10.0, 0.1), (-2.0, 0.1)]), r"roll 2: length=-2.0 mm"),
+        (dict(rolls=[(10.0, float("nan"))]), "roll 1: .* must be finite"),
+        (dict(rolls=[(10.0, 0.1)], rule="best"), r"unknown rule 'best'; use one of \['likelihood', 'paper'\]"),
+        (dict(rolls=[(10.0, 0.1)], sd_length=0.0), "sd_length=0.0 must be a positive number"),
+        (dict(rolls=[(10.0, 0.1)], confidence=2.0), "confidence=2.0"),
+        (dict(rolls=[(10.0, 0.1)], direction="left"), "unknown direction 'left'"),
+    ],
+)
 def test_bad_arguments(kwargs, match):
     with pytest.raises(QueryError, match=match):
         localize(trefoil(), **kwargs)

@@ -22,10 +22,13 @@ def exact_slope(part, seg):
     return float(part.curvature(seg.end_param) - part.curvature(seg.start_param))
 
 
-@pytest.mark.parametrize("make, starts, lengths", [
-    (ellipse, [10.0, 70.0, 150.0], [20.0, 35.0, 12.0]),
-    (trefoil, [30.0, 100.0, 200.0, 310.0], [25.0, 40.0, 10.0, 60.0]),
-])
+@pytest.mark.parametrize(
+    "make, starts, lengths",
+    [
+        (ellipse, [10.0, 70.0, 150.0], [20.0, 35.0, 12.0]),
+        (trefoil, [30.0, 100.0, 200.0, 310.0], [25.0, 40.0, 10.0, 60.0]),
+    ],
+)
 def test_tight_march_finds_the_exact_segments_to_the_step(make, starts, lengths):
     """With tight tolerances the march lands on every exact root, to the grid's resolution."""
     part = make()

@@ -110,16 +110,19 @@ def test_load_json_and_csv(tmp_path):
     assert part2.perimeter == pytest.approx(part.perimeter, abs=1e-12)
 
 
-@pytest.mark.parametrize("points, match", [
-    ([[0, 0], [1, 0], [1, 1]], "at least 4 points, got 3"),
-    ([[0, 0], [1, 0], [1, np.nan], [0, 1]], r"point 2 is \[1.0, nan\]: NaN or inf"),
-    ([[0, 0], [1, 0], [1, np.inf], [0, 1]], "NaN or inf"),
-    ([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1]], "points 1 and 2 coincide"),
-    ([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]], "points 4 and 0 coincide"),
-    ([[0, 0], [1, 1], [1, 0], [0, 1]], "crosses itself"),
-    ([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], r"shape \(N, 2\)"),
-    ([["a", 0], [1, 0], [1, 1], [0, 1]], "list of"),
-])
+@pytest.mark.parametrize(
+    "points, match",
+    [
+        ([[0, 0], [1, 0], [1, 1]], "at least 4 points, got 3"),
+        ([[0, 0], [1, 0], [1, np.nan], [0, 1]], r"point 2 is \[1.0, nan\]: NaN or inf"),
+        ([[0, 0], [1, 0], [1, np.inf], [0, 1]], "NaN or inf"),
+        ([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1]], "points 1 and 2 coincide"),
+        ([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]], "points 4 and 0 coincide"),
+        ([[0, 0], [1, 1], [1, 0], [0, 1]], "crosses itself"),
+        ([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], r"shape \(N, 2\)"),
+        ([["a", 0], [1, 0], [1, 1], [0, 1]], "list of"),
+    ],
+)
 def test_bad_points_raise_part_error(points, match):
     with pytest.raises(PartError, match=match):
         part_from_points(points)

@@ -41,8 +41,10 @@ def test_many_particles_agree_with_the_grid_filter(cam):
     assert mass == pytest.approx(b.mass, abs=0.2)
 
 
-@pytest.mark.parametrize("kwargs, match", [({"particles": 1}, "particles=1"), ({"sd_position": 0}, "sd_position=0"),
-                                           ({"process": -1.0}, "process=-1.0")])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [({"particles": 1}, "particles=1"), ({"sd_position": 0}, "sd_position=0"), ({"process": -1.0}, "process=-1.0")],
+)
 def test_bad_particle_filter_settings(cam, kwargs, match):
     with pytest.raises(QueryError, match=match):
         ParticleFilter(cam, **kwargs)

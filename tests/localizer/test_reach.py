@@ -60,10 +60,10 @@ def test_the_interval_agrees_with_the_definition_on_the_shipped_parts(name):
 def test_below_the_hull_of_a_wide_concavity_only_one_end_of_the_jaw_reaches(star):
     r = Reach(star)
     deep = (r.hull_depth > 4.0) & r.touchable(r.sigma)
-    assert deep.any()                                    # the old 4 mm hull tolerance left these out
+    assert deep.any()  # the old 4 mm hull tolerance left these out
     for i in np.flatnonzero(deep)[::25]:
         lo, hi = r.lo[i], r.hi[i]
-        assert lo > -50 or hi < 50                       # not the whole jaw
+        assert lo > -50 or hi < 50  # not the whole jaw
         for d in (max(lo, -50) + 0.5, min(hi, 50) - 0.5):
             if max(lo, -50) + 0.5 < min(hi, 50) - 0.5:
                 assert brute_touchable(star, r.sigma[i], d)
@@ -86,7 +86,7 @@ def test_calibration_is_at_the_most_curved_point_the_whole_jaw_reaches(star):
     kappa = np.asarray(star.curvature_at_arc(full))
     assert r.full[int(np.rint(arc / r.h)) % r.sigma.size]
     assert float(star.curvature_at_arc(arc)) == pytest.approx(kappa.max(), rel=1e-6)
-    for d in np.linspace(-50, 50, 11):                   # the 11 taps all touch there
+    for d in np.linspace(-50, 50, 11):  # the 11 taps all touch there
         assert brute_touchable(star, arc, d)
 
 

@@ -131,16 +131,19 @@ def test_circular_stretch_is_reported_as_continuum():
     assert covered == pytest.approx(part.perimeter, rel=1e-6)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(length=0.0, turn=0.1), r"length=0.0 mm is out of range"),
-    (dict(length=-1.0, turn=0.1), "out of range"),
-    (dict(length=1e4, turn=0.1), r"perimeter=337.7"),
-    (dict(length=float("nan"), turn=0.1), "must be finite"),
-    (dict(length=10.0, turn=float("inf")), "must be finite"),
-    (dict(length="ten", turn=0.1), "must be numbers"),
-    (dict(length=10.0, turn=0.1, method="newton"), r"unknown method 'newton'; use one of \['exact', 'march'\]"),
-    (dict(length=10.0, turn=0.1, direction="up"), r"unknown direction 'up'; use one of \['ccw', 'cw'\]"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(length=0.0, turn=0.1), r"length=0.0 mm is out of range"),
+        (dict(length=-1.0, turn=0.1), "out of range"),
+        (dict(length=1e4, turn=0.1), r"perimeter=337.7"),
+        (dict(length=float("nan"), turn=0.1), "must be finite"),
+        (dict(length=10.0, turn=float("inf")), "must be finite"),
+        (dict(length="ten", turn=0.1), "must be numbers"),
+        (dict(length=10.0, turn=0.1, method="newton"), r"unknown method 'newton'; use one of \['exact', 'march'\]"),
+        (dict(length=10.0, turn=0.1, direction="up"), r"unknown direction 'up'; use one of \['ccw', 'cw'\]"),
+    ],
+)
 def test_bad_queries(kwargs, match):
     with pytest.raises(QueryError, match=match):
         feasible_segments(trefoil(), **kwargs)
@@ -158,14 +161,18 @@ def test_near_double_roots_are_found_not_skipped(offset):
 
     part = trefoil()
     L = 20.0
+
     def dg(s):
         return float(part.curvature_at_arc(s + L) - part.curvature_at_arc(s))
+
     grid = np.linspace(0, part.perimeter, 2000, endpoint=False)
     vals = np.array([dg(s) for s in grid])
     i = int(np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0])
     s_star = brentq(dg, grid[i], grid[i + 1], xtol=1e-13)
+
     def phi(s):
         return float(part.tangent_angle_at_arc(s + L) - part.tangent_angle_at_arc(s))
+
     # step towards the inside of the extremum so that two roots exist for offset > 0
     curvature_sign = np.sign(phi(s_star + 0.01) + phi(s_star - 0.01) - 2 * phi(s_star))
     w = phi(s_star) + curvature_sign * offset

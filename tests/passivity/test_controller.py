@@ -21,20 +21,20 @@ def test_observer_sums_port_energy_when_passive():
 
 def test_controller_dissipates_exactly_the_produced_energy():
     pc = PassivityController(DT)
-    pc.update(1.0, 0.01)                   # E = 1e-5
-    step = pc.update(-3.0, 0.01)           # produces 3e-5: E = -2e-5
-    alpha = 2e-5 / (DT * 0.01 ** 2)        # 200 N·s/m
+    pc.update(1.0, 0.01)  # E = 1e-5
+    step = pc.update(-3.0, 0.01)  # produces 3e-5: E = -2e-5
+    alpha = 2e-5 / (DT * 0.01**2)  # 200 N·s/m
     assert step.alpha == pytest.approx(alpha)
     assert step.control == pytest.approx(alpha * 0.01)
     assert step.force == pytest.approx(-3.0 + 2.0)
     assert step.energy == pytest.approx(0.0, abs=1e-18)
-    nxt = pc.update(0.0, 0.005)            # the dissipation is booked into the observer
+    nxt = pc.update(0.0, 0.005)  # the dissipation is booked into the observer
     assert pc.energy == pytest.approx(0.0, abs=1e-18) and nxt.alpha == 0.0
 
 
 def test_no_division_by_zero_at_zero_velocity():
     pc = PassivityController(DT)
-    pc.update(-5.0, 0.01)                  # E < 0, damped
+    pc.update(-5.0, 0.01)  # E < 0, damped
     step = pc.update(-5.0, 0.0)
     assert step.alpha == 0.0 and step.control == 0.0 and math.isfinite(step.force)
 
@@ -71,7 +71,7 @@ def test_sign_fix_ignores_only_energy_produced_at_a_velocity_sign_change():
 
 def test_force_limit_bounds_the_control_and_keeps_the_rest_in_the_observer():
     pc = PassivityController(DT, force_limit=0.5)
-    step = pc.update(-3.0, 0.01)           # would need 3 N of control
+    step = pc.update(-3.0, 0.01)  # would need 3 N of control
     assert step.control == pytest.approx(0.5)
     assert step.energy == pytest.approx(-3e-5 + DT * 0.5 * 0.01)
 
@@ -85,14 +85,14 @@ def test_bad_parameters():
 
 def test_observed_booking_pairs_the_held_output_with_the_next_motion():
     pc = PassivityController(DT, booking="observed")
-    s0 = pc.update(2.0, 0.01)              # nothing was held before: books 0
+    s0 = pc.update(2.0, 0.01)  # nothing was held before: books 0
     assert s0.energy == 0.0 and s0.control == 0.0
-    s1 = pc.update(5.0, 0.02)              # 2 N held while moving 0.02 m/s
+    s1 = pc.update(5.0, 0.02)  # 2 N held while moving 0.02 m/s
     assert pc.energy == pytest.approx(DT * 2.0 * 0.02)
-    s2 = pc.update(0.0, -0.01)             # 5 N held, moving back: produces 5e-5 J
+    s2 = pc.update(0.0, -0.01)  # 5 N held, moving back: produces 5e-5 J
     e = DT * (2.0 * 0.02 - 5.0 * 0.01)
     assert pc.energy == pytest.approx(e) and e < 0
-    assert s2.control == pytest.approx(-e / (DT * -0.01))   # α·v with α = -E/(ΔT v²)
+    assert s2.control == pytest.approx(-e / (DT * -0.01))  # α·v with α = -E/(ΔT v²)
     assert s2.energy == pytest.approx(0.0, abs=1e-18)
     # the control force is part of the held output: its work is observed, not assumed
     pc.update(0.0, -0.01)
@@ -101,7 +101,7 @@ def test_observed_booking_pairs_the_held_output_with_the_next_motion():
 
 
 def test_a_sampled_spring_is_passive_when_assumed_and_active_when_observed():
-    k, q = 20000.0, 1e-5                   # N/m, m: a stiff wall dithering one count
+    k, q = 20000.0, 1e-5  # N/m, m: a stiff wall dithering one count
     xs = [0, q, 0, q, 0, q, 0]
     assumed = PassivityController(DT)
     observed = PassivityController(DT, booking="observed")
@@ -114,7 +114,7 @@ def test_a_sampled_spring_is_passive_when_assumed_and_active_when_observed():
 
 
 def test_observed_sign_change_of_a_held_control_force_is_what_the_sign_fix_drops():
-    seq = [(0.0, 0.01), (3.0, 0.01), (0.0, -0.01)]    # hold 3 N, then reverse under it
+    seq = [(0.0, 0.01), (3.0, 0.01), (0.0, -0.01)]  # hold 3 N, then reverse under it
     plain = PassivityController(DT, booking="observed")
     fixed = PassivityController(DT, booking="observed", sign_fix=True)
     a = [plain.update(f, v) for f, v in seq]

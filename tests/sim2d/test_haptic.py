@@ -10,7 +10,7 @@ from sim2d.haptic import Axis, Operator, Servo, simulate_servo, simulate_wall
 
 def test_a_free_axis_follows_the_closed_form_of_a_damped_mass():
     axis = Axis(mass=0.1, damping=5.0, substeps=50)
-    servo = Servo(gain=0.0, start=-1.0, duration=0.2)      # the part is 1 m away: a constant 1 N push
+    servo = Servo(gain=0.0, start=-1.0, duration=0.2)  # the part is 1 m away: a constant 1 N push
     tr = simulate_servo(servo, axis=axis)
     tau, vt = 0.1 / 5.0, 1.0 / 5.0
     expected = -1.0 + vt * (tr.time - tau * (1 - np.exp(-tr.time / tau)))
@@ -45,9 +45,9 @@ def test_plain_pc_is_noisy_at_low_velocity_and_the_sign_fix_and_both_fixes_quiet
     both = simulate_wall(_pc(sign_fix=True, hold_fix=True))
     assert plain.noise() > 20 * sign.noise() and plain.noise() > 20 * both.noise()
     for tr in (plain, sign, both):
-        assert tr.energy[-1] >= -1e-12                  # passivity kept at the end
+        assert tr.energy[-1] >= -1e-12  # passivity kept at the end
     assert both.energy.min() > -1e-4 and sign.energy.min() > -1e-4
-    assert plain.energy.min() < -1e-3                    # what the plain PC cannot dissipate
+    assert plain.energy.min() < -1e-3  # what the plain PC cannot dissipate
 
 
 def test_the_assumed_booking_sees_a_sampled_wall_as_passive():
@@ -60,7 +60,7 @@ def test_guarded_servo_keeps_contact_where_the_bare_servo_chatters():
     bare = simulate_servo(servo)
     guarded = simulate_servo(servo, _pc(sign_fix=True, hold_fix=True))
     tail = bare.time >= 0.3
-    assert np.sum(bare.contact_force[tail] == 0) > 50     # loses the part every cycle
+    assert np.sum(bare.contact_force[tail] == 0) > 50  # loses the part every cycle
     assert np.all(guarded.contact_force[tail] > 0.5)
     assert abs(guarded.contact_force[tail].mean() - servo.target) < 0.05
 
@@ -74,9 +74,14 @@ def test_a_gentle_servo_is_left_alone_by_the_guard():
         assert np.all(np.abs(tr.contact_force[tail] - servo.target) < 0.01)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"mass": 0}, "Axis.mass=0"), ({"damping": -1}, "Axis.damping=-1"), ({"substeps": 0}, "Axis.substeps=0"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"mass": 0}, "Axis.mass=0"),
+        ({"damping": -1}, "Axis.damping=-1"),
+        ({"substeps": 0}, "Axis.substeps=0"),
+    ],
+)
 def test_bad_axis(kwargs, match):
     with pytest.raises(SimError, match=match):
         Axis(**kwargs)

@@ -58,13 +58,16 @@ def test_load_noise_presets_and_toml(tmp_path):
     assert PRESETS["paper"].scaled(v2_noise=2.0).v2_noise == 2 * PRESETS["paper"].v2_noise
 
 
-@pytest.mark.parametrize("text, match", [
-    ("v2_noize = 1.0\n", r"unknown key\(s\) \['v2_noize'\]"),
-    ("v2_noise = -1.0\n", "v2_noise=-1.0 must be >= 0"),
-    ('v2_noise = "a"\n', "must be a finite number"),
-    ('preset = "lab"\n', "unknown preset 'lab'"),
-    ("v2_noise = \n", "not valid TOML"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("v2_noize = 1.0\n", r"unknown key\(s\) \['v2_noize'\]"),
+        ("v2_noise = -1.0\n", "v2_noise=-1.0 must be >= 0"),
+        ('v2_noise = "a"\n', "must be a finite number"),
+        ('preset = "lab"\n', "unknown preset 'lab'"),
+        ("v2_noise = \n", "not valid TOML"),
+    ],
+)
 def test_bad_noise_files(tmp_path, text, match):
     f = tmp_path / "bad.toml"
     f.write_text(text)
@@ -90,6 +93,6 @@ def test_machining_error_is_smooth_and_of_the_stated_size():
     rng = np.random.default_rng(3)
     real = machined_part(part, NoiseModel(machining_error=0.05), rng)
     dev = np.einsum("ij,ij->i", real.points - part.points, part.normal(np.arange(part.n_knots, dtype=float)))
-    assert np.sqrt(np.mean(dev ** 2)) == pytest.approx(0.05, rel=1e-6)
+    assert np.sqrt(np.mean(dev**2)) == pytest.approx(0.05, rel=1e-6)
     assert np.abs(np.diff(dev)).max() < 0.05  # smooth: neighbouring knots move alike
     assert machined_part(part, NoiseModel(), rng) is part
