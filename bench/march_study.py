@@ -165,7 +165,7 @@ def cost_against_step(steps=(1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, 
     qs = [_query(part, rng) for _ in range(n_queries)]
     rows = []
     for h in steps:
-        part.__dict__.pop("_march_grid", None)
+        part.forget_tables()
         t0 = time.perf_counter()
         march_grid(part, h)
         build = time.perf_counter() - t0
@@ -215,7 +215,7 @@ def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int
                         "missed": missed,
                     }
                 )
-            part.__dict__.pop("_march_grid", None)  # free the h-grid (72 MB per million cells)
+            part.forget_tables()  # free the h-grid (72 MB per million cells)
             _log(f"  completeness: {'convex' if convex else 'non-convex'} part {k + 1}/{n_parts}")
     return rows
 

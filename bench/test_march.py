@@ -60,7 +60,7 @@ def test_march_grid_at_paper_step(benchmark):
     p = trefoil_part()
 
     def build():
-        p.__dict__.pop("_march_grid", None)
+        p.forget_tables()
         return march_grid(p, H)
 
     grid = benchmark.pedantic(build, rounds=2, iterations=1)

@@ -1,33 +1,36 @@
-"""One small cache of read-only tables built per part (the filter's tracks, the jaw's reach)."""
+"""The one way a table built from a part is kept: with the part, for as long as the part lives.
+
+The arc tables, the march's grid, the filter's tracks and the jaw's reach are read-only and cost
+from milliseconds to seconds to build; every user of a part shares them. They live in the part's
+own store (so they go when the part goes), and :meth:`localizer.Part.forget_tables` drops them.
+"""
 
 from __future__ import annotations
 
-from collections import OrderedDict
-from collections.abc import Callable
-from typing import TypeVar
+from collections.abc import Callable, Hashable
+from typing import TYPE_CHECKING, TypeVar
+
+if TYPE_CHECKING:
+    from ._part import Part
 
 T = TypeVar("T")
 
 __all__ = ["per_part"]
 
-_ENTRIES: OrderedDict[tuple, object] = OrderedDict()
-_SIZE = 16
 
-
-def per_part(kind: str, part, args: tuple, build: Callable[[], T]) -> T:
+def per_part(kind: str, part: Part, args: Hashable, build: Callable[[], T], *, latest_only: bool = False) -> T:
     """The table ``kind`` of ``part`` for ``args``, built by ``build()`` on first use.
 
-    Keyed by the part's points (two Part objects of the same points share their tables)
-    and ``args`` (hashable). The tables are read-only, so callers can share them; the
-    least recently used of more than 16 is dropped.
+    ``latest_only``: keep only the latest ``args`` of this kind (a table too large to keep several
+    of, like the march's grid at a fine step).
     """
-    key = (kind, part.points.tobytes(), part.cells_per_piece, args)
-    hit = _ENTRIES.get(key)
-    if hit is not None:
-        _ENTRIES.move_to_end(key)
-        return hit  # type: ignore[return-value]
+    store = part._tables
+    key = (kind, args)
+    if key in store:
+        return store[key]  # type: ignore[no-any-return]
     value = build()
-    _ENTRIES[key] = value
-    while len(_ENTRIES) > _SIZE:
-        _ENTRIES.popitem(last=False)
+    if latest_only:
+        for old in [k for k in store if k[0] == kind]:
+            del store[old]
+    store[key] = value
     return value

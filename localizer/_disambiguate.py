@@ -141,7 +141,7 @@ def _chain_turns(part: Part, start, lengths, sign):
     """Positions and turns of consecutive segments from unrolled arc ``start``."""
     pos = start + sign * np.concatenate([[0.0], np.cumsum(lengths)])
     t = part.param_at_arc(pos)
-    _, theta, kappa, _ = part._state(t)
+    _, theta, kappa, _ = part.state(t)
     return pos, np.diff(theta), kappa, t
 
 
@@ -187,7 +187,7 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
     # seeds: first-roll feasible starts for the measurement and for ±2 sd around it
     # (a rotation error moves a start by sd_turn/|g'|, a length error by about
     # sd_length·κ/|g'|: the turn-shifted queries bracket both)
-    sd_eff = float(np.hypot(sd_turn, sd_length * np.abs(part._kappa_abs).max()))
+    sd_eff = float(np.hypot(sd_turn, sd_length * part.curvature_bound))
     seeds = []
     for dw in (-2.0, 0.0, 2.0):
         for s in feasible_segments(part, L[0], W[0] + dw * min(sd_eff, 10 * sd_turn), direction=direction):

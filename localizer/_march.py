@@ -29,6 +29,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ._cache import per_part
 from ._errors import QueryError
 from ._part import Part, _curvature
 from ._segment import Segment
@@ -144,10 +145,11 @@ class MarchResult:
 
 
 def march_grid(part: Part, h: float) -> MarchGrid:
-    """The h-grid integrals of ``part``, built by the trapezoid rule (cached for the last h)."""
-    cached = part.__dict__.get("_march_grid")
-    if cached is not None and cached.h == h:
-        return cached
+    """The h-grid integrals of ``part``, built by the trapezoid rule (kept with the part for the last h)."""
+    return per_part("march_grid", part, float(h), lambda: _build(part, h), latest_only=True)
+
+
+def _build(part: Part, h: float) -> MarchGrid:
     n = part.n_knots
     M = int(round(n / h))
     if 4 * n > M or abs(M * h - n) > 1e-9 * n:
@@ -162,7 +164,7 @@ def march_grid(part: Part, h: float) -> MarchGrid:
         idx = np.arange(start, min(start + chunk, M + 1))
         t = idx * h
         piece = np.minimum(t.astype(np.int64), n - 1)
-        dx, dy, ddx, ddy = part._derivs(piece, t - piece)
+        dx, dy, ddx, ddy = part.derivatives(piece, t - piece)
         v = np.hypot(dx, dy)
         k = _curvature(dx, dy, ddx, ddy)
         w = k * v
@@ -182,7 +184,6 @@ def march_grid(part: Part, h: float) -> MarchGrid:
         acc_l, acc_t = length[idx[-1]], turn[idx[-1]]
         prev_v, prev_w = v[-1], w[-1]
     grid = MarchGrid(h=h, cells=M, length=length, turn=turn, kappa=kappa)
-    part.__dict__["_march_grid"] = grid
     return grid
 
 

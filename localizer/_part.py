@@ -88,8 +88,24 @@ class Part:
     cells_per_piece: int = 4
     n_knots: int = field(init=False)
     perimeter: float = field(init=False)
+    # the spline's polynomial coefficients per piece and its cell tables, built once here
+    _cx: np.ndarray = field(init=False, repr=False)  # x(u), ascending powers, (N, 4)
+    _cy: np.ndarray = field(init=False, repr=False)
+    _num: np.ndarray = field(init=False, repr=False)  # x'y'' − y'x''
+    _den: np.ndarray = field(init=False, repr=False)  # |α'|²
+    _dkappa: np.ndarray = field(init=False, repr=False)  # numerator of dκ/dt·den^2.5
+    _dcols: np.ndarray = field(init=False, repr=False)  # x', y' coefficients as rows (6, N)
+    _t_nodes: np.ndarray = field(init=False, repr=False)  # cell boundaries: parameter
+    _sig_nodes: np.ndarray = field(init=False, repr=False)  # ... arc position, mm
+    _theta_nodes: np.ndarray = field(init=False, repr=False)  # ... unwrapped tangent angle, rad
+    _dtds_nodes: np.ndarray = field(init=False, repr=False)  # ... dt/dσ, 1/mm
+    _kappa_abs: np.ndarray = field(init=False, repr=False)  # bound on |κ| per cell, 1/mm
+    _turning: float = field(init=False, repr=False)  # total turning, rad (2π for a simple outline)
+    # tables the solvers and filters build per part (localizer._cache.per_part); freed with the part
+    _tables: dict = field(init=False, repr=False)
 
     def __post_init__(self):
+        object.__setattr__(self, "_tables", {})
         pts = np.array(self.points, dtype=float)
         pts.setflags(write=False)
         object.__setattr__(self, "points", pts)
@@ -153,11 +169,10 @@ class Part:
         object.__setattr__(self, "perimeter", perimeter)
         t_nodes = np.arange(n * m + 1) / m
         node_piece = np.minimum(t_nodes.astype(int), n - 1)
-        dxn, dyn, _, _ = self._derivs(node_piece, t_nodes - node_piece)
+        dxn, dyn, _, _ = self.derivatives(node_piece, t_nodes - node_piece)
         raw = np.arctan2(dyn, dxn)
         theta = raw[0] + np.concatenate([[0.0], np.cumsum(_wrap(np.diff(raw)))])
         turning = theta[-1] - theta[0]
-        object.__setattr__(self, "_m", m)
         object.__setattr__(self, "_t_nodes", t_nodes)
         object.__setattr__(self, "_sig_nodes", sig)
         object.__setattr__(self, "_theta_nodes", theta)
@@ -166,12 +181,31 @@ class Part:
         v_nodes = np.hypot(dxn, dyn)
         object.__setattr__(self, "_dtds_nodes", 1.0 / v_nodes)
 
-    def _derivs(self, piece, u):
-        """x', y', x'', y'' of spline pieces ``piece`` at local parameters ``u`` (broadcast)."""
+    # ---------------------------------------------- evaluation for the solvers
+    # The exact solver, the march, the arc tables and the disambiguation evaluate the spline
+    # piece by piece through these four, and through nothing else of its inside.
+    def derivatives(self, piece, u) -> tuple:
+        """x', y', x'', y'' of spline pieces ``piece`` (int) at local parameters ``u`` in [0, 1]
+        (broadcast), mm per unit parameter and per unit parameter squared."""
         c = self._dcols[:, piece]
         dx = (c[2] * u + c[1]) * u + c[0]
         dy = (c[5] * u + c[4]) * u + c[3]
         return dx, dy, 2.0 * c[2] * u + c[1], 2.0 * c[5] * u + c[4]
+
+    def curvature_slope(self, piece, u) -> np.ndarray:
+        """dκ/dσ, 1/mm², of spline pieces ``piece`` at local parameters ``u`` (broadcast)."""
+        den = horner(self._den[piece], u)
+        return horner(self._dkappa[piece], u) / (den * den * den)
+
+    @property
+    def curvature_bound(self) -> float:
+        """An upper bound on |κ| over the whole boundary, 1/mm (from the cells' Bernstein bounds)."""
+        return float(np.abs(self._kappa_abs).max())
+
+    def forget_tables(self) -> None:
+        """Drop the tables built for this part by the solvers and filters (the march's grid takes
+        72 MB per million cells); they are built again when next needed."""
+        self._tables.clear()
 
     def _speed_piece(self, piece, u):
         c = self._dcols[:, piece]
@@ -186,7 +220,7 @@ class Part:
         tt = t - lap * n
         piece = np.minimum(tt.astype(np.int64), n - 1)
         u = tt - piece
-        cell = np.minimum((tt * self._m).astype(np.int64), n * self._m - 1)
+        cell = np.minimum((tt * self.cells_per_piece).astype(np.int64), n * self.cells_per_piece - 1)
         return lap, piece, u, cell
 
     # -------------------------------------------------------- functions of t
@@ -198,7 +232,7 @@ class Part:
     def derivative(self, t) -> np.ndarray:
         """Curve derivative dα/dt at ``t``; shape ``t.shape + (2,)``, mm per unit parameter."""
         _, piece, u, _ = self._split(t)
-        dx, dy, _, _ = self._derivs(piece, u)
+        dx, dy, _, _ = self.derivatives(piece, u)
         return np.stack([dx, dy], axis=-1)
 
     def speed(self, t) -> np.ndarray:
@@ -219,7 +253,7 @@ class Part:
     def tangent_angle(self, t) -> np.ndarray:
         """Unwrapped tangent angle θ(t), rad: continuous, θ(t + N) = θ(t) + 2π."""
         lap, piece, u, cell = self._split(t)
-        dx, dy, _, _ = self._derivs(piece, u)
+        dx, dy, _, _ = self.derivatives(piece, u)
         return self._unwrap(np.arctan2(dy, dx), cell, lap)
 
     def _unwrap(self, raw, cell, lap):
@@ -230,7 +264,7 @@ class Part:
     def curvature(self, t) -> np.ndarray:
         """Signed curvature κ(t), 1/mm: positive where the boundary is convex."""
         _, piece, u, _ = self._split(t)
-        return _curvature(*self._derivs(piece, u))
+        return _curvature(*self.derivatives(piece, u))
 
     def arc_at_param(self, t) -> np.ndarray:
         """Unrolled arc position Λ(t) = ℓ(0, t), mm (grows by the perimeter per lap)."""
@@ -239,7 +273,7 @@ class Part:
 
     def _partial_arc(self, piece, cell, u):
         """Arc length from the start of ``cell`` to ``u`` within ``piece``."""
-        u0 = (cell - piece * self._m) / self._m
+        u0 = (cell - piece * self.cells_per_piece) / self.cells_per_piece
         w = u - u0
         uu = u0[..., None] + w[..., None] * _GL8_X
         return (self._speed_piece(piece[..., None], uu) * _GL8_W).sum(axis=-1) * w
@@ -266,10 +300,11 @@ class Part:
         laps = np.where(t < s, np.ceil((s - t) / self.n_knots), 0.0)
         return self.tangent_angle(t + laps * self.n_knots) - self.tangent_angle(s)
 
-    def _state(self, t):
-        """Exact (unrolled arc position, unwrapped tangent angle, curvature, speed) at ``t``."""
+    def state(self, t) -> tuple:
+        """Exact (unrolled arc position mm, unwrapped tangent angle rad, curvature 1/mm, speed mm per
+        unit parameter) at unrolled parameters ``t``, in one pass."""
         lap, piece, u, cell = self._split(t)
-        dx, dy, ddx, ddy = self._derivs(piece, u)
+        dx, dy, ddx, ddy = self.derivatives(piece, u)
         theta = self._unwrap(np.arctan2(dy, dx), cell, lap)
         sigma = self._sig_nodes[cell] + self._partial_arc(piece, cell, u) + self.perimeter * lap
         return sigma, theta, _curvature(dx, dy, ddx, ddy), np.hypot(dx, dy)
@@ -291,7 +326,7 @@ class Part:
         s0, s1 = nodes[cell], nodes[cell + 1]
         h = s1 - s0
         x = (ss - s0) / h
-        m = self._m
+        m = self.cells_per_piece
         t0 = cell / m
         dt = 1.0 / m
         d0 = self._dtds_nodes[cell] * h

@@ -58,8 +58,8 @@ def _g_exact(part: Part, sigma, length, turn):
     """Exact g, g' and the parameters of both ends at arc positions ``sigma``."""
     ts = part.param_at_arc(sigma)
     te = part.param_at_arc(sigma + length)
-    _, th_s, k_s, _ = part._state(ts)
-    _, th_e, k_e, _ = part._state(te)
+    _, th_s, k_s, _ = part.state(ts)
+    _, th_e, k_e, _ = part.state(te)
     return th_e - th_s - turn, k_e - k_s, ts, te
 
 
@@ -75,7 +75,7 @@ def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
     p, lap = table.param_at(np.concatenate([sigma, sigma + length]))
     both = p + lap * part.n_knots
     for it in range(max_iter + 1):
-        lam, th, ka, v = part._state(both)
+        lam, th, ka, v = part.state(both)
         f1 = lam[k:] - lam[:k] - length
         f2 = th[k:] - th[:k] - turn
         gp = ka[k:] - ka[:k]

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._cache import per_part
 from ._part import _TWO_PI, Part, _curvature, _wrap
 from ._poly import bernstein_bounds, horner
 
@@ -111,11 +112,11 @@ class ArcTable:
 
 def _node_state(part: Part, piece, u):
     """θ, κ, dκ/dσ, t, dt/dσ, d²t/dσ² from one spline piece at u (one-sided at knots)."""
-    dx, dy, ddx, ddy = part._derivs(piece, u)
+    dx, dy, ddx, ddy = part.derivatives(piece, u)
     v2 = dx * dx + dy * dy
     v = np.sqrt(v2)
     kappa = _curvature(dx, dy, ddx, ddy)
-    dkds = horner(part._dkappa[piece], u) / (v2 * v2 * v2)
+    dkds = part.curvature_slope(piece, u)
     dtds = 1.0 / v
     vt = (dx * ddx + dy * ddy) / v
     d2tds2 = -vt / (v2 * v)
@@ -128,13 +129,14 @@ def arc_table(part: Part, *, max_theta_error: float = 1e-9) -> ArcTable:
     Cells are the part's table cells, split further until the measured
     interpolation error of θ is below ``max_theta_error`` rad.
     """
-    cached = part.__dict__.get("_arc_table")
-    if cached is not None:
-        return cached
+    return per_part("arc_table", part, (float(max_theta_error),), lambda: _build(part, max_theta_error))
+
+
+def _build(part: Part, max_theta_error: float) -> ArcTable:
     n = part.n_knots
     sub = 1
     while True:
-        m = part._m * sub
+        m = part.cells_per_piece * sub
         J = n * m
         j = np.arange(J)
         piece = j // m
@@ -181,5 +183,4 @@ def arc_table(part: Part, *, max_theta_error: float = 1e-9) -> ArcTable:
         theta_error=float(err_th),
         param_error=float(err_t),
     )
-    part.__dict__["_arc_table"] = table
     return table
