@@ -17,10 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from bench.baselines import random_outline, trapezoid_perimeter, trefoil_part
-from localizer import feasible_segments, march, march_grid, part_from_points
+from localizer import LENGTH_TOL, TURN_TOL, feasible_segments, march, march_grid, part_from_points
 
-PAPER = dict(length_tol=0.004, turn_tol=0.0004, min_separation=0.5)
-TIGHT = dict(length_tol=1e-10, turn_tol=1e-10)
+TIGHT: dict[str, float] = {"length_tol": 1e-10, "turn_tol": 1e-10}
 
 
 def _log(msg: str) -> None:
@@ -65,7 +64,7 @@ def proposition_1(n_parts: int, seed: int, h: float = 1e-4, max_iterations: int 
         for _ in range(2):
             _, L, w = _query(part, rng)
             exact = feasible_segments(part, L, w)
-            res = march(part, L, w, step=h, max_iterations=max_iterations, **TIGHT)
+            res = march(part, L, w, step=h, max_iterations=max_iterations, length_tol=1e-10, turn_tol=1e-10)
             for seg in res.segments:
                 e = _nearest(part, exact, seg.start_arc)
                 ks, kt = float(part.curvature(e.start_param)), float(part.curvature(e.end_param))
@@ -115,7 +114,7 @@ def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int,
                     Ls[i + 1],
                 )
                 w = float(part.tangent_angle_at_arc(s0 + L) - part.tangent_angle_at_arc(s0))
-                res = march(part, L, w, step=h, max_iterations=max_iterations, **TIGHT)
+                res = march(part, L, w, step=h, max_iterations=max_iterations, length_tol=1e-10, turn_tol=1e-10)
                 seg = _nearest(part, res.segments, s0) if res.segments else None
                 if seg is None or abs(part.arc_offset(seg.start_arc, s0)) > 1.0:
                     continue
@@ -145,7 +144,7 @@ def theorem_2(n_parts: int, seed: int, h: float = 1e-4):
         for convex in (True, False):
             part = _random_part(rng, convex)
             _, L, w = _query(part, rng)
-            res = march(part, L, w, step=h, **PAPER)
+            res = march(part, L, w, step=h)
             rows.append(
                 {
                     "convex": convex,
@@ -170,7 +169,7 @@ def cost_against_step(steps=(1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, 
         march_grid(part, h)
         build = time.perf_counter() - t0
         t0 = time.perf_counter()
-        nsteps = [march(part, L, w, step=h, **PAPER).steps for _, L, w in qs]
+        nsteps = [march(part, L, w, step=h).steps for _, L, w in qs]
         per_query = (time.perf_counter() - t0) / n_queries
         rows.append(
             {
@@ -195,11 +194,11 @@ def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int
             for _ in range(queries_per_part):
                 s0, L, w = _query(part, rng)
                 exact = feasible_segments(part, L, w)
-                marched = march(part, L, w, step=h, **PAPER).segments
+                marched = march(part, L, w, step=h).segments
                 missed = []
                 for e in exact:
                     slope = abs(float(part.curvature(e.end_param) - part.curvature(e.start_param)))
-                    allowed = 2 * PAPER["turn_tol"] / max(slope, 1e-12) + 2 * PAPER["length_tol"] + 0.01
+                    allowed = 2 * TURN_TOL / max(slope, 1e-12) + 2 * LENGTH_TOL + 0.01
                     d = min((abs(float(part.arc_offset(m.start_arc, e.start_arc))) for m in marched), default=np.inf)
                     if d > allowed:
                         missed.append({"start_arc": e.start_arc, "distance": d, "allowed": allowed, "slope": slope})
@@ -240,7 +239,7 @@ def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
         ex = feasible_segments(part, L, w)
         t_exact = time.perf_counter() - t0
         t0 = time.perf_counter()
-        res = march(part, L, w, step=h, **PAPER)
+        res = march(part, L, w, step=h)
         t_march = time.perf_counter() - t0
         ma = res.segments
         rows.append(

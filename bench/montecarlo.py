@@ -317,7 +317,7 @@ def plot_study(study: Study, rows, out: Path) -> None:
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    bins = np.logspace(-4, 3, 36)
+    bins = np.logspace(-4, 3, 36).tolist()
     for lv in range(study.levels):
         e = np.array([float(r["error_mm"]) for r in rows if int(r["level"]) == lv])
         e = np.clip(e[np.isfinite(e)], 1e-4, 1e3)

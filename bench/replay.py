@@ -26,7 +26,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from localizer import ContactFilter
+from localizer import ContactFilter, Part
 
 from .study import TrialSpec, load_study, run_trial
 
@@ -83,7 +83,7 @@ class Recorded:
     """One trial's reactive filter: the part, the settings it was built with, the calls, the trial's
     row of trials.csv and its start (mm)."""
 
-    part: object
+    part: Part
     settings: dict
     calls: tuple
     row: dict
@@ -171,7 +171,7 @@ def main(argv=None) -> int:
         help="a ContactFilter setting for one variant (repeat for more variants)",
     )
     args = ap.parse_args(argv)
-    variants = [{}]
+    variants: list[dict] = [{}]
     for item in args.set:
         name, sep, value = item.partition("=")
         if not sep:

@@ -19,7 +19,7 @@ import numpy as np
 from bench.baselines import PARTS_DIR
 from driver.procedures import _delta, calibrate, establish_contact, localize_by_rolling, roll
 from driver.rig import RigError
-from localizer import load_part
+from localizer import SUCCESS_RADIUS, load_part
 from sim2d import SimRig
 
 SHIPPED = ("cam.json", "ellipse.json", "trefoil.json", "kidney.csv")
@@ -135,7 +135,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
     for name in SHIPPED:
         part = load_part(PARTS_DIR / name)
         cal = calibration_for(part, noise, seed, engine)
-        rows = []
+        rows: list[dict] = []
         for _k in range(trials):
             start = float(rng.uniform(0, part.perimeter))
             rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=engine)
@@ -179,7 +179,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
                 }
             )
         done = [r for r in rows if "error_mm" in r]
-        ok = sum(r["error_mm"] < 0.3 for r in done)
+        ok = sum(r["error_mm"] < SUCCESS_RADIUS for r in done)
         n = len(done)
         # Wilson 95% interval of the success rate
         z = 1.96
@@ -194,12 +194,12 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
             "success_rate": p,
             "ci95": [centre - half, centre + half],
             "ambiguous": sum(r["ambiguous"] for r in done),
-            "success_top2": sum(r["top2_error_mm"] < 0.3 for r in done),
+            "success_top2": sum(r["top2_error_mm"] < SUCCESS_RADIUS for r in done),
             "no_candidate": sum(bool(r.get("no_candidate")) for r in done),
             "median_error_mm": float(np.median([r["error_mm"] for r in done])) if done else None,
             "rows": rows,
         }
-        _log(f"  end to end ({noise}): {name}: {ok}/{n} within 0.3 mm, {trials - n} refused")
+        _log(f"  end to end ({noise}): {name}: {ok}/{n} within {SUCCESS_RADIUS} mm, {trials - n} refused")
     return out
 
 

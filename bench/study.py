@@ -10,7 +10,7 @@ A study file::
     engine = "kinematic"                 # or "pymunk"
     trials = 200                         # per level
     seed = 2005
-    success_radius = 0.3                 # mm
+    success_radius = 0.3                 # mm (default localizer.SUCCESS_RADIUS)
     noise = "paper"                      # preset or a TOML file (relative to the study file)
 
     [sweep]                              # optional: one noise-model field over levels
@@ -30,7 +30,7 @@ Several methods on the same trials (instead of ``method``)::
 
     [reactive]                           # the sequential filter (driver.reactive)
     confidence = 0.95
-    max_rotation_deg = 180.0
+    max_rotation_deg = 240.0             # default driver.reactive.MAX_ROTATION
     sd_position = 0.04                   # mm, one contact-location reading   } each optional: the
     sd_scale = 0.003                     # calibration scale                  } filter's own default,
     sd_slope = 0.003                     # rad, the part's slope error        } with its noise scale
@@ -68,7 +68,11 @@ from pathlib import Path
 
 import numpy as np
 
-from localizer import RolltouchError
+from driver.reactive import CONFIDENCE, MAX_ROTATION
+from localizer import ROLL_STEP, SUCCESS_RADIUS, RolltouchError
+
+#: The rolling step, degrees, from its one home.
+STEP_DEG = round(math.degrees(ROLL_STEP), 9)
 
 __all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS"]
 
@@ -133,8 +137,8 @@ METHOD_COLUMNS = (
 class ReactiveOptions:
     """[reactive] of a study file (see :func:`driver.reactive.localize_reactively`)."""
 
-    confidence: float = 0.95
-    max_rotation_deg: float = 180.0
+    confidence: float = CONFIDENCE
+    max_rotation_deg: float = round(math.degrees(MAX_ROTATION), 9)
     check_every: int = 5
     confirm: int | None = None  # None: driver.reactive.CONFIRM (checks in a row at the confidence)
     sd_position: float | None = None  # None: the filter's default
@@ -166,12 +170,12 @@ class Study:
     name: str
     parts: tuple
     rolls_deg: tuple
-    step_deg: float = 0.2
+    step_deg: float = STEP_DEG
     method: str = "paper"
     engine: str = "kinematic"
     trials: int = 100
     seed: int = 0
-    success_radius: float = 0.3
+    success_radius: float = SUCCESS_RADIUS
     noise: str = "paper"
     parameter: str | None = None
     values: tuple = ()
@@ -287,8 +291,8 @@ def load_study(path) -> Study:
         v = data.get(key, default)
         if not isinstance(v, int) or v < lo:
             raise StudyError(f"study {path}: {key}={v!r} must be an integer >= {lo}")
-    for key, default in (("step_deg", 0.2), ("success_radius", 0.3)):
-        v = data.get(key, default)
+    for key, fallback in (("step_deg", STEP_DEG), ("success_radius", SUCCESS_RADIUS)):
+        v = data.get(key, fallback)
         if not isinstance(v, (int, float)) or not v > 0:
             raise StudyError(f"study {path}: {key}={v!r} must be a positive number")
     noise = data.get("noise", "paper")
@@ -300,37 +304,37 @@ def load_study(path) -> Study:
         base = load_noise(noise)
     except SimError as exc:
         raise StudyError(f"study {path}: noise: {exc}") from None
-    parameter, values = None, ()
+    parameter: str | None = None
+    values: tuple = ()
     sweep = data.get("sweep")
     if sweep is not None:
         if not isinstance(sweep, dict) or set(sweep) - {"parameter", "values"}:
             raise StudyError(f"study {path}: [sweep] takes 'parameter' and 'values'")
         parameter = sweep.get("parameter")
+        given = sweep.get("values")
         if parameter == "noise":
-            values = sweep.get("values")
-            if not isinstance(values, list) or not values or not all(isinstance(v, str) for v in values):
+            if not isinstance(given, list) or not given or not all(isinstance(v, str) for v in given):
                 raise StudyError(f"study {path}: a noise sweep's values must be a non-empty list of presets or files")
-            for v in values:
+            for v in given:
                 try:
                     load_noise(v if v in PRESETS else resolve(v))
                 except SimError as exc:
                     raise StudyError(f"study {path}: sweep noise {v!r}: {exc}") from None
-            values = tuple(v if v in PRESETS else resolve(v) for v in values)
+            values = tuple(v if v in PRESETS else resolve(v) for v in given)
         elif parameter not in NoiseModel.__dataclass_fields__:
             raise StudyError(
                 f"study {path}: sweep parameter {parameter!r} is not a noise-model field nor "
                 f"'noise'; fields: {sorted(NoiseModel.__dataclass_fields__)}"
             )
         else:
-            values = sweep.get("values")
-            if not isinstance(values, list) or not values:
+            if not isinstance(given, list) or not given:
                 raise StudyError(f"study {path}: sweep values must be a non-empty list")
-            for v in values:
+            for v in given:
                 try:
                     replace(base, **{parameter: v})
                 except (SimError, TypeError) as exc:
                     raise StudyError(f"study {path}: sweep value {v!r} of {parameter}: {exc}") from None
-            values = tuple(float(v) for v in values)
+            values = tuple(float(v) for v in given)
     lk = data.get("likelihood", {})
     if not isinstance(lk, dict) or set(lk) - {"sd_length", "sd_turn_deg"}:
         raise StudyError(f"study {path}: [likelihood] takes 'sd_length' and 'sd_turn_deg'")
@@ -338,12 +342,12 @@ def load_study(path) -> Study:
         name=str(data.get("name", path.stem)),
         parts=tuple(parts),
         rolls_deg=tuple(float(r) for r in rolls),
-        step_deg=float(data.get("step_deg", 0.2)),
+        step_deg=float(data.get("step_deg", STEP_DEG)),
         method=method,
         engine=engine,
         trials=int(data.get("trials", 100)),
         seed=int(data.get("seed", 0)),
-        success_radius=float(data.get("success_radius", 0.3)),
+        success_radius=float(data.get("success_radius", SUCCESS_RADIUS)),
         noise=str(noise),
         parameter=parameter,
         values=values,

@@ -85,7 +85,7 @@ class Emulator:
         self.stopped = threading.Event()
         self.zero = (0.0, 0.0)
         self.input_range = 10.0  # V: the DAQ's input range, reported by STATUS
-        self._closers = []
+        self._closers: list = []
         if start_pose is not None:
             rig.move(*start_pose)
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from localizer import SUCCESS_RADIUS
+
 __all__ = ["plot_localization", "plot_run"]
 
 
@@ -147,6 +149,6 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
     title = f"{part.name}: {trace.metadata.get('engine', '')} rig, noise {trace.metadata.get('noise_name', '')}"
     if has_truth and result.best is not None:
         err = abs(float(part.arc_offset(result.best.end_arc, cols["true_arc"][-1])))
-        title += f"\nerror {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)"
+        title += f"\nerror {err:.3f} mm ({'success' if err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
     ax.set_title(title, fontsize=9)
     _finish(fig, ax, path)

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from localizer import Localization, Part, arc_from_jaw_positions, localize
+from localizer import ROLL_STEP, Localization, Part, arc_from_jaw_positions, localize
 
 from .rig import Rig, RigError
 
@@ -230,6 +230,8 @@ class Calibration:
     positions: tuple
     ratios: tuple
     target: float = 0.4
+    _r: np.ndarray = field(init=False, repr=False, compare=False)  # the ratios, ascending
+    _d: np.ndarray = field(init=False, repr=False, compare=False)  # the positions in that order, mm
 
     def __post_init__(self):
         d = np.asarray(self.positions, float)
@@ -412,7 +414,7 @@ def roll(
     calibration: Calibration,
     angle: float,
     *,
-    step: float = math.radians(0.2),
+    step: float = ROLL_STEP,
     n: int = 32,
     offset: float | None = None,
     bridge_jump: float | None = 3.0,
@@ -445,7 +447,8 @@ def roll(
     k = max(1, int(round(abs(angle) / step)))
     if offset is None:
         offset = edge_offset(rig, hand, baseline)
-    readings, truth = [], []
+    readings: list[tuple] = []
+    truth: list[tuple] = []
     k_steps = k
     if observer is not None:
         observer(
@@ -564,7 +567,7 @@ def roll_sequence(
     *,
     calibration: Calibration,
     approach_pose,
-    step: float = math.radians(0.2),
+    step: float = ROLL_STEP,
     n: int = 32,
     bridge_jump: float = 3.0,
     observer=None,
@@ -611,7 +614,7 @@ def localize_by_rolling(
     *,
     calibration: Calibration,
     approach_pose,
-    step: float = math.radians(0.2),
+    step: float = ROLL_STEP,
     n: int = 32,
     bridge_jump: float = 3.0,
     rule: str = "likelihood",

@@ -46,15 +46,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from localizer import Belief, ContactFilter, Part, arc_from_jaw_positions
+from localizer import ROLL_STEP, Belief, ContactFilter, Part, arc_from_jaw_positions
 
 from .procedures import Calibration, _location, edge_offset, establish_contact, press
 from .rig import Rig, RigError
 
-__all__ = ["ReactiveRun", "localize_reactively", "spread_by_direction", "CONFIRM"]
+__all__ = ["ReactiveRun", "localize_reactively", "spread_by_direction", "CONFIRM", "CONFIDENCE", "MAX_ROTATION"]
 
 #: Checks in a row at which the belief must reach the confidence before the rolling stops (step 3).
 CONFIRM = 1
+#: Probability within the success radius that stops the rolling.
+CONFIDENCE = 0.95
+#: Budget of rolled rotation, both directions counted, rad (the command line's and the studies' too).
+MAX_ROTATION = math.radians(240.0)
 
 
 @dataclass(frozen=True)
@@ -157,10 +161,10 @@ def localize_reactively(
     calibration: Calibration,
     approach_pose,
     filter: ContactFilter | None = None,
-    step: float = math.radians(0.2),
+    step: float = ROLL_STEP,
     n: int = 32,
-    confidence: float = 0.95,
-    max_rotation: float = math.radians(120.0),
+    confidence: float = CONFIDENCE,
+    max_rotation: float = MAX_ROTATION,
     direction: int | None = None,
     check_every: int = 5,
     lookahead: float = math.radians(15.0),
@@ -219,7 +223,8 @@ def localize_reactively(
     hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
     offset = edge_offset(rig, hand, baseline)
     jaw_limit = float(np.max(np.abs(calibration.positions))) - end_margin
-    readings, truth = [], []
+    readings: list[tuple] = []
+    truth: list[tuple] = []
 
     def read():
         return _location(rig, baseline, calibration, n, readings, truth, hand)

@@ -83,7 +83,7 @@ class SerialRig:
         self.move_speed = float(move_speed)
         self.log = log
         self._seq = 0
-        self._commanded = None
+        self._commanded: tuple[float, float, float] | None = None
         self.ports = {}
         try:
             for name, url in (("arm", arm_url), ("daq", daq_url)):

@@ -87,7 +87,7 @@ class Trace:
         start = events[0]
         rolls = {e["roll"]: e for e in events if e.get("event") == "roll"}
         rows = [e for e in events if e.get("event") == "reading"]
-        counts = {}
+        counts: dict[int, int] = {}
         for e in rows:
             counts[e["roll"]] = counts.get(e["roll"], 0) + 1
         keep = [k for k in sorted(rolls) if counts.get(k, 0) >= 2]

@@ -2,6 +2,7 @@
 
 from ._belief import Belief, Mode
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, ContactFilter
+from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._march import MarchGrid, MarchResult, march, march_grid
@@ -14,6 +15,11 @@ from ._solver import METHODS, feasible_segments
 from ._tracks import ModeTracks, tracks_for
 
 __all__ = [
+    "LENGTH_TOL",
+    "TURN_TOL",
+    "MIN_SEPARATION",
+    "SUCCESS_RADIUS",
+    "ROLL_STEP",
     "ContactFilter",
     "ParticleFilter",
     "Belief",

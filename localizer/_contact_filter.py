@@ -103,6 +103,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from ._belief import Belief, Mode
+from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw
@@ -225,7 +226,7 @@ class ContactFilter:
         sd_scale: float = 0.003,
         sd_slope: float = 0.001,
         shape_spacing: float = 5.0,
-        radius: float = 0.3,
+        radius: float = SUCCESS_RADIUS,
         mode_floor: float = 0.05,
         confidence: float = 0.95,
         prune: float = 40.0,
@@ -325,19 +326,21 @@ class ContactFilter:
         self._szz = 0.0
         self._touched = np.zeros(m, dtype=bool)  # basis columns some reading has touched
         self._touched[0] = True
-        self._prior_ref, self._prior_upto = None, 0  # the slope priors' reference and readings done
+        # the slope priors' reference and readings done
+        self._prior_ref: int | None = None
+        self._prior_upto = 0
         self._segment = 0
         self._penalty = np.zeros(n)  # log-probability of the reach evidence (touches, bridges)
         self.jaw_position = math.nan  # the contact's last measured place on the jaw, mm
         self._live = self.feasible.copy()  # hypotheses still worth evaluating
         self._live_idx = np.flatnonzero(self._live)
-        self._ref = None  # the hypothesis whose radii set the slope term's prior
+        self._ref: int | None = None  # the hypothesis whose radii set the slope term's prior
         self._slope_var = np.zeros(self._m)  # prior variance of each slope coefficient, mm²
-        self._hist = []  # (z, turn) of every reading, for the reference's radii
+        self._hist: list[tuple[float, float]] = []  # (z, turn) of every reading, for the reference's radii
         self._version = 0  # changes to the likelihood (its cache's key)
         self._rows = 0  # readings added
-        self._cached = None
-        self._last_row = None
+        self._cached: dict | None = None
+        self._last_row: tuple[np.ndarray, np.ndarray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
         self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
@@ -726,13 +729,13 @@ class ContactFilter:
                 if live[k]:
                     labels[k] = label
                 prev = live[k]
-        out = []
-        for lab in range(labels.max() + 1):
+        out: list[Mode] = []
+        for lab in range(int(labels.max()) + 1):
             bins = labels == lab
             sel = bins[b]
             if not sel.any():
                 continue
-            k = int(np.argmax(np.where(sel, w, -1.0)))
-            out.append(Mode(arc=float(present[k]), mass=float(mass[bins].sum()), start_arc=float(self.grid[k])))
+            top = int(np.argmax(np.where(sel, w, -1.0)))
+            out.append(Mode(arc=float(present[top]), mass=float(mass[bins].sum()), start_arc=float(self.grid[top])))
         out.sort(key=lambda m: -m.mass)
         return out

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._part import Part
 from ._segment import DIRECTIONS
@@ -260,9 +261,9 @@ def localize(
     direction: str = "ccw",
     sd_length: float = 0.5,
     sd_turn: float = float(np.radians(0.03)),
-    length_tol: float = 0.004,
-    turn_tol: float = 0.0004,
-    min_separation: float = 0.5,
+    length_tol: float = LENGTH_TOL,
+    turn_tol: float = TURN_TOL,
+    min_separation: float = MIN_SEPARATION,
     confidence: float = 0.95,
 ) -> Localization:
     """Localize the jaw from a chain of consecutive rolls.

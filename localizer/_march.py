@@ -30,6 +30,7 @@ from functools import cached_property
 import numpy as np
 
 from ._cache import per_part
+from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._part import Part, _curvature
 from ._segment import Segment
@@ -217,9 +218,9 @@ def march(
     turn: float,
     *,
     step: float = 1e-5,
-    length_tol: float = 0.004,
-    turn_tol: float = 0.0004,
-    min_separation: float = 0.5,
+    length_tol: float = LENGTH_TOL,
+    turn_tol: float = TURN_TOL,
+    min_separation: float = MIN_SEPARATION,
     max_iterations: int = 100_000,
 ) -> MarchResult:
     """Counter-clockwise marching over the whole boundary (the paper's algorithm).
@@ -420,7 +421,7 @@ def march(
         )
     # a root found at the end of one mode and the start of the next is one root
     segs.sort(key=lambda g: g.start_arc)
-    out = []
+    out: list[Segment] = []
     for g in segs:
         if out and abs(part.arc_offset(g.start_arc, out[-1].start_arc)) < min_separation:
             continue

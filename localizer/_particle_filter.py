@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
 from ._tracks import tracks_for
@@ -52,7 +53,7 @@ class ParticleFilter:
         particles: int = 2000,
         sd_position: float = 0.04,
         process: float = 0.005,
-        radius: float = 0.3,
+        radius: float = SUCCESS_RADIUS,
         seed: int = 0,
         spacing: float = 0.02,
     ):

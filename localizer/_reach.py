@@ -125,8 +125,8 @@ class Reach:
         tan = np.asarray(part.tangent(t))
         eq = ConvexHull(pts).equations  # n·x + d ≤ 0 inside
         depth = np.full(n, -np.inf)
-        for c in range(0, len(eq), 256):
-            e = eq[c : c + 256]
+        for j0 in range(0, len(eq), 256):
+            e = eq[j0 : j0 + 256]
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
         self.hull_depth = np.maximum(-depth, 0.0)
         half = jaw.half

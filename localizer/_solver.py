@@ -34,6 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._march import march
 from ._part import _TWO_PI, Part
@@ -131,7 +132,7 @@ def _solve_ccw(
     # Breakpoints: the table nodes (their θ, κ are the table's constants) and the
     # starts whose end falls on a node; one table evaluation covers both.
     J = nodes.size
-    th_n, k_n = table._th_cols[0], table._k_cols[0]
+    th_n, k_n = table.theta_cols[0], table.kappa_cols[0]
     shifted = nodes - length
     wrapped = shifted < 0.0
     shifted = np.where(wrapped, shifted + P, shifted)
@@ -212,10 +213,10 @@ def _solve_ccw(
         K = np.concatenate([K, K])
 
     zeros = np.concatenate(exact_zero)
-    brackets = tuple(np.concatenate([x[i] for x in brackets]) for i in range(7)) if brackets else None
-    doubles = np.concatenate(doubles) if doubles else np.empty(0)
+    joined = tuple(np.concatenate([x[i] for x in brackets]) for i in range(7)) if brackets else None
+    double_roots = np.concatenate(doubles) if doubles else np.empty(0)
     continua = _merge_flats(np.concatenate(flats) if flats else np.empty((0, 2)), P)
-    return zeros, brackets, doubles, continua
+    return zeros, joined, double_roots, continua
 
 
 def _hermite_root(g0, g1, d0, d1, iterations=2):
@@ -345,9 +346,9 @@ def feasible_segments(
     double_width: float = 1e-7,
     max_cells: int = 2_000_000,
     step: float = 1e-5,
-    length_tol: float = 0.004,
-    turn_tol: float = 0.0004,
-    min_separation: float = 0.5,
+    length_tol: float = LENGTH_TOL,
+    turn_tol: float = TURN_TOL,
+    min_separation: float = MIN_SEPARATION,
 ) -> list[Segment]:
     """Every boundary segment with arc length ``length`` and total curvature ``turn``.
 
@@ -411,11 +412,11 @@ def feasible_segments(
     P = part.perimeter
     omega = turn if direction == "ccw" else -turn
     if method == "march":
-        res = march(
+        marched = march(
             part, length, omega, step=step, length_tol=length_tol, turn_tol=turn_tol, min_separation=min_separation
         )
         if direction == "ccw":
-            return [replace(g, turn=turn) for g in res.segments]
+            return [replace(g, turn=turn) for g in marched.segments]
         # the ccw stretch was travelled from its far end
         return sorted(
             (
@@ -428,7 +429,7 @@ def feasible_segments(
                     turn=turn,
                     direction="cw",
                 )
-                for g in res.segments
+                for g in marched.segments
             ),
             key=lambda g: g.start_arc,
         )

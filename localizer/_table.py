@@ -9,7 +9,7 @@ they are built, on every cell, and the solver widens its certificates by it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -53,6 +53,9 @@ class ArcTable:
         Bound of |d²θ/dσ²| = |dκ/dσ| of the tabulated θ on each cell, 1/mm².
     theta_error, param_error : float
         Worst measured interpolation error of θ (rad) and of t.
+    theta_cols, kappa_cols, param_cols : ndarray, shapes (6, J), (5, J), (6, J)
+        ``theta``, ``dtheta`` and ``param`` column by column (gathering 1-D columns is several
+        times faster), for the exact solver's breakpoints and the evaluations here.
     """
 
     perimeter: float
@@ -64,12 +67,16 @@ class ArcTable:
     kappa_slope: np.ndarray
     theta_error: float
     param_error: float
+    theta_cols: np.ndarray = field(init=False, repr=False)
+    kappa_cols: np.ndarray = field(init=False, repr=False)
+    param_cols: np.ndarray = field(init=False, repr=False)
+    _inv_h: np.ndarray = field(init=False, repr=False)
+    _last: int = field(init=False, repr=False)
 
     def __post_init__(self):
-        # column-major copies: gathering 1-D columns is several times faster
-        object.__setattr__(self, "_th_cols", np.ascontiguousarray(self.theta.T))
-        object.__setattr__(self, "_k_cols", np.ascontiguousarray(self.dtheta.T))
-        object.__setattr__(self, "_t_cols", np.ascontiguousarray(self.param.T))
+        object.__setattr__(self, "theta_cols", np.ascontiguousarray(self.theta.T))
+        object.__setattr__(self, "kappa_cols", np.ascontiguousarray(self.dtheta.T))
+        object.__setattr__(self, "param_cols", np.ascontiguousarray(self.param.T))
         object.__setattr__(self, "_inv_h", 1.0 / self.h)
         object.__setattr__(self, "_last", len(self.h) - 1)
 
@@ -90,11 +97,11 @@ class ArcTable:
     def theta_kappa_cell(self, sigma):
         """As :meth:`theta_kappa`, plus the table cell of each point."""
         lap, cell, x = self.locate(sigma)
-        c = self._th_cols
+        c = self.theta_cols
         th = c[5][cell]
         for k in (4, 3, 2, 1, 0):
             th = th * x + c[k][cell]
-        c = self._k_cols
+        c = self.kappa_cols
         ka = c[4][cell]
         for k in (3, 2, 1, 0):
             ka = ka * x + c[k][cell]
@@ -103,7 +110,7 @@ class ArcTable:
     def param_at(self, sigma):
         """Tabulated unrolled spline parameter at ``sigma`` (add ``lap * N`` outside)."""
         lap, cell, x = self.locate(sigma)
-        c = self._t_cols
+        c = self.param_cols
         t = c[5][cell]
         for k in (4, 3, 2, 1, 0):
             t = t * x + c[k][cell]

@@ -4,6 +4,7 @@ from ._errors import SimError
 from .machining import machined_part, machining_slope
 from .noise import PRESETS, NoiseModel, load_noise
 from .rig import SimRig
+from .world import Contact, World
 from .wrist import Wrist, encoder_angle
 
 __all__ = [
@@ -16,4 +17,6 @@ __all__ = [
     "encoder_angle",
     "machined_part",
     "machining_slope",
+    "World",
+    "Contact",
 ]

@@ -226,7 +226,7 @@ def _run(axis: Axis, n: int, x0: float, physical: Callable, sampled: Callable) -
             x += h * xd
             if not math.isfinite(x):
                 raise SimError(f"the axis diverged at t = {t:.3f} s")
-    a = np.array(rows)
+    a = np.array(rows, dtype=float)
     return {
         "time": a[:, 0],
         "position": a[:, 1],

@@ -25,7 +25,8 @@ import pymunk
 from localizer import Part
 
 from ._errors import SimError
-from .quasistatic import Contact, tangent_point
+from .quasistatic import tangent_point
+from .world import Contact
 
 __all__ = ["PymunkWorld", "polygonise"]
 
@@ -54,9 +55,9 @@ def _polygon(part: Part, chord_tolerance: float):
         h_max = math.sqrt(8.0 * chord_tolerance / max(kappa, 1e-12))
         n = max(1, math.ceil(length * (speed.max() / speed.mean()) / h_max))
         ts.append(i + np.arange(n) / n)
-    ts = np.concatenate(ts)
-    pts = part.point(ts)
-    return np.vstack([pts, pts[:1]]), ts
+    t = np.concatenate(ts)
+    pts = part.point(t)
+    return np.vstack([pts, pts[:1]]), t
 
 
 class PymunkWorld:
@@ -140,7 +141,8 @@ class PymunkWorld:
         spring = pymunk.DampedSpring(self.hand_body, self.jaw_body, (0.0, -rest), (0.0, 0.0), rest, k, damping)
         gear = pymunk.GearJoint(self.hand_body, self.jaw_body, 0.0, 1.0)
         space.add(self.hand_body, self.jaw_body, jaw, groove, spring, gear)
-        self.hand = None  # not placed yet: the first command puts the arm there directly
+        # not placed yet: the first command puts the arm there directly
+        self.hand: tuple[float, float, float] | None = None
 
     def _place(self, x, y, phi):
         for b in (self.hand_body, self.jaw_body):

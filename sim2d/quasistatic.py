@@ -11,40 +11,14 @@ a concavity the contact jumps from one side to the other and the jaw bridges.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from localizer import Part
 
 from ._errors import SimError
+from .world import Contact
 
-__all__ = ["Contact", "QuasiStaticWorld", "tangent_point"]
-
-
-@dataclass(frozen=True)
-class Contact:
-    """Where and how hard the jaw touches the part.
-
-    Attributes
-    ----------
-    force : float, N
-        Normal contact force (0 when not touching).
-    jaw_position : float, mm
-        Contact location along the jaw from the wrist's axis (along e).
-    param : float
-        Spline parameter of the contact point on the (real) part.
-    depth : float, mm
-        How far the part would cut into the rigid edge (the wrist's give).
-    at_edge : bool
-        The contact is at an end of the jaw (outside the calibrated span).
-    """
-
-    force: float
-    jaw_position: float
-    param: float
-    depth: float
-    at_edge: bool
+__all__ = ["QuasiStaticWorld", "tangent_point"]
 
 
 class QuasiStaticWorld:
@@ -68,7 +42,7 @@ class QuasiStaticWorld:
         self.half_span = float(half_span)
         self._t = np.arange(part.n_knots * 32) / 32.0
         self._xy = part.point(self._t)
-        self.hand = (0.0, 0.0, 0.0)
+        self.hand: tuple[float, float, float] | None = (0.0, 0.0, 0.0)
 
     def set_hand(self, x: float, y: float, phi: float) -> None:
         """Put the hand (wrist axis at (x, y) mm, jaw angle φ rad) there."""
@@ -76,7 +50,7 @@ class QuasiStaticWorld:
 
     def contact(self) -> Contact:
         """The contact for the present hand pose (force 0 when the jaw is clear)."""
-        x, y, phi = self.hand
+        x, y, phi = self.hand or (0.0, 0.0, 0.0)
         e = np.array([np.cos(phi), np.sin(phi)])
         m = np.array([-np.sin(phi), np.cos(phi)])
         rel = self._xy - (x, y)

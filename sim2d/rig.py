@@ -17,6 +17,7 @@ from ._errors import SimError
 from .machining import machined_part
 from .noise import NoiseModel, load_noise
 from .quasistatic import QuasiStaticWorld
+from .world import World
 from .wrist import Wrist, encoder_angle
 
 __all__ = ["SimRig"]
@@ -72,6 +73,7 @@ class SimRig:
         self.noise: NoiseModel = load_noise(noise)
         self.rng = np.random.default_rng(seed)
         self.part = machined_part(part, self.noise, self.rng)
+        self.world: World
         if engine == "pymunk":
             from .pymunk_world import PymunkWorld
 

@@ -6,9 +6,13 @@ from __future__ import annotations
 import argparse
 import math
 
-from localizer import RolltouchError
+from localizer import ROLL_STEP, SUCCESS_RADIUS, RolltouchError
+
+from ..reactive import CONFIDENCE, MAX_ROTATION
 
 __all__ = [
+    "STEP_DEG",
+    "MAX_ROTATION_DEG",
     "UsageError",
     "add_command",
     "positive",
@@ -18,6 +22,11 @@ __all__ = [
     "reactive_arguments",
     "servo_option",
 ]
+
+
+#: The command line's defaults in its own units (degrees), from their one home.
+STEP_DEG = round(math.degrees(ROLL_STEP), 9)
+MAX_ROTATION_DEG = round(math.degrees(MAX_ROTATION), 9)
 
 
 class UsageError(RolltouchError, ValueError):
@@ -77,22 +86,22 @@ def reactive_arguments(p) -> None:
     p.add_argument(
         "--reactive",
         action="store_true",
-        help="instead of fixed rolls, roll step by step until the contact is known within 0.3 mm "
+        help=f"instead of fixed rolls, roll step by step until the contact is known within {SUCCESS_RADIUS} mm "
         "with --confidence, or --max-rotation is rolled (docs/robustness.md)",
     )
     p.add_argument(
         "--confidence",
         type=probability,
-        default=0.95,
+        default=CONFIDENCE,
         metavar="P",
-        help="reactive: probability within 0.3 mm that stops the rolling (default 0.95)",
+        help=f"reactive: probability within {SUCCESS_RADIUS} mm that stops the rolling (default {CONFIDENCE})",
     )
     p.add_argument(
         "--max-rotation",
         type=positive,
-        default=240.0,
+        default=MAX_ROTATION_DEG,
         metavar="DEG",
-        help="reactive: rotation budget, both directions counted (default 240°)",
+        help=f"reactive: rotation budget, both directions counted (default {MAX_ROTATION_DEG:g}°)",
     )
 
 

@@ -6,15 +6,16 @@ import json
 import math
 import sys
 
-from localizer import ContactFilter
+from localizer import SUCCESS_RADIUS, ContactFilter
 
 from ._options import servo_option
 
 __all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run"]
 
 
-def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> dict:
-    """Run the reactive localization on ``rig``; the JSON object of 'simulate|run --reactive'."""
+def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:
+    """Run the reactive localization on ``rig``: the JSON object of 'simulate|run --reactive' and the
+    :class:`driver.reactive.ReactiveRun`."""
     from driver.reactive import localize_reactively
 
     res = localize_reactively(
@@ -58,13 +59,14 @@ def print_reactive(doc) -> None:
         f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
         f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)"
     )
-    print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within 0.3 mm")
+    print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within {SUCCESS_RADIUS} mm")
     for m in doc["modes"][1:3]:
         print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")
     if doc.get("error_mm") is not None:
         err = doc["error_mm"]
         print(
-            f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm ({'success' if err < 0.3 else 'failure'} at 0.3 mm)"
+            f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
+            f"({'success' if err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
         )
 
 
@@ -117,5 +119,5 @@ def print_run(doc) -> None:
         err = doc["error_mm"]
         print(
             f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
-            f"({'success' if err is not None and err < 0.3 else 'failure'} at 0.3 mm)"
+            f"({'success' if err is not None and err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
         )

@@ -4,11 +4,12 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 import numpy as np
 
-from localizer import DIRECTIONS, RULES, load_part, localize
+from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, load_part, localize
 
 from ._options import add_command, positive
 from ._output import emit_run, run_summary
@@ -64,16 +65,16 @@ def register(sub) -> None:
     loc.add_argument(
         "--length-tol",
         type=positive,
-        default=0.004,
+        default=LENGTH_TOL,
         metavar="MM",
-        help="paper rule: length tolerance (default 0.004 mm)",
+        help=f"paper rule: length tolerance (default {LENGTH_TOL} mm)",
     )
     loc.add_argument(
         "--turn-tol",
         type=positive,
-        default=float(np.degrees(0.0004)),
+        default=math.degrees(TURN_TOL),
         metavar="DEG",
-        help="paper rule: turn tolerance (default 0.0004 rad = 0.0229 deg)",
+        help=f"paper rule: turn tolerance (default {TURN_TOL} rad = {math.degrees(TURN_TOL):.4f} deg)",
     )
     loc.add_argument("--json", action="store_true", help="print the result as JSON")
     loc.add_argument("--plot", metavar="FILE.png", help="draw the part, the candidate segments and the contact")
@@ -136,10 +137,8 @@ def localize_command(args) -> int:
                 x, y = xy(c.end_arc)
                 print(f"{k:>3} {c.start_arc:>10.3f} {c.end_arc:>15.3f} {x:>9.3f} {y:>9.3f} {c.probability:>6.3f}")
             verdict = "AMBIGUOUS" if result.ambiguous else "localized"
-            print(
-                f"{verdict}: contact now at arc {result.best.end_arc:.3f} mm "
-                f"(p={result.best.probability:.3f}, rule {result.rule})"
-            )
+            best = result.candidates[0]
+            print(f"{verdict}: contact now at arc {best.end_arc:.3f} mm (p={best.probability:.3f}, rule {result.rule})")
     if args.plot:
         from driver.plotting import plot_localization
 

@@ -9,9 +9,9 @@ import json
 import math
 import sys
 
-from localizer import load_part
+from localizer import SUCCESS_RADIUS, load_part
 
-from ._options import add_command, positive, reactive_arguments, rig_arguments, servo_arguments, servo_option
+from ._options import STEP_DEG, add_command, positive, reactive_arguments, rig_arguments, servo_arguments, servo_option
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
 __all__ = ["register", "calibrate_command", "run_command"]
@@ -49,7 +49,9 @@ def register(sub) -> None:
         metavar="DEG",
         help="a roll's rotation in degrees; repeat (default 20 then 15)",
     )
-    run.add_argument("--step", type=positive, default=0.2, metavar="DEG", help="rolling step (default 0.2°)")
+    run.add_argument(
+        "--step", type=positive, default=STEP_DEG, metavar="DEG", help=f"rolling step (default {STEP_DEG}°)"
+    )
     servo_arguments(run)
     reactive_arguments(run)
     run.add_argument("--log", metavar="FILE.jsonl", help="run log, JSON Lines, flushed per sample")
@@ -163,7 +165,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
         if event.get("event") == "belief":
             sys.stderr.write(
                 f"\rrolled {math.degrees(event['rotation']):6.1f}°  best {event['map_arc']:8.2f} mm  "
-                f"{event['mass']:6.1%} within 0.3 mm "
+                f"{event['mass']:6.1%} within {SUCCESS_RADIUS} mm "
             )
             sys.stderr.flush()
 

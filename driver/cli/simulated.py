@@ -12,7 +12,7 @@ import numpy as np
 from localizer import QueryError, load_part
 
 from ..rig import RigError
-from ._options import UsageError, add_command, positive, reactive_arguments, servo_arguments, servo_option
+from ._options import STEP_DEG, UsageError, add_command, positive, reactive_arguments, servo_arguments, servo_option
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
 __all__ = ["register", "simulate_command", "emulate_command"]
@@ -57,7 +57,9 @@ def register(sub) -> None:
         help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk)",
     )
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    sim.add_argument("--step", type=positive, default=0.2, metavar="DEG", help="rolling step, degrees (default 0.2)")
+    sim.add_argument(
+        "--step", type=positive, default=STEP_DEG, metavar="DEG", help=f"rolling step, degrees (default {STEP_DEG})"
+    )
     servo_arguments(sim)
     reactive_arguments(sim)
     sim.add_argument("--out", required=True, metavar="TRACE.npz", help="trace file to write")

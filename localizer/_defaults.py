@@ -1,0 +1,21 @@
+"""The paper's constants and the package's defaults, each defined once and imported where used.
+
+Jia (2005) states the tolerances of its marching algorithm (§II-C, §IV: "ε-close" in length
+and turn), the separation below which two feasible segments are one, the success radius of its
+experiments and the rolling step of its arm (0.2°, §IV).
+"""
+
+import math
+
+__all__ = ["LENGTH_TOL", "TURN_TOL", "MIN_SEPARATION", "SUCCESS_RADIUS", "ROLL_STEP"]
+
+#: The paper's tolerance on a segment's contact travel, mm.
+LENGTH_TOL = 0.004
+#: The paper's tolerance on a segment's rotation, rad.
+TURN_TOL = 0.0004
+#: Feasible starts closer than this are one segment, mm.
+MIN_SEPARATION = 0.5
+#: A localization is a success when its estimate is within this of the true contact, mm.
+SUCCESS_RADIUS = 0.3
+#: The arm's rolling step, rad (0.2°).
+ROLL_STEP = math.radians(0.2)
