@@ -30,7 +30,8 @@ def wilson(successes: int, n: int, z: float = 1.96):
     denom = 1 + z * z / n
     centre = (p + z * z / (2 * n)) / denom
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return (max(0.0, centre - half), min(1.0, centre + half))
+    # in exact arithmetic the interval holds p; rounding at p = 1 (or 0) must not put it outside
+    return (max(0.0, min(p, centre - half)), min(1.0, max(p, centre + half)))
 
 
 def read_trials(path) -> list:
