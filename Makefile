@@ -1,5 +1,5 @@
 # make demo : set up .venv, simulate two rolls on a shipped part with the paper's noise, localize (plot in out/)
-# make test : set up .venv and run the tests, the doctests and the benchmark smoke run
+# make test : set up .venv; lint (ruff), type-check (mypy), run the tests, the doctests and the benchmark smoke run
 PYTHON ?= python3.11
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -18,8 +18,13 @@ demo: $(STAMP)
 	$(VENV)/bin/rolltouch simulate parts/trefoil.json --start 120 --roll 20 --roll 15 --noise paper --engine pymunk --out out/demo.npz --plot out/demo.png
 	$(VENV)/bin/rolltouch locate out/demo.npz --part parts/trefoil.json
 
+CODE   := localizer passivity sim2d driver bench tests
+
 test: $(STAMP)
-	$(PY) -m pytest -q tests localizer passivity
+	$(VENV)/bin/ruff check $(CODE)
+	$(VENV)/bin/ruff format --check $(CODE)
+	$(VENV)/bin/mypy
+	$(PY) -m pytest -q tests localizer passivity sim2d driver
 	$(PY) -m pytest -q bench --benchmark-disable -p no:cacheprovider
 
 bench: $(STAMP)

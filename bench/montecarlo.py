@@ -23,7 +23,15 @@ __all__ = ["run_study", "read_trials", "summarize", "wilson"]
 
 
 def wilson(successes: int, n: int, z: float = 1.96):
-    """Wilson 95% interval of a success rate, (low, high)."""
+    """Wilson 95% interval of a success rate, (low, high).
+
+    Examples
+    --------
+    >>> [round(v, 3) for v in wilson(45, 100)]
+    [0.356, 0.548]
+    >>> wilson(100, 100)[1]
+    1.0
+    """
     if n == 0:
         return (math.nan, math.nan)
     p = successes / n

@@ -165,7 +165,24 @@ class StudyError(RolltouchError, ValueError):
 
 @dataclass(frozen=True)
 class Study:
-    """A parsed study (see the module notes for the file format)."""
+    """A parsed study: each field is the study file's key of the same name (module notes), paths resolved.
+
+    Attributes
+    ----------
+    name, parts, rolls_deg, step_deg, method, engine, trials, seed, success_radius, noise
+        The file's keys (``parts``: absolute paths; ``rolls_deg`` and ``step_deg`` in degrees;
+        ``success_radius`` in mm; ``noise``: a preset or a resolved file).
+    parameter, values
+        The ``[sweep]``: the swept noise-model field (or ``"noise"``) and its values.
+    sd_length, sd_turn_deg
+        The ``[likelihood]`` table (mm, degrees).
+    source : str
+        The study file's path.
+    methods : tuple of str
+        The methods scored on the same trials.
+    reactive, particle : ReactiveOptions, ParticleOptions
+        The ``[reactive]`` and ``[particle]`` tables.
+    """
 
     name: str
     parts: tuple
@@ -197,15 +214,16 @@ class Study:
         return max(1, len(self.values))
 
     def level_value(self, level: int):
+        """The swept parameter's value at ``level`` (None without a sweep)."""
         return self.values[level] if self.values else None
 
     def level_label(self, level: int):
-        """The level's value as trials.csv and summary.json write it (a noise file by its name)."""
+        """The value of ``level`` as trials.csv and summary.json write it (a noise file by its name)."""
         v = self.level_value(level)
         return Path(v).stem if self.parameter == "noise" and v is not None else v
 
     def level_noise(self, level: int):
-        """The noise model of a level."""
+        """The noise model of ``level``."""
         from sim2d import load_noise
 
         if self.parameter == "noise":
@@ -216,6 +234,7 @@ class Study:
         return noise
 
     def with_overrides(self, *, trials=None, engine=None) -> Study:
+        """The study with ``trials`` per level and the ``engine`` replaced where given (the command line's flags)."""
         s = self
         if trials is not None:
             if int(trials) < 1:
@@ -228,11 +247,12 @@ class Study:
         return s
 
     def as_dict(self) -> dict:
+        """Plain-JSON form (study.json)."""
         return asdict(self)
 
 
 def load_study(path) -> Study:
-    """Read and check a study file.
+    """Read and check the study file at ``path`` (TOML, see the module notes).
 
     Raises
     ------

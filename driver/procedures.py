@@ -225,6 +225,14 @@ class Calibration:
         Measured Δv2/Δv1 at each tap.
     target : float, V
         Δv1 held during the taps.
+
+    Examples
+    --------
+    A sensor whose ratio grows linearly along the jaw:
+
+    >>> cal = Calibration(positions=(-50.0, -25.0, 0.0, 25.0, 50.0), ratios=(0.5, 0.75, 1.0, 1.25, 1.5))
+    >>> round(cal.position(1.1), 6)
+    10.0
     """
 
     positions: tuple

@@ -49,13 +49,30 @@ def _number(x: float) -> str:
 
 
 def encode_request(seq: int, command: str, *args) -> bytes:
-    """``<seq> <COMMAND> [args...]\\n`` (numbers written exactly, as Python's repr)."""
+    """``<seq> <COMMAND> [args...]\\n`` (numbers written exactly, as Python's repr).
+
+    Examples
+    --------
+    >>> encode_request(3, "MOVE", 10.0, -2.5, 30.0)
+    b'3 MOVE 10.0 -2.5 30.0\\n'
+    >>> parse_request(b'3 MOVE 10.0 -2.5 30.0', ARM_COMMANDS)
+    (3, 'MOVE', [10.0, -2.5, 30.0])
+    """
     parts = [str(int(seq) % 65536), command] + [_number(a) if not isinstance(a, int) else str(a) for a in args]
     return (" ".join(parts) + "\n").encode("ascii")
 
 
 def encode_reply(seq: int, status: str, *fields) -> bytes:
-    """``<seq> <OK|DATA|ERR> [fields...] *<cc>\\n``; float fields written exactly."""
+    """``<seq> <OK|DATA|ERR> [fields...] *<cc>\\n``; float fields written exactly.
+
+    Examples
+    --------
+    >>> line = encode_reply(7, "OK", 12.5, -0.25)
+    >>> line
+    b'7 OK 12.5 -0.25 *3F\\n'
+    >>> parse_reply(line).numbers(2)
+    (12.5, -0.25)
+    """
     parts = [str(int(seq) % 65536), status] + [_number(f) if isinstance(f, float) else str(f) for f in fields]
     body = " ".join(parts).encode("ascii")
     return body + b" *" + checksum(body).encode("ascii") + b"\n"

@@ -42,7 +42,7 @@ class Rig(Protocol):
     """
 
     def move(self, x: float, y: float, phi: float) -> None:
-        """Move the hand to the pose and return when it is there."""
+        """Move the hand to (``x``, ``y``) mm, jaw angle ``phi`` rad, and return when it is there."""
 
     def pose(self) -> tuple:
         """The arm's reading of the hand pose, (x, y, φ)."""

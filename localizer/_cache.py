@@ -27,7 +27,7 @@ def per_part(kind: str, part: Part, args: Hashable, build: Callable[[], T], *, l
     store = part._tables
     key = (kind, args)
     if key in store:
-        return store[key]  # type: ignore[no-any-return]
+        return store[key]
     value = build()
     if latest_only:
         for old in [k for k in store if k[0] == kind]:

@@ -674,7 +674,8 @@ class ContactFilter:
         return s["w"].copy()
 
     def belief(self, radius: float | None = None) -> Belief:
-        """The belief over the present contact (see :class:`Belief`)."""
+        """The belief over the present contact (see :class:`Belief`), its mass taken within ``radius`` mm
+        (default: the filter's ``radius``)."""
         radius = self.radius if radius is None else float(radius)
         part = self.part
         w = self.posterior()

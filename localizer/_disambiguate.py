@@ -99,6 +99,8 @@ class Localization:
         The measured chain, (mm, rad).
     rule : str
         Rule used.
+    direction : {"ccw", "cw"}
+        Direction the contact moved on the part.
     confidence : float
         Probability the best candidate needs for the result not to be ambiguous.
     """

@@ -87,11 +87,11 @@ class MarchGrid:
         return cum[k] + f * (cum[k + 1] - cum[k]) + lap * cum[-1]
 
     def ell(self, s, t):
-        """ℓ(s, t) by the trapezoid rule, mm (unrolled s <= t)."""
+        """ℓ(s, t) by the trapezoid rule, mm, between unrolled parameters ``s`` <= ``t``."""
         return self._value(self.length, t) - self._value(self.length, s)
 
     def phi(self, s, t):
-        """Φ(s, t) by the trapezoid rule, rad (unrolled s <= t)."""
+        """Φ(s, t) by the trapezoid rule, rad, between unrolled parameters ``s`` <= ``t``."""
         return self._value(self.turn, t) - self._value(self.turn, s)
 
     def _search(self, cum, target, x_lo, x_hi):
@@ -146,7 +146,8 @@ class MarchResult:
 
 
 def march_grid(part: Part, h: float) -> MarchGrid:
-    """The h-grid integrals of ``part``, built by the trapezoid rule (kept with the part for the last h)."""
+    """The integrals of ``part`` on a grid of step ``h`` in the parameter, built by the trapezoid rule (kept
+    with the part for the last ``h``)."""
     return per_part("march_grid", part, float(h), lambda: _build(part, h), latest_only=True)
 
 

@@ -251,7 +251,7 @@ class Part:
         return np.stack([tg[..., 1], -tg[..., 0]], axis=-1)
 
     def tangent_angle(self, t) -> np.ndarray:
-        """Unwrapped tangent angle θ(t), rad: continuous, θ(t + N) = θ(t) + 2π."""
+        """Unwrapped tangent angle θ(t), rad, at unrolled parameters ``t``: continuous, θ(t + N) = θ(t) + 2π."""
         lap, piece, u, cell = self._split(t)
         dx, dy, _, _ = self.derivatives(piece, u)
         return self._unwrap(np.arctan2(dy, dx), cell, lap)
@@ -262,12 +262,12 @@ class Part:
         return base + _wrap(raw - base) + _TWO_PI * lap
 
     def curvature(self, t) -> np.ndarray:
-        """Signed curvature κ(t), 1/mm: positive where the boundary is convex."""
+        """Signed curvature κ(t), 1/mm, at unrolled parameters ``t``: positive where the boundary is convex."""
         _, piece, u, _ = self._split(t)
         return _curvature(*self.derivatives(piece, u))
 
     def arc_at_param(self, t) -> np.ndarray:
-        """Unrolled arc position Λ(t) = ℓ(0, t), mm (grows by the perimeter per lap)."""
+        """Unrolled arc position Λ(t) = ℓ(0, t), mm, at unrolled parameters ``t`` (grows by the perimeter per lap)."""
         lap, piece, u, cell = self._split(t)
         return self._sig_nodes[cell] + self._partial_arc(piece, cell, u) + self.perimeter * lap
 
@@ -311,7 +311,8 @@ class Part:
 
     # ---------------------------------------------------- functions of arc
     def param_at_arc(self, sigma, *, newton_steps: int = 2) -> np.ndarray:
-        """Unrolled parameter at unrolled arc position ``sigma`` (mm): the inverse of ℓ(0, ·).
+        """Unrolled parameter at unrolled arc position ``sigma`` (mm): the inverse of ℓ(0, ·), refined by
+        ``newton_steps`` Newton steps.
 
         A cubic Hermite guess inside the table cell, then safeguarded Newton
         steps on the Gauss-Legendre arc length (two steps give ~1e-13 mm).
@@ -356,7 +357,7 @@ class Part:
         return self.curvature(self.param_at_arc(sigma))
 
     def wrap_arc(self, sigma) -> np.ndarray:
-        """Arc positions reduced to ``[0, perimeter)``."""
+        """Arc positions ``sigma`` (mm) reduced to ``[0, perimeter)``."""
         w = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
         return np.where(w >= self.perimeter, 0.0, w)
 
@@ -370,7 +371,9 @@ class Part:
         return np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
 
     def sample(self, per_piece: int = 16) -> np.ndarray:
-        """Dense closed polyline of the boundary, shape (N*per_piece + 1, 2), mm."""
+        """Dense closed polyline of the boundary, ``per_piece`` points per spline piece, mm.
+
+        Returns an array of shape (N*per_piece + 1, 2), its last point the first."""
         t = np.arange(self.n_knots * per_piece + 1) / per_piece
         return self.point(t)
 

@@ -43,7 +43,11 @@ class ParticleFilter:
     process : float, mm
         Standard deviation of the random walk added to each particle per step.
     radius : float, mm
+        The belief's success radius (:data:`localizer.SUCCESS_RADIUS`).
     seed : int
+        Seeds the particles' draws and random walk.
+    spacing : float, mm
+        Grid step of the tracks the particles are moved along (:func:`localizer.tracks_for`).
     """
 
     def __init__(
@@ -92,7 +96,8 @@ class ParticleFilter:
         return moved - t.sigma[i], ok
 
     def update(self, arc: float, turn: float) -> None:
-        """Take one reading: cumulative signed arc (mm) and net rotation (rad), as ContactFilter."""
+        """Take one reading: cumulative signed ``arc`` (mm) and net rotation ``turn`` (rad), as
+        :meth:`localizer.ContactFilter.update`."""
         if not (math.isfinite(arc) and math.isfinite(turn)):
             raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
         d_turn = turn - self._turn

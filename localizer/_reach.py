@@ -216,7 +216,8 @@ class Reach:
 
 
 def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, clearance: float = 0.1) -> Reach:
-    """The part's :class:`Reach` for ``jaw``, built once per part, jaw, spacing and clearance (shared, read-only)."""
+    """The ``part``'s :class:`Reach` for ``jaw`` (grid ``spacing`` mm, ``clearance`` mm), built once per part and
+    settings (shared, read-only)."""
     return per_part(
         "reach",
         part,
@@ -226,7 +227,7 @@ def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, 
 
 
 def calibration_arc(part: Part, jaw: StraightJaw = DEFAULT_JAW) -> float:
-    """Where to calibrate on ``part``: the most curved point the jaw touches at every place along it, mm.
+    """Where to calibrate on ``part``: the most curved point the ``jaw`` touches at every place along it, mm.
 
     The calibration taps one object point with the contact at 11 places from one end of
     the jaw to the other (paper §III-B), so the point must be touchable with the whole jaw;

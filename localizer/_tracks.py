@@ -15,7 +15,7 @@ __all__ = ["ModeTracks", "tracks_for"]
 
 
 def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> ModeTracks:
-    """The part's :class:`ModeTracks` at ``spacing`` mm for ``jaw``, built once per part, spacing and jaw.
+    """The ``part``'s :class:`ModeTracks` at ``spacing`` mm for ``jaw``, built once per part, spacing and jaw.
 
     Building them takes most of a second (the dense sample, the jaw's reach, the banded
     tangent-angle table); a Monte Carlo trial makes a grid filter and a particle filter on
@@ -37,6 +37,14 @@ class ModeTracks:
         The jaw touches the point at some place along it.
     convex : ndarray of bool
         Where a rolling can be: a convex stretch (θ rising, κ > 0) the jaw touches.
+
+    Parameters
+    ----------
+    part : Part
+    spacing : float, mm
+        Grid step (at least 64 points over the perimeter).
+    jaw : StraightJaw
+        The jaw whose reach is tabulated.
     """
 
     def __init__(self, part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW):
@@ -150,7 +158,8 @@ class ModeTracks:
     def roll(
         self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0, turn_margin: float = 0.0
     ) -> tuple:
-        """:meth:`advance`, and the landing must be touchable.
+        """:meth:`advance` the hypotheses ``index`` (grid indices) by net rotation ``turn`` (rad, at most
+        ``turn_margin`` rad past a convex stretch's end), and the landing must be touchable.
 
         ``jaw`` (mm) is the contact's place on the jaw at arc ``at`` (mm, default the grid
         points): the landing's place is taken as that plus the arc rolled (the contact moves

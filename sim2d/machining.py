@@ -14,7 +14,8 @@ __all__ = ["machined_part", "machining_slope"]
 
 
 def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Part:
-    """The part as machined: each knot moved along the model's outward normal.
+    """The ``part`` as machined under the ``noise`` model, its random harmonics drawn from ``rng``: each knot
+    moved along the model's outward normal.
 
     The deviation is a random sum of harmonics of the arc position with
     wavelengths down to ``noise.machining_wavelength`` mm, scaled to an RMS of
@@ -37,7 +38,15 @@ def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Pa
 
 def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:
     """RMS slope error (rad) of a boundary deviation of ``rms`` mm made of harmonics of the
-    perimeter with 1/k amplitudes down to ``wavelength`` mm (the simulator's machining model)."""
+    ``perimeter`` (mm) with 1/k amplitudes down to ``wavelength`` mm (the simulator's machining model).
+
+    Examples
+    --------
+    The ``paper`` preset's 0.009 mm at 20 mm on a 400 mm outline:
+
+    >>> round(machining_slope(0.009, 20.0, 400.0) * 1e3, 3)  # mrad
+    0.5
+    """
     if rms <= 0:
         return 0.0
     k = np.arange(1, max(1, int(perimeter / wavelength)) + 1)

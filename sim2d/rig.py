@@ -95,7 +95,7 @@ class SimRig:
 
     # ------------------------------------------------------------ Rig: arm
     def move(self, x: float, y: float, phi: float) -> None:
-        """Move the hand to (x, y) mm with jaw angle φ rad (blocks until there)."""
+        """Move the hand to (``x``, ``y``) mm with jaw angle ``phi`` rad (blocks until there)."""
         pose = (float(x), float(y), float(phi))
         if not all(math.isfinite(v) for v in pose):
             raise SimError(f"move to {pose!r}: the pose must be finite")
@@ -149,7 +149,7 @@ class SimRig:
         and 5 N·s/m on the wrist's stiffness), for ``duration`` s, starting from
         the present press. With ``guard`` a passivity observer/controller with
         both low-velocity fixes sits on the correction's port
-        (:mod:`localizer._passivity`, "observed" booking). The hand ends where
+        (:class:`passivity.PassivityController`, "observed" booking). The hand ends where
         the servo left it.
 
         Parameters
@@ -160,7 +160,10 @@ class SimRig:
             Force-error gain (N/N). Above about 8 the bare loop rings; above
             about 15 it loses the part every cycle.
         guard : bool
+            The passivity observer/controller on the servo's port.
         duration : float, s
+        seed : int, optional
+            Seeds the servo's sensor noise (default: drawn from the rig's own generator).
 
         Returns
         -------

@@ -50,7 +50,7 @@ class World(Protocol):
     hand: tuple[float, float, float] | None
 
     def set_hand(self, x: float, y: float, phi: float) -> None:
-        """Put the hand at (x, y) mm, φ rad, and let the world settle."""
+        """Put the hand at (``x``, ``y``) mm, ``phi`` rad, and let the world settle."""
         ...
 
     def contact(self) -> Contact:

@@ -44,20 +44,22 @@ class Wrist:
     volts_per_newton: float = 0.4
 
     def stresses(self, force, d):
-        """(σ1, σ2) in MPa for force F (N) at jaw position d (mm), eqs. (10) and (12)."""
+        """(σ1, σ2) in MPa for ``force`` F (N) at jaw position ``d`` (mm), eqs. (10) and (12)."""
         force = np.asarray(force, dtype=float)
         mb = force * self.height
         mt = force * np.asarray(d, dtype=float)
         return -6.0 * mb / (self.w1 * self.delta**2), 3.0 * mt / (self.w2**2 * self.delta)
 
     def ideal_voltages(self, force, d):
-        """Noise-free (Δv1, Δv2), V: both channels have the same volts per MPa."""
+        """Noise-free (Δv1, Δv2), V, for ``force`` (N) at jaw position ``d`` (mm): both channels have the same
+        volts per MPa."""
         s1, s2 = self.stresses(force, d)
         k = self.volts_per_newton / self.stresses(1.0, 0.0)[0]  # V per MPa (< 0), so that Δv1 > 0 when pressed
         return k * s1, k * s2
 
     def voltages(self, force, d, time, noise: NoiseModel, rng: np.random.Generator):
-        """One raw sample of (v1, v2), V, under ``noise`` at ``time`` (s)."""
+        """One raw sample of (v1, v2), V, for ``force`` (N) at jaw position ``d`` (mm), under ``noise`` at
+        ``time`` (s), its random parts drawn from ``rng``."""
         dv1, dv2 = self.ideal_voltages(force, d)
         dv2 = dv2 * (1.0 + noise.gain_error) * (1.0 + noise.nonlinearity * (np.asarray(d) / 50.0) ** 2)
         v1 = noise.v1_offset + dv1 + noise.crosstalk * dv2 + noise.v1_drift * time
@@ -73,7 +75,16 @@ class Wrist:
 
 
 def encoder_angle(phi, noise: NoiseModel):
-    """The arm's reading of the jaw angle ``phi`` (rad), quantized to ``noise.encoder_step``."""
+    """The arm's reading of the jaw angle ``phi`` (rad), quantized to the ``noise`` model's encoder step.
+
+    Examples
+    --------
+    >>> import math
+    >>> from sim2d import load_noise
+    >>> paper = load_noise("paper")                        # a 0.03° encoder
+    >>> round(math.degrees(encoder_angle(math.radians(10.01), paper)), 4)
+    10.02
+    """
     if not noise.encoder_step:
         return phi
     return np.round(np.asarray(phi) / noise.encoder_step) * noise.encoder_step
