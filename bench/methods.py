@@ -43,7 +43,7 @@ def fixed_readings(rolls, part) -> dict:
     the true contact (mm), each step's signed arc, and the contact's place on the jaw (mm)."""
     from localizer import arc_from_jaw_positions
 
-    z, turns, truth, steps, jaw = [0.0], [0.0], [rolls[0].truth[0][0]], [], [rolls[0].positions[0]]
+    z, turns, truth, steps, jaw = [0.0], [0.0], [rolls[0].truth[0].contact_arc], [], [rolls[0].positions[0]]
     phi0 = rolls[0].angles[0]
     for r in rolls:
         sign = 1.0 if r.step > 0 else -1.0
@@ -52,7 +52,7 @@ def fixed_readings(rolls, part) -> dict:
             steps.append(a)
             z.append(z[-1] + a)
             turns.append(r.angles[i] - phi0)
-            truth.append(r.truth[i][0])
+            truth.append(r.truth[i].contact_arc)
             jaw.append(r.positions[i])
     return {
         "z": np.array(z),

@@ -152,7 +152,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
             except RigError as exc:
                 rows.append({"start": start, "refused": str(exc)[:120]})
                 continue
-            first = run.rolls[0].truth[0][0]
+            first = run.rolls[0].truth[0].contact_arc
             if abs(float(part.arc_offset(first, start))) > 1.0:  # the start is not on the hull
                 rows.append({"start": start, "refused": f"not on the convex hull (touched at {first:.2f} mm)"})
                 continue

@@ -507,7 +507,7 @@ def run_trial(spec: TrialSpec) -> dict:
                 )
             except RigError:
                 continue
-            if abs(float(part.arc_offset(run[0].truth[0][0], start))) > 1.0:  # laid off the point
+            if abs(float(part.arc_offset(run[0].truth[0].contact_arc, start))) > 1.0:  # laid off the point
                 run = None
                 continue
             break

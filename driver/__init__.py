@@ -1,5 +1,27 @@
 """Rig protocol, procedures, pipeline, serial rig and the command line (depends on localizer)."""
 
-from .rig import ProtocolError, Rig, RigError
+from .rig import (
+    Clocked,
+    ForceServo,
+    GroundTruth,
+    Pose,
+    ProtocolError,
+    Reading,
+    Rig,
+    RigError,
+    SampleLog,
+    Truth,
+)
 
-__all__ = ["Rig", "RigError", "ProtocolError"]
+__all__ = [
+    "Rig",
+    "ForceServo",
+    "Clocked",
+    "GroundTruth",
+    "SampleLog",
+    "Pose",
+    "Reading",
+    "Truth",
+    "RigError",
+    "ProtocolError",
+]

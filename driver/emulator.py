@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .protocol import ARM_COMMANDS, DAQ_COMMANDS, MAX_LINE, encode_reply, parse_request
-from .rig import ProtocolError, RigError
+from .rig import ForceServo, ProtocolError, RigError
 
 __all__ = ["Faults", "Emulator"]
 
@@ -104,7 +104,7 @@ class Emulator:
             target, gain, guard, ms = args
             if not (target > 0 and gain >= 0 and guard in (0, 1) and 1 <= ms <= 10000):
                 return [encode_reply(seq, "ERR", "BADARG", "SERVO target>0 gain>=0 guard 0|1 ms 1..10000")]
-            if not hasattr(self.rig, "servo"):
+            if not isinstance(self.rig, ForceServo):
                 return [encode_reply(seq, "ERR", "UNSUPPORTED", "this arm has no force servo")]
             try:
                 r = self.rig.servo(float(target), float(gain), guard=bool(guard), duration=ms / 1000.0)

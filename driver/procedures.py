@@ -23,7 +23,7 @@ from scipy.interpolate import CubicSpline
 
 from localizer import ROLL_STEP, Localization, Part, arc_from_jaw_positions, localize
 
-from .rig import Rig, RigError
+from .rig import Clocked, ForceServo, GroundTruth, Reading, Rig, RigError, SampleLog, Truth
 
 __all__ = [
     "hold_force",
@@ -186,10 +186,9 @@ def hold_force(
     dict
         The rig's report: ``dv1``, ``dv1_std``, ``contact_lost``, ``min_energy``, ``guard``.
     """
-    servo = getattr(rig, "servo", None)
-    if servo is None:
+    if not isinstance(rig, ForceServo):
         raise RigError(f"{type(rig).__name__} has no force servo; use press() (move-and-read)")
-    report = servo(target, gain, guard=guard, duration=duration)
+    report = rig.servo(target, gain, guard=guard, duration=duration)
     if report["contact_lost"] > 0:
         raise RigError(
             f"the force servo lost the part for {report['contact_lost']} samples at gain {gain:g} "
@@ -353,10 +352,10 @@ class RollResult:
         at the working force, measured by :func:`edge_offset`); see below.
     step : float, rad
         The signed rotation of each step.
-    readings : tuple of (Δv1 V, Δv2 V, φ rad, time s, x mm, y mm, φ commanded rad)
+    readings : tuple of Reading
         The reading behind each contact location, with the arm's reading of φ,
         the time and the commanded hand pose.
-    truth : tuple of (contact arc mm, jaw position mm)
+    truth : tuple of Truth
         Ground truth at each reading (NaN on a real rig).
 
     Notes
@@ -398,8 +397,7 @@ def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 
 
 def _clock(rig) -> float:
     """The rig's clock (s): a simulated rig's own time, else the process's monotonic clock."""
-    t = getattr(rig, "time", None)
-    return float(t) if isinstance(t, (int, float)) else time.monotonic()
+    return float(rig.time) if isinstance(rig, Clocked) else time.monotonic()
 
 
 def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=None):
@@ -407,9 +405,9 @@ def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=Non
     dv1, dv2 = _delta(rig, baseline, n)
     if readings is not None:
         x, y, phi_cmd = hand.pose if hand is not None else (math.nan,) * 3
-        readings.append((dv1, dv2, rig.pose()[2], _clock(rig), x, y, phi_cmd))
-        t = rig.truth() if hasattr(rig, "truth") else {}
-        truth.append((t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
+        readings.append(Reading(dv1, dv2, rig.pose()[2], _clock(rig), x, y, phi_cmd))
+        t = rig.truth() if isinstance(rig, GroundTruth) else {}
+        truth.append(Truth(t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
     if dv1 <= 0.1 * calibration.target:
         raise RigError(f"lost contact while rolling (Δv1 = {dv1:.3f} V)")
     return calibration.position(dv2 / dv1)
@@ -455,8 +453,8 @@ def roll(
     k = max(1, int(round(abs(angle) / step)))
     if offset is None:
         offset = edge_offset(rig, hand, baseline)
-    readings: list[tuple] = []
-    truth: list[tuple] = []
+    readings: list[Reading] = []
+    truth: list[Truth] = []
     k_steps = k
     if observer is not None:
         observer(
@@ -472,22 +470,22 @@ def roll(
 
     def observe(j):
         if observer is not None:
-            dv1, dv2, phi, tm, x, y, phi_cmd = readings[-1]
+            r, t = readings[-1], truth[-1]
             observer(
                 {
                     "event": "reading",
                     "roll": index,
                     "step": j,
-                    "time": tm,
-                    "x": x,
-                    "y": y,
-                    "phi_command": phi_cmd,
-                    "phi": phi,
-                    "dv1": dv1,
-                    "dv2": dv2,
+                    "time": r.time,
+                    "x": r.x,
+                    "y": r.y,
+                    "phi_command": r.phi_commanded,
+                    "phi": r.phi,
+                    "dv1": r.dv1,
+                    "dv2": r.dv2,
                     "jaw_position": d[-1],
-                    "true_arc": truth[-1][0],
-                    "true_jaw_position": truth[-1][1],
+                    "true_arc": t.contact_arc,
+                    "true_jaw_position": t.jaw_position,
                     "steps": k_steps,
                 }
             )
@@ -651,7 +649,12 @@ def localize_by_rolling(
     estimates = tuple((r.length, r.turn) for r in results)
     direction = "ccw" if results[0].step > 0 else "cw"
     loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)
-    return RollingRun(rolls=results, estimates=estimates, localization=loc, samples=list(getattr(rig, "samples", [])))
+    return RollingRun(
+        rolls=results,
+        estimates=estimates,
+        localization=loc,
+        samples=list(rig.samples) if isinstance(rig, SampleLog) else [],
+    )
 
 
 def run_from_here(

@@ -49,7 +49,7 @@ import numpy as np
 from localizer import ROLL_STEP, Belief, ContactFilter, Part, arc_from_jaw_positions
 
 from .procedures import Calibration, _location, edge_offset, establish_contact, press
-from .rig import Rig, RigError
+from .rig import Reading, Rig, RigError, Truth
 
 __all__ = ["ReactiveRun", "localize_reactively", "spread_by_direction", "CONFIRM", "CONFIDENCE", "MAX_ROTATION"]
 
@@ -223,8 +223,8 @@ def localize_reactively(
     hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
     offset = edge_offset(rig, hand, baseline)
     jaw_limit = float(np.max(np.abs(calibration.positions))) - end_margin
-    readings: list[tuple] = []
-    truth: list[tuple] = []
+    readings: list[Reading] = []
+    truth: list[Truth] = []
 
     def read():
         return _location(rig, baseline, calibration, n, readings, truth, hand)
@@ -244,7 +244,7 @@ def localize_reactively(
     explored = [0.0, 0.0]
     blocked = {1: False, -1: False}
     arcs, turns, history = [0.0], [0.0], []
-    true_arcs = [truth[-1][0] if truth else math.nan]
+    true_arcs = [truth[-1].contact_arc if truth else math.nan]
     segments = [0]
     if direction is None:
         direction = 1  # nothing is known yet: counter-clockwise, like the paper
@@ -316,13 +316,13 @@ def localize_reactively(
         explored = [min(explored[0], turn), max(explored[1], turn)]
         arcs.append(z)
         turns.append(turn)
-        true_arcs.append(truth[-1][0] if truth else math.nan)
+        true_arcs.append(truth[-1].contact_arc if truth else math.nan)
         segments.append(flt.segment)
         d_prev = d
         steps += 1
         if steps % check_every == 0:
             belief = flt.belief()
-            true_arc = truth[-1][0] if truth else math.nan
+            true_arc = truth[-1].contact_arc if truth else math.nan
             history.append((rotation, belief.map_arc, belief.mass, true_arc))
             if observer is not None:
                 observer(
@@ -370,7 +370,7 @@ def localize_reactively(
                 reversals += 1
     if belief is None or belief.steps != flt.steps:
         belief = flt.belief()
-        history.append((rotation, belief.map_arc, belief.mass, truth[-1][0] if truth else math.nan))
+        history.append((rotation, belief.map_arc, belief.mass, truth[-1].contact_arc if truth else math.nan))
     return ReactiveRun(
         belief=belief,
         rotation=rotation,

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import serial
 
 from .protocol import MAX_LINE, Reply, encode_request, parse_reply
-from .rig import ProtocolError, RigError
+from .rig import Pose, ProtocolError, RigError
 
 __all__ = ["SerialRig", "Workspace"]
 
@@ -166,10 +166,10 @@ class SerialRig:
         )
         self._commanded = (float(x), float(y), float(phi))
 
-    def pose(self) -> tuple:
+    def pose(self) -> Pose:
         """POSE: the arm's (x mm, y mm, φ rad)."""
         x, y, phi_deg = self._transact("arm", "POSE").numbers(3)
-        return x, y, math.radians(phi_deg)
+        return Pose(x, y, math.radians(phi_deg))
 
     def read(self, n: int = 32) -> tuple:
         """READ n: averaged (v1, v2) in volts; stops the run above the overload limit."""

@@ -49,8 +49,8 @@ class Trace:
         """Collect the readings of a :class:`RollingRun` with ``metadata`` about how it was made."""
         rows = []
         for k, r in enumerate(run.rolls):
-            for j, ((dv1, dv2, phi, tm, x, y, phi_cmd), (arc, jaw)) in enumerate(zip(r.readings, r.truth)):
-                rows.append((k, j, tm, x, y, phi_cmd, phi, dv1, dv2, arc, jaw))
+            for j, (rd, t) in enumerate(zip(r.readings, r.truth)):
+                rows.append((k, j, rd.time, rd.x, rd.y, rd.phi_commanded, rd.phi, rd.dv1, rd.dv2, *t))
         arr = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
         columns = {name: arr[:, i] for i, name in enumerate(COLUMNS)}
         columns["roll"] = columns["roll"].astype(np.int64)

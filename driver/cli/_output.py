@@ -8,6 +8,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, ContactFilter
 
+from ..rig import GroundTruth
 from ._options import servo_option
 
 __all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run"]
@@ -45,9 +46,8 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
         "regrasps": res.regrasps,
         "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
     }
-    truth = getattr(rig, "truth", None)
-    if truth is not None:
-        true_arc = truth()["contact_arc"]
+    if isinstance(rig, GroundTruth):
+        true_arc = rig.truth()["contact_arc"]
         doc["true_arc"] = true_arc
         doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
     return doc, res

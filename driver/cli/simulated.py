@@ -148,7 +148,7 @@ def simulate_command(args) -> int:
         approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0),
         **servo_option(args),
     )
-    first = run.rolls[0].truth[0][0]
+    first = run.rolls[0].truth[0].contact_arc
     if math.isfinite(first) and abs(float(part.arc_offset(first, args.start))) > 1.0:
         raise RigError(
             f"--start {args.start} mm is not on the part's convex hull: a straight jaw laid there "

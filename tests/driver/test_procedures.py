@@ -166,3 +166,10 @@ def test_rolls_must_turn_one_way(cam, cam_cal):
     rig = SimRig(cam)
     with pytest.raises(RigError, match="must all turn the same way"):
         localize_by_rolling(rig, cam, [0.2, -0.2], calibration=cam_cal, approach_pose=rig.approach_pose(10.0))
+
+
+def test_a_simulated_rig_has_every_optional_capability():
+    from driver.rig import Clocked, ForceServo, GroundTruth, SampleLog
+
+    sim = SimRig(load_part(PARTS / "cam.json"), noise="none", seed=0)
+    assert all(isinstance(sim, p) for p in (Rig, ForceServo, Clocked, GroundTruth, SampleLog))

@@ -194,6 +194,20 @@ def test_bad_requests_carry_their_code_and_sequence(line, code, seq):
     assert (reply.status, reply.seq, reply.fields[0]) == ("ERR", seq, code)
 
 
+def test_the_serial_rig_is_a_rig_without_the_simulators_extras():
+    from driver.rig import Clocked, GroundTruth, Pose, Rig, SampleLog
+
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq) as rig:
+            assert isinstance(rig, Rig)
+            assert not any(isinstance(rig, p) for p in (Clocked, GroundTruth, SampleLog))
+            assert isinstance(rig.pose(), Pose)
+    finally:
+        emu.close()
+
+
 def test_requests_round_trip():
     seq, cmd, args = parse_request(encode_request(12, "MOVE", 1.5, -2.25, 30.0), ARM_COMMANDS)
     assert (seq, cmd, args) == (12, "MOVE", [1.5, -2.25, 30.0])
