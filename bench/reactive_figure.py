@@ -18,7 +18,7 @@ import numpy as np
 
 from bench.methods import reactive_filter
 from bench.study import load_study
-from driver.procedures import calibrate
+from driver.procedures import calibrate_simulated
 from driver.reactive import localize_reactively
 from localizer import load_part
 from sim2d import SimRig, load_noise
@@ -30,8 +30,7 @@ def run(part_file: Path, start: float, seed: int):
     part = load_part(part_file)
     study = load_study(ROOT / "bench" / "studies" / "reactive.toml")
     noise = load_noise("paper")
-    cal_rig = SimRig(part, noise=noise, seed=seed + 1)
-    cal = calibrate(cal_rig, cal_rig.calibration_pose())
+    cal = calibrate_simulated(part, noise, seed=seed + 1)
     rig = SimRig(part, noise=noise, seed=seed)
     flt = reactive_filter(study, part, noise)
     snaps = []

@@ -17,7 +17,14 @@ from pathlib import Path
 import numpy as np
 
 from bench.baselines import PARTS_DIR
-from driver.procedures import _delta, calibrate, establish_contact, localize_by_rolling, roll
+from driver.procedures import (
+    calibrate_simulated,
+    delta_voltages,
+    establish_contact,
+    laid_off,
+    localize_by_rolling,
+    roll,
+)
 from driver.rig import RigError
 from localizer import SUCCESS_RADIUS, load_part
 from sim2d import SimRig
@@ -29,15 +36,10 @@ def _log(msg):
     print(msg, file=sys.stderr, flush=True)
 
 
-def calibration_for(part, noise="none", seed=0, engine="kinematic"):
-    rig = SimRig(part, noise=noise, seed=seed, engine=engine)
-    return calibrate(rig, rig.calibration_pose())
-
-
 def fidelity(steps_deg=(0.8, 0.4, 0.2, 0.1), starts=(20.0, 90.0, 160.0, 230.0), angle_deg=40.0):
     """Noise-free rolls on the cam: the paper's L estimate and ours against the true arc length."""
     part = load_part(PARTS_DIR / "cam.json")
-    cal = calibration_for(part)
+    cal = calibrate_simulated(part)
     rows = []
     for deg in steps_deg:
         for start in starts:
@@ -69,11 +71,11 @@ def calibration_accuracy(noises=("none", "paper"), seeds=(0, 1, 2)):
     for noise in noises:
         errs = []
         for seed in seeds:
-            cal = calibration_for(part, noise, seed)
+            cal = calibrate_simulated(part, noise, seed=seed)
             rig = SimRig(part, noise=noise, seed=seed + 10)
             for d in np.linspace(-45, 45, 19):
                 _, base, _ = establish_contact(rig, rig.approach_pose(120.0, jaw_position=d, standoff=1.0))
-                dv1, dv2 = _delta(rig, base, 32)
+                dv1, dv2 = delta_voltages(rig, base, 32)
                 errs.append(cal.position(dv2 / dv1) - rig.truth()["jaw_position"])
         errs = np.array(errs)
         out[noise] = {
@@ -87,7 +89,7 @@ def calibration_accuracy(noises=("none", "paper"), seeds=(0, 1, 2)):
 def engines(starts=(20.0, 120.0, 200.0)):
     """The same noise-free two-roll runs on the kinematic and the pymunk rig."""
     part = load_part(PARTS_DIR / "cam.json")
-    cal = calibration_for(part)
+    cal = calibrate_simulated(part)
     rows = []
     for start in starts:
         res = {}
@@ -134,7 +136,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
     out = {}
     for name in SHIPPED:
         part = load_part(PARTS_DIR / name)
-        cal = calibration_for(part, noise, seed, engine)
+        cal = calibrate_simulated(part, noise, seed=seed, engine=engine)
         rows: list[dict] = []
         for _k in range(trials):
             start = float(rng.uniform(0, part.perimeter))
@@ -153,7 +155,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
                 rows.append({"start": start, "refused": str(exc)[:120]})
                 continue
             first = run.rolls[0].truth[0].contact_arc
-            if abs(float(part.arc_offset(first, start))) > 1.0:  # the start is not on the hull
+            if laid_off(part, first, start):  # the start is not on the hull
                 rows.append({"start": start, "refused": f"not on the convex hull (touched at {first:.2f} mm)"})
                 continue
             truth = rig.truth()["contact_arc"]

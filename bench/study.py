@@ -464,7 +464,7 @@ def run_trial(spec: TrialSpec) -> dict:
     laid off the point) is redrawn, up to 20 times (``restarts``). With ``methods``, every
     method is scored on that same trial, each on its own.
     """
-    from driver.procedures import calibrate, roll_sequence
+    from driver.procedures import calibrate_simulated, laid_off, roll_sequence
     from driver.rig import RigError
     from sim2d import SimRig
 
@@ -487,8 +487,7 @@ def run_trial(spec: TrialSpec) -> dict:
     jaw_start = -JAW_START if rolls[0] > 0 else JAW_START
     rule = s.method if s.method in ("paper", "likelihood") else "paper"
     try:
-        cal_rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=s.engine)
-        cal = calibrate(cal_rig, cal_rig.calibration_pose())
+        cal = calibrate_simulated(part, noise, seed=int(rng.integers(1 << 31)), engine=s.engine)
         candidates, tracks = start_sampler(part, rolls, jaw_start)
         if candidates.size == 0:
             raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")
@@ -507,7 +506,7 @@ def run_trial(spec: TrialSpec) -> dict:
                 )
             except RigError:
                 continue
-            if abs(float(part.arc_offset(run[0].truth[0].contact_arc, start))) > 1.0:  # laid off the point
+            if laid_off(part, run[0].truth[0].contact_arc, start):
                 run = None
                 continue
             break

@@ -38,7 +38,7 @@ def test_pymunk_steps_per_second(benchmark, part):
 
     def run(n=2000):
         for _ in range(n):
-            w._step()
+            w.step()
         return w.contact()
 
     contact = benchmark.pedantic(run, rounds=5, iterations=1)

@@ -32,9 +32,12 @@ __all__ = [
     "RollResult",
     "RollingRun",
     "zero",
+    "delta_voltages",
     "press",
     "establish_contact",
     "calibrate",
+    "calibrate_simulated",
+    "laid_off",
     "edge_offset",
     "roll",
     "roll_sequence",
@@ -81,7 +84,9 @@ def zero(rig: Rig, n: int = 256) -> tuple:
     return rig.read(n)
 
 
-def _delta(rig: Rig, baseline, n: int):
+def delta_voltages(rig: Rig, baseline, n: int) -> tuple:
+    """(Δv1, Δv2), V: the wrist's two channels averaged over ``n`` samples, against their ``baseline``
+    (the jaw clear, :func:`zero`)."""
     v1, v2 = rig.read(n)
     return v1 - baseline[0], v2 - baseline[1]
 
@@ -121,7 +126,7 @@ def press(
     -------
     (dv1, dv2) : the last reading, V, relative to ``baseline``.
     """
-    dv1, dv2 = _delta(rig, baseline, n)
+    dv1, dv2 = delta_voltages(rig, baseline, n)
     travelled = 0.0
     threshold = 0.1 * target
     while dv1 < threshold:
@@ -132,7 +137,7 @@ def press(
             )
         hand.press_by(search_step)
         travelled += search_step
-        dv1, dv2 = _delta(rig, baseline, n)
+        dv1, dv2 = delta_voltages(rig, baseline, n)
     prev = None
     for _ in range(max_steps):
         if dv1 > overload:
@@ -141,7 +146,7 @@ def press(
         if abs(dv1 - target) <= tol:
             if servo is not None:
                 hold_force(rig, target=target, **servo)
-                dv1, dv2 = _delta(rig, baseline, n)
+                dv1, dv2 = delta_voltages(rig, baseline, n)
             return dv1, dv2
         if prev is not None and abs(dv1 - prev[1]) > 4 * tol and prev[0] != 0:
             slope = max((dv1 - prev[1]) / prev[0], 0.05 * slope)
@@ -150,7 +155,7 @@ def press(
             move = search_step
         hand.press_by(move)
         prev = (move, dv1)
-        dv1, dv2 = _delta(rig, baseline, n)
+        dv1, dv2 = delta_voltages(rig, baseline, n)
     raise RigError(f"Δv1 did not settle at {target} ± {tol} V in {max_steps} moves (last {dv1:.3f} V)")
 
 
@@ -321,10 +326,27 @@ def calibrate(
     for d in positions:
         hand = Hand(rig, (x0 - d * math.cos(phi), y0 - d * math.sin(phi), phi))
         press(rig, hand, baseline, target=target, **press_options)
-        dv1, dv2 = _delta(rig, baseline, n)
+        dv1, dv2 = delta_voltages(rig, baseline, n)
         ratios.append(dv2 / dv1)
         hand.press_by(-backoff - 1.0)
     return Calibration(tuple(float(v) for v in positions), tuple(float(v) for v in ratios), target)
+
+
+def calibrate_simulated(part: Part, noise="none", *, seed: int = 0, engine: str = "kinematic") -> Calibration:
+    """Calibrate a simulated wrist as the real one is calibrated (paper §III-B): a simulated rig of its own,
+    seeded ``seed``, with the ``noise`` model and ``engine`` of :class:`sim2d.SimRig`, taps ``part`` at its
+    most curved point that the whole jaw reaches (:func:`localizer.calibration_arc`)."""
+    from sim2d import SimRig
+
+    rig = SimRig(part, noise=noise, seed=seed, engine=engine)
+    return calibrate(rig, rig.calibration_pose())
+
+
+def laid_off(part: Part, first_contact: float, start: float, tolerance: float = 1.0) -> bool:
+    """Whether a jaw laid at arc ``start`` (mm) on ``part`` first touched it elsewhere: at ``first_contact``
+    (mm, a simulated rig's truth; NaN: not known) more than ``tolerance`` mm away. A straight jaw laid on a
+    start off the convex hull touches the hull instead."""
+    return math.isfinite(first_contact) and abs(float(part.arc_offset(first_contact, start))) > tolerance
 
 
 # --------------------------------------------------------------- rolling
@@ -383,11 +405,11 @@ def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 
     Presses ``probe`` mm in and out around the present pose (Δv1 is
     proportional to the give of a linear wrist) and returns to it.
     """
-    here = _delta(rig, baseline, n)[0]
+    here = delta_voltages(rig, baseline, n)[0]
     hand.press_by(probe)
-    deeper = _delta(rig, baseline, n)[0]
+    deeper = delta_voltages(rig, baseline, n)[0]
     hand.press_by(-2 * probe)
-    shallower = _delta(rig, baseline, n)[0]
+    shallower = delta_voltages(rig, baseline, n)[0]
     hand.press_by(probe)
     slope = (deeper - shallower) / (2 * probe)
     if not slope > 0:
@@ -402,7 +424,7 @@ def _clock(rig) -> float:
 
 def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=None):
     """Contact location on the jaw (mm) from one averaged reading; logs the reading."""
-    dv1, dv2 = _delta(rig, baseline, n)
+    dv1, dv2 = delta_voltages(rig, baseline, n)
     if readings is not None:
         x, y, phi_cmd = hand.pose if hand is not None else (math.nan,) * 3
         readings.append(Reading(dv1, dv2, rig.pose()[2], _clock(rig), x, y, phi_cmd))

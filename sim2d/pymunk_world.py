@@ -175,16 +175,17 @@ class PymunkWorld:
             frac = dt / t
             hb.velocity = tuple(dp * frac / dt)
             hb.angular_velocity = da * frac / dt
-            self._step()
+            self.step()
         hb.velocity = (0.0, 0.0)
         hb.angular_velocity = 0.0
         hb.position = (float(x), float(y))
         hb.angle = float(phi)
         for _ in range(self.settle_steps):
-            self._step()
+            self.step()
         self.hand = (float(x), float(y), float(phi))
 
-    def _step(self):
+    def step(self) -> None:
+        """Advance the world by one time step (``dt`` s)."""
         self.space.step(self.dt)
         self.steps += 1
 

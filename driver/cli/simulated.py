@@ -99,7 +99,7 @@ def register(sub) -> None:
 
 
 def simulate_command(args) -> int:
-    from driver.procedures import calibrate, localize_by_rolling
+    from driver.procedures import calibrate_simulated, laid_off, localize_by_rolling
     from driver.trace import Trace
     from sim2d import SimRig, load_noise
 
@@ -110,9 +110,7 @@ def simulate_command(args) -> int:
     rolls = [math.radians(r) for r in (args.roll or [20.0])]
     if not 0 <= args.start < part.perimeter:
         raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
-    # calibrate on the part's most curved point that the whole jaw reaches, with its own rig instance
-    cal_rig = SimRig(part, noise=noise, seed=args.seed + 1, engine=args.engine)
-    calibration = calibrate(cal_rig, cal_rig.calibration_pose())
+    calibration = calibrate_simulated(part, noise, seed=args.seed + 1, engine=args.engine)
     rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine)
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
     _check_reach(part, args.start, jaw_start)
@@ -149,7 +147,7 @@ def simulate_command(args) -> int:
         **servo_option(args),
     )
     first = run.rolls[0].truth[0].contact_arc
-    if math.isfinite(first) and abs(float(part.arc_offset(first, args.start))) > 1.0:
+    if laid_off(part, first, args.start):
         raise RigError(
             f"--start {args.start} mm is not on the part's convex hull: a straight jaw laid there "
             f"touches at {first:.2f} mm instead"

@@ -6,7 +6,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.procedures import Calibration, Hand, _delta, calibrate, establish_contact, localize_by_rolling, press, roll
+from driver.procedures import (
+    Calibration,
+    Hand,
+    calibrate,
+    delta_voltages,
+    establish_contact,
+    localize_by_rolling,
+    press,
+    roll,
+)
 from driver.rig import Rig, RigError
 from localizer import load_part
 from sim2d import NoiseModel, SimRig
@@ -45,7 +54,7 @@ def test_calibration_recovers_contact_location(cam, noise, rms_limit, max_limit)
     errs = []
     for d in np.linspace(-45, 45, 13):
         hand, base, _ = establish_contact(rig, rig.approach_pose(120.0, jaw_position=d, standoff=1.0))
-        dv1, dv2 = _delta(rig, base, 32)
+        dv1, dv2 = delta_voltages(rig, base, 32)
         errs.append(cal.position(dv2 / dv1) - rig.truth()["jaw_position"])
     errs = np.array(errs)
     assert np.sqrt(np.mean(errs**2)) < rms_limit and np.abs(errs).max() < max_limit
