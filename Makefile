@@ -31,10 +31,10 @@ bench: $(STAMP)
 	$(PY) -m pytest bench --benchmark-only --benchmark-json=out/bench.json
 
 passivity-report: $(STAMP)
-	$(PY) -m bench.passivity --out docs/passivity
+	$(PY) -m bench.reports.passivity --out docs/generated/passivity
 
 march-report: $(STAMP)
-	$(PY) -m bench.march_study --out docs/march
+	$(PY) -m bench.reports.march_study --out docs/generated/march
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .benchmarks

@@ -2,7 +2,7 @@
 contact-force servo, both with an optional passivity observer/controller on the sampled port.
 
 SI units throughout this module (m, s, N, J): it is a device model, and the
-passivity literature and the interface of ``bench.passivity`` speak joules.
+passivity literature and the interface of ``bench.reports.passivity`` speak joules.
 
 The device is a mass ``m`` with viscous damping ``b`` driven by an actuator
 whose force is computed at ``dt`` and held (zero-order hold), saturating at

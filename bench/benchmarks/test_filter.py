@@ -1,6 +1,6 @@
 """The sequential filters' cost per rolling step (target: well under 1 ms on a 100-knot part).
 
-Run: ``pytest bench/test_filter.py --benchmark-only``. Each benchmark feeds a filter a
+Run: ``pytest bench/benchmarks/test_filter.py --benchmark-only``. Each benchmark feeds a filter a
 25° roll first (checking the belief every 5 steps, as the reactive procedure does, which
 prunes hypotheses 40 nats below the best), so that it is timed in the state it has
 mid-localization.
@@ -94,7 +94,7 @@ def test_reach_build(benchmark, part100, name):
     part = (
         part100
         if name == "egg100"
-        else load_part(Path(__file__).resolve().parent / "parts" / "heldout-a" / "star-16.json")
+        else load_part(Path(__file__).resolve().parents[1] / "parts" / "heldout-a" / "star-16.json")
     )
     r = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)
     benchmark.extra_info.update({"perimeter_mm": round(part.perimeter, 1), "grid": int(r.sigma.size)})

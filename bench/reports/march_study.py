@@ -1,6 +1,6 @@
 """Studies of the paper's marching algorithm: Proposition 1, Theorem 2, completeness, cost.
 
-Run ``python -m bench.march_study [--quick] [--out docs/march]``: it prints the
+Run ``python -m bench.reports.march_study [--quick] [--out docs/generated/march]``: it prints the
 figures, writes PNG plots and ``summary.json`` into ``--out``, and
 ``docs/march.md`` quotes them. ``--quick`` uses fewer instances and a coarser
 step for the completeness study (for a smoke run); the report is made without it.
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.baselines import random_outline, trapezoid_perimeter, trefoil_part
+from bench.benchmarks.baselines import random_outline, trapezoid_perimeter, trefoil_part
 from localizer import LENGTH_TOL, TURN_TOL, feasible_segments, march, march_grid, part_from_points
 
 TIGHT: dict[str, float] = {"length_tol": 1e-10, "turn_tol": 1e-10}
@@ -454,7 +454,7 @@ def summarize(prop1, thm2, cost, compl, versus):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="docs/march", help="folder for the PNG plots and summary.json")
+    ap.add_argument("--out", default="docs/generated/march", help="folder for the PNG plots and summary.json")
     ap.add_argument("--quick", action="store_true", help="few instances and h=1e-4 for completeness")
     ap.add_argument("--seed", type=int, default=2005)
     args = ap.parse_args(argv)

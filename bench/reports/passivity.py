@@ -1,7 +1,7 @@
 """The seed's passivity study, reproduced, and the guarded contact-force servo.
 
-    python -m bench.passivity --json              # the four variants' noise and min_energy
-    python -m bench.passivity --out docs/passivity # plus the servo comparison, plots, summary.json
+    python -m bench.reports.passivity --json              # the four variants' noise and min_energy
+    python -m bench.reports.passivity --out docs/generated/passivity # plus the servo comparison, plots, summary.json
 
 Part 1 (Ryu et al. 2005): the one-axis device of :mod:`sim2d.haptic`, an
 operator pressing slowly into a 20 kN/m virtual wall and out again, with a
@@ -152,7 +152,7 @@ def _plots(out: Path, wall: dict, servo_traces: dict) -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m bench.passivity", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m bench.reports.passivity", description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--json",
         action="store_true",

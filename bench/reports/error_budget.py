@@ -1,6 +1,6 @@
 """Which error source drives failures: the paper's setting with one noise source removed at a time.
 
-Run ``python -m bench.error_budget --out docs/robustness/budget [--trials N]``. For each
+Run ``python -m bench.reports.error_budget --out docs/generated/robustness/budget [--trials N]``. For each
 group of noise-model fields it runs ``bench/studies/paper.toml`` with that group set to
 zero (everything else at the ``paper`` levels) or, with ``--mode only``, with every other
 group set to zero; plus the full preset and no noise at all. Writes ``summary.json`` and
@@ -30,10 +30,13 @@ GROUPS = {
     "offsets, gain, cross-talk, nonlinearity": ["v1_offset", "v2_offset", "gain_error", "crosstalk", "nonlinearity"],
 }
 
+#: The study the budget varies the noise of.
+PAPER_STUDY = Path(__file__).resolve().parents[1] / "studies" / "paper.toml"
+
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="docs/robustness/budget")
+    ap.add_argument("--out", default="docs/generated/robustness/budget")
     ap.add_argument("--trials", type=int, default=150)
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument(
@@ -45,7 +48,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    base = load_study(Path(__file__).parent / "studies" / "paper.toml").with_overrides(trials=args.trials)
+    base = load_study(PAPER_STUDY).with_overrides(trials=args.trials)
     paper = PRESETS["paper"]
     every = [n for names in GROUPS.values() for n in names]
     configs = {
@@ -63,7 +66,7 @@ def main(argv=None) -> int:
         for k, (label, zeroed) in enumerate(configs.items()):
             noise_file = Path(tmp) / f"noise{k}.toml"
             noise_file.write_text('preset = "paper"\n' + "".join(f"{n} = {v!r}\n" for n, v in zeroed.items()))
-            study = load_study(Path(__file__).parent / "studies" / "paper.toml").with_overrides(trials=args.trials)
+            study = load_study(PAPER_STUDY).with_overrides(trials=args.trials)
             from dataclasses import replace
 
             study = replace(study, noise=str(noise_file), name=label)

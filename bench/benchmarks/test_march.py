@@ -1,7 +1,7 @@
 """The paper's marching algorithm: cost at the paper's step, Theorem 2, Proposition 1.
 
 Run: ``pytest bench --benchmark-only`` (figures in ``--benchmark-json``); the
-full studies and plots are ``python -m bench.march_study``.
+full studies and plots are ``python -m bench.reports.march_study``.
 """
 
 import time
@@ -9,8 +9,8 @@ import time
 import numpy as np
 import pytest
 
-from bench.baselines import trefoil_part
-from bench.march_study import proposition_1
+from bench.benchmarks.baselines import trefoil_part
+from bench.reports.march_study import proposition_1
 from localizer import feasible_segments, march, march_grid
 
 H = 1e-5  # the paper's step

@@ -1,6 +1,6 @@
 """Studies of the simulated rig: rolling fidelity (paper §III-C), calibration, engines, end to end.
 
-Run ``python -m bench.sim_study [--out docs/sim] [--trials N]``: prints the
+Run ``python -m bench.reports.sim_study [--out docs/generated/sim] [--trials N]``: prints the
 figures, writes ``summary.json`` and PNG plots into ``--out``; ``docs/simulation.md``
 quotes them.
 """
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.baselines import PARTS_DIR
+from bench.benchmarks.baselines import PARTS_DIR
 from driver.procedures import (
     calibrate_simulated,
     delta_voltages,
@@ -251,7 +251,7 @@ def _plot(out: Path, fid, e2e_paper):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="docs/sim")
+    ap.add_argument("--out", default="docs/generated/sim")
     ap.add_argument("--trials", type=int, default=40, help="random starts per part and noise level")
     ap.add_argument("--seed", type=int, default=2005)
     args = ap.parse_args(argv)

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from bench.baselines import PARTS_DIR
+from bench.benchmarks.baselines import PARTS_DIR
 from driver.procedures import Calibration, establish_contact, roll
 from localizer import load_part
 from sim2d import SimRig

@@ -1,6 +1,6 @@
 """The belief over the part as it sharpens during one reactive localization (a figure).
 
-    python -m bench.reactive_figure --out docs/robustness/reactive [--part parts/trefoil.json]
+    python -m bench.reports.reactive_figure --out docs/generated/robustness/reactive [--part parts/trefoil.json]
 
 Runs :func:`driver.reactive.localize_reactively` on a simulated rig with the ``paper``
 noise and draws (1) the probability of the present contact along the part's
@@ -23,7 +23,7 @@ from driver.reactive import localize_reactively
 from localizer import load_part
 from sim2d import SimRig, load_noise
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def run(part_file: Path, start: float, seed: int):
@@ -112,7 +112,9 @@ def draw(part, snaps, out: Path, title: str) -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m bench.reactive_figure", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m bench.reports.reactive_figure", description=__doc__.split("\n\n")[0]
+    )
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--part", type=Path, default=ROOT / "parts" / "trefoil.json")
     parser.add_argument("--start", type=float, default=211.1, help="arc position of the first contact, mm")

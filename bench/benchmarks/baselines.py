@@ -8,7 +8,7 @@ __all__ = ["trapezoid_perimeter", "trefoil_part", "PARTS_DIR"]
 
 from pathlib import Path
 
-PARTS_DIR = Path(__file__).resolve().parents[1] / "parts"
+PARTS_DIR = Path(__file__).resolve().parents[2] / "parts"
 
 
 def trapezoid_perimeter(part, h: float = 1e-5, chunk: int = 1_000_000) -> float:

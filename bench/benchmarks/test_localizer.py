@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from bench.baselines import trapezoid_perimeter, trefoil_part
+from bench.benchmarks.baselines import trapezoid_perimeter, trefoil_part
 from localizer import feasible_segments
 
 N_QUERIES = 20

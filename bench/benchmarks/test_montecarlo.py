@@ -12,7 +12,7 @@ import pytest
 from bench.montecarlo import run_study
 from bench.study import TrialSpec, load_study, run_trial
 
-STUDY = Path(__file__).resolve().parent / "studies" / "paper.toml"
+STUDY = Path(__file__).resolve().parents[1] / "studies" / "paper.toml"
 
 
 @pytest.mark.parametrize("engine", ["kinematic", "pymunk"])
