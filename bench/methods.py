@@ -271,7 +271,7 @@ def reactive_stop(run) -> str:
 
 def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None) -> dict:
     """The reactive filter from the same start on a rig with the same seed."""
-    from driver.reactive import CONFIRM, localize_reactively
+    from driver.reactive import CONFIRM, ReactivePolicy, localize_reactively
     from sim2d import SimRig
 
     o = study.reactive
@@ -282,12 +282,14 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
         calibration=cal,
         filter=reactive_filter(study, part, noise, filter_class),
         approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
-        step=math.radians(study.step_deg),
-        confidence=o.confidence,
-        max_rotation=math.radians(o.max_rotation_deg),
-        check_every=o.check_every,
-        min_spread=o.min_spread,
-        confirm=CONFIRM if o.confirm is None else o.confirm,
+        policy=ReactivePolicy(
+            step=math.radians(study.step_deg),
+            confidence=o.confidence,
+            max_rotation=math.radians(o.max_rotation_deg),
+            check_every=o.check_every,
+            min_spread=o.min_spread,
+            confirm=CONFIRM if o.confirm is None else o.confirm,
+        ),
     )
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)

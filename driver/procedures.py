@@ -78,6 +78,79 @@ class Hand:
         self.go(x, y, phi + angle)
 
 
+# ------------------------------------------------------------ settings
+@dataclass(frozen=True)
+class ServoSettings:
+    """Hold the force with the arm's own servo after every press (:func:`hold_force`).
+
+    Attributes
+    ----------
+    gain : float
+        Force-error gain (N/N).
+    guard : bool
+        With the passivity observer/controller on the servo's port.
+    duration : float, s
+        How long the servo holds.
+    max_std : float or None, V
+        Refuse a loop whose held Δv1 varies more than this (a ringing loop).
+    """
+
+    gain: float
+    guard: bool = True
+    duration: float = 0.3
+    max_std: float | None = 0.05
+
+    def __post_init__(self):
+        if not (math.isfinite(self.gain) and self.gain > 0):
+            raise RigError(f"servo gain={self.gain!r} must be a positive number")
+        if not (math.isfinite(self.duration) and self.duration > 0):
+            raise RigError(f"servo duration={self.duration!r} s must be positive")
+
+
+@dataclass(frozen=True)
+class PressSettings:
+    """How a press finds the force: translate along the jaw normal until Δv1 is at the target
+    (paper §III-C). Every procedure that presses takes one (``pressing``).
+
+    Attributes
+    ----------
+    tol : float, V
+        Δv1 within this of the target ends the press.
+    slope : float, V/mm
+        First guess of dΔv1/d(press); refined from the readings (secant).
+    search_step : float, mm
+        Advance per reading while there is no contact yet.
+    max_travel : float, mm
+        Give up (RigError) after pressing this far without contact.
+    overload : float, V
+        Δv1 above this backs the jaw off and stops the run (wrist protection).
+    max_steps : int
+        Moves allowed to settle.
+    servo : ServoSettings or None
+        When given, the arm's own force servo then holds the target.
+    """
+
+    tol: float = 0.01
+    slope: float = 0.4
+    search_step: float = 0.25
+    max_travel: float = 15.0
+    overload: float = 2.0
+    max_steps: int = 60
+    servo: ServoSettings | None = None
+
+    def __post_init__(self):
+        for name in ("tol", "slope", "search_step", "max_travel", "overload"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise RigError(f"press {name}={value!r} must be a positive number")
+        if self.max_steps < 1:
+            raise RigError(f"press max_steps={self.max_steps!r} must be at least 1")
+
+
+#: The paper's press: Δv1 back within 0.01 V of the target, no servo.
+PRESS = PressSettings()
+
+
 # ---------------------------------------------------------------- sensing
 def zero(rig: Rig, n: int = 256) -> tuple:
     """The default readings (v1, v2) with the jaw clear of everything, V."""
@@ -97,35 +170,31 @@ def press(
     baseline,
     *,
     target: float = 0.4,
-    tol: float = 0.01,
     n: int = 32,
-    slope: float = 0.4,
-    search_step: float = 0.25,
-    max_travel: float = 15.0,
-    overload: float = 2.0,
-    max_steps: int = 60,
-    servo: dict | None = None,
+    pressing: PressSettings = PRESS,
 ) -> tuple:
-    """Translate along the jaw normal until Δv1 = ``target`` ± ``tol`` V (the paper's feedback).
+    """Translate along the jaw normal until Δv1 = ``target`` ± ``pressing.tol`` V (the paper's feedback).
 
     Parameters
     ----------
-    slope : float, V/mm
-        First guess of dΔv1/d(press); refined from the readings (secant).
-    search_step : float, mm
-        Advance per reading while there is no contact yet.
-    max_travel : float, mm
-        Give up (RigError) after pressing this far without contact.
-    overload : float, V
-        Δv1 above this backs the jaw off and stops the run (wrist protection).
-    servo : dict or None
-        When given, the arm's own force servo then holds the target:
-        ``hold_force(rig, target=target, **servo)``, e.g. ``{"gain": 20, "guard": True}``.
+    rig : Rig
+    hand : Hand
+        The commanded pose, moved along the jaw normal.
+    baseline : (float, float), V
+        The wrist's readings with the jaw clear (:func:`zero`).
+    target : float, V
+        The Δv1 to reach.
+    n : int
+        Samples averaged per reading.
+    pressing : PressSettings
+        Tolerance, search, limits and the optional servo hold.
 
     Returns
     -------
     (dv1, dv2) : the last reading, V, relative to ``baseline``.
     """
+    tol, slope, search_step = pressing.tol, pressing.slope, pressing.search_step
+    max_travel, overload, max_steps, servo = pressing.max_travel, pressing.overload, pressing.max_steps, pressing.servo
     dv1, dv2 = delta_voltages(rig, baseline, n)
     travelled = 0.0
     threshold = 0.1 * target
@@ -145,7 +214,14 @@ def press(
             raise RigError(f"Δv1 = {dv1:.3f} V exceeds the overload limit {overload} V: backed off")
         if abs(dv1 - target) <= tol:
             if servo is not None:
-                hold_force(rig, target=target, **servo)
+                hold_force(
+                    rig,
+                    target=target,
+                    gain=servo.gain,
+                    guard=servo.guard,
+                    duration=servo.duration,
+                    max_std=servo.max_std,
+                )
                 dv1, dv2 = delta_voltages(rig, baseline, n)
             return dv1, dv2
         if prev is not None and abs(dv1 - prev[1]) > 4 * tol and prev[0] != 0:
@@ -204,15 +280,18 @@ def hold_force(
     return report
 
 
-def establish_contact(rig: Rig, approach_pose, *, baseline=None, target: float = 0.4, **press_options):
-    """Move to ``approach_pose`` (clear of the part), zero the sensor, press until Δv1 ≈ target.
+def establish_contact(
+    rig: Rig, approach_pose, *, baseline=None, target: float = 0.4, n: int = 32, pressing: PressSettings = PRESS
+):
+    """Move to ``approach_pose`` (clear of the part), zero the sensor unless a ``baseline`` is given, press
+    until Δv1 ≈ ``target`` V (``n`` samples a reading, as ``pressing`` says).
 
     Returns (hand, baseline, (dv1, dv2)).
     """
     hand = Hand(rig, approach_pose)
     if baseline is None:
         baseline = zero(rig)
-    reading = press(rig, hand, baseline, target=target, **press_options)
+    reading = press(rig, hand, baseline, target=target, n=n, pressing=pressing)
     return hand, baseline, reading
 
 
@@ -310,7 +389,7 @@ def calibrate(
     target: float = 0.4,
     n: int = 256,
     backoff: float = 2.0,
-    **press_options,
+    pressing: PressSettings = PRESS,
 ) -> Calibration:
     """Tap an immobilized object at ``taps`` jaw positions from -span to +span mm (paper §III-B).
 
@@ -325,7 +404,7 @@ def calibrate(
     ratios = []
     for d in positions:
         hand = Hand(rig, (x0 - d * math.cos(phi), y0 - d * math.sin(phi), phi))
-        press(rig, hand, baseline, target=target, **press_options)
+        press(rig, hand, baseline, target=target, pressing=pressing)
         dv1, dv2 = delta_voltages(rig, baseline, n)
         ratios.append(dv2 / dv1)
         hand.press_by(-backoff - 1.0)
@@ -448,7 +527,7 @@ def roll(
     bridge_jump: float | None = 3.0,
     observer=None,
     index: int = 0,
-    **press_options,
+    pressing: PressSettings = PRESS,
 ) -> RollResult:
     """Roll by ``angle`` rad (positive: counter-clockwise) in steps of about ``step`` (paper §III-C).
 
@@ -517,7 +596,7 @@ def roll(
     phis = [rig.pose()[2]]
     for j in range(k):
         hand.rotate_by(angle / k)
-        press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+        press(rig, hand, baseline, target=calibration.target, n=n, pressing=pressing)
         try:
             d.append(_location(rig, baseline, calibration, n, readings, truth, hand))
         except RigError:
@@ -599,7 +678,7 @@ def roll_sequence(
     n: int = 32,
     bridge_jump: float = 3.0,
     observer=None,
-    **press_options,
+    pressing: PressSettings = PRESS,
 ) -> tuple:
     """Establish contact and roll by each angle of ``rolls`` (rad), all the same way; no localization.
 
@@ -611,7 +690,7 @@ def roll_sequence(
         raise RigError("rolls is empty: give at least one roll angle")
     if len({a > 0 for a in rolls}) != 1:
         raise RigError(f"rolls {rolls!r} must all turn the same way")
-    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
+    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, pressing=pressing)
     results = []
     for k, angle in enumerate(rolls):
         try:
@@ -627,7 +706,7 @@ def roll_sequence(
                     bridge_jump=bridge_jump,
                     observer=observer,
                     index=k,
-                    **press_options,
+                    pressing=pressing,
                 )
             )
         except RigError as exc:
@@ -649,7 +728,7 @@ def localize_by_rolling(
     sd_length: float = 0.5,
     sd_turn: float = math.radians(0.03),
     observer=None,
-    **press_options,
+    pressing: PressSettings = PRESS,
 ) -> RollingRun:
     """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
 
@@ -666,7 +745,7 @@ def localize_by_rolling(
         n=n,
         bridge_jump=bridge_jump,
         observer=observer,
-        **press_options,
+        pressing=pressing,
     )
     estimates = tuple((r.length, r.turn) for r in results)
     direction = "ccw" if results[0].step > 0 else "cw"

@@ -29,8 +29,7 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    Rules 4 and 5 turn round only towards a way that is clear for ``lookahead``
    beyond what has been rolled there; otherwise the jaw rolls on (a bridge is
    safe: it is detected and undone). Without this the two rules can turn the
-   jaw back and forth every check, rolling in place (measured: 110 reversals
-   in one trial);
+   jaw back and forth at every check and roll in place;
 6. at the end of the jaw's calibrated span the jaw is lifted, slid along
    itself and put back on the same point (a regrasp; the filter starts a new
    segment with its own offset), and rolling goes on the same way;
@@ -48,10 +47,18 @@ import numpy as np
 
 from localizer import ROLL_STEP, Belief, ContactFilter, Part, arc_from_jaw_positions
 
-from .procedures import Calibration, _location, edge_offset, establish_contact, press
+from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
 from .rig import Reading, Rig, RigError, Truth
 
-__all__ = ["ReactiveRun", "localize_reactively", "spread_by_direction", "CONFIRM", "CONFIDENCE", "MAX_ROTATION"]
+__all__ = [
+    "ReactiveRun",
+    "ReactivePolicy",
+    "localize_reactively",
+    "spread_by_direction",
+    "CONFIRM",
+    "CONFIDENCE",
+    "MAX_ROTATION",
+]
 
 #: Checks in a row at which the belief must reach the confidence before the rolling stops (step 3).
 CONFIRM = 1
@@ -154,36 +161,16 @@ def _jaw_now(flt: ContactFilter, idx) -> dict:
     return {"jaw": flt.jaw_position, "at": flt.current[idx]}
 
 
-def localize_reactively(
-    rig: Rig,
-    part: Part,
-    *,
-    calibration: Calibration,
-    approach_pose,
-    filter: ContactFilter | None = None,
-    step: float = ROLL_STEP,
-    n: int = 32,
-    confidence: float = CONFIDENCE,
-    max_rotation: float = MAX_ROTATION,
-    direction: int | None = None,
-    check_every: int = 5,
-    lookahead: float = math.radians(15.0),
-    bridge_jump: float = 3.0,
-    end_margin: float = 5.0,
-    backoff: float = 2.0,
-    min_spread: float = 0.05,
-    confirm: int = CONFIRM,
-    observer=None,
-    **press_options,
-) -> ReactiveRun:
-    """Roll until the contact is known within the filter's radius with ``confidence`` (module notes).
+@dataclass(frozen=True)
+class ReactivePolicy:
+    """How the reactive method rolls and when it stops (module notes, rules 1–7).
 
-    Parameters
+    Attributes
     ----------
-    filter : ContactFilter, optional
-        The belief to update (reset first); default: ``ContactFilter(part)``.
     step : float, rad
-        Rolling step (paper: 0.2°).
+        Rolling step (paper: 0.2°, :data:`localizer.ROLL_STEP`).
+    n : int
+        Samples averaged per reading.
     confidence : float
         Probability within the success radius that stops the rolling.
     max_rotation : float, rad
@@ -192,35 +179,89 @@ def localize_reactively(
         First rolling direction (counter-clockwise is 1; None: 1).
     check_every : int
         Steps between checks of the stopping and direction rules.
-    confirm : int
-        Checks in a row at which the belief must reach ``confidence`` before the rolling stops.
     lookahead : float, rad
         Rotation over which the direction rule compares the two ways.
-    min_spread : float, mm
-        The direction rule turns round when the window ahead separates the two leading
-        modes' predicted arcs by less than this and the other way's window by more than
-        three times this (0: never turn round by choice).
     bridge_jump : float, mm
         A step whose contact moves more than this on the jaw has bridged a concavity.
     end_margin : float, mm
         The contact is kept this far inside the calibrated span of the jaw; there the jaw
         is lifted by ``backoff`` mm, slid along itself and put back (a regrasp).
+    backoff : float, mm
+        How far the jaw is lifted off for a regrasp or after a bridge.
+    min_spread : float, mm
+        The direction rule turns round when the window ahead separates the two leading
+        modes' predicted arcs by less than this and the other way's window by more than
+        three times this (0: never turn round by choice).
+    confirm : int
+        Checks in a row at which the belief must reach ``confidence`` before the rolling stops.
+    """
+
+    step: float = ROLL_STEP
+    n: int = 32
+    confidence: float = CONFIDENCE
+    max_rotation: float = MAX_ROTATION
+    direction: int | None = None
+    check_every: int = 5
+    lookahead: float = math.radians(15.0)
+    bridge_jump: float = 3.0
+    end_margin: float = 5.0
+    backoff: float = 2.0
+    min_spread: float = 0.05
+    confirm: int = CONFIRM
+
+    def __post_init__(self):
+        if not (math.isfinite(self.step) and self.step > 0):
+            raise RigError(f"step={self.step!r} rad must be positive")
+        if not (math.isfinite(self.max_rotation) and self.max_rotation > 0):
+            raise RigError(f"max_rotation={self.max_rotation!r} rad must be positive")
+        if self.direction not in (1, -1, None):
+            raise RigError(f"direction={self.direction!r}: use 1 (counter-clockwise), -1 or None")
+        if not 0 < self.confidence < 1:
+            raise RigError(f"confidence={self.confidence!r} must be in (0, 1)")
+        for name in ("confirm", "check_every", "n"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise RigError(f"{name}={value!r} must be a whole number ≥ 1")
+
+
+def localize_reactively(
+    rig: Rig,
+    part: Part,
+    *,
+    calibration: Calibration,
+    approach_pose,
+    filter: ContactFilter | None = None,
+    policy: ReactivePolicy = ReactivePolicy(),
+    pressing: PressSettings = PRESS,
+    observer=None,
+) -> ReactiveRun:
+    """Roll until the contact is known within the filter's radius with the ``policy``'s confidence (module notes).
+
+    Parameters
+    ----------
+    rig : Rig
+    part : Part
+        The part's model.
+    calibration : Calibration
+        The wrist's calibration (contact place on the jaw from Δv2/Δv1).
+    approach_pose : (x mm, y mm, φ rad)
+        Where the hand starts, clear of the part, facing the first contact.
+    filter : ContactFilter, optional
+        The belief to update (reset first); default: ``ContactFilter(part)``.
+    policy : ReactivePolicy
+        How it rolls and when it stops.
+    pressing : PressSettings
+        How every press finds the force (and the optional servo hold).
     observer : callable, optional
         Called with ``{"event": "belief", ...}`` at every check.
     """
-    if not (math.isfinite(step) and step > 0):
-        raise RigError(f"step={step!r} rad must be positive")
-    if not (math.isfinite(max_rotation) and max_rotation > 0):
-        raise RigError(f"max_rotation={max_rotation!r} rad must be positive")
-    if direction not in (1, -1, None):
-        raise RigError(f"direction={direction!r}: use 1 (counter-clockwise), -1 or None")
-    if not 0 < confidence < 1:
-        raise RigError(f"confidence={confidence!r} must be in (0, 1)")
-    if isinstance(confirm, bool) or not isinstance(confirm, (int, np.integer)) or confirm < 1:
-        raise RigError(f"confirm={confirm!r} must be a whole number of checks ≥ 1")
+    p = policy
+    step, n, confidence, max_rotation, direction = p.step, p.n, p.confidence, p.max_rotation, p.direction
+    check_every, lookahead, bridge_jump, end_margin = p.check_every, p.lookahead, p.bridge_jump, p.end_margin
+    backoff, min_spread, confirm = p.backoff, p.min_spread, p.confirm
     flt = filter if filter is not None else ContactFilter(part)
     flt.reset()
-    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, **press_options)
+    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, pressing=pressing)
     offset = edge_offset(rig, hand, baseline)
     jaw_limit = float(np.max(np.abs(calibration.positions))) - end_margin
     readings: list[Reading] = []
@@ -232,7 +273,7 @@ def localize_reactively(
     def pressed() -> bool:
         """Press back to the force; False when the press was refused (overload, no contact)."""
         try:
-            press(rig, hand, baseline, target=calibration.target, n=n, **press_options)
+            press(rig, hand, baseline, target=calibration.target, n=n, pressing=pressing)
             return True
         except RigError:
             return False

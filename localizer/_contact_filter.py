@@ -27,9 +27,8 @@ p_j(σ₀) = σ(θ(σ₀) + Ω_j) − σ₀ are related by
   hypothesis, the most probable one (re-chosen every ``refresh`` readings; the
   part's median radius before the first), the same for every hypothesis. ρ̂ must
   not be measured from the readings themselves (arc over rotation over the last
-  few steps, as the first version did): that puts the reading noise into the model
-  and the term fits it. Nor may the basis' *values* be scaled by ρ̂ (as the second
-  version did): when the reference changes, ρ̂ jumps, the term's constant part then
+  few steps): that puts the reading noise into the model and the term fits it. Nor
+  may the basis' *values* be scaled by ρ̂: when the reference changes, ρ̂ jumps, the term's constant part then
   looks measured, and on a flat stretch the belief said 97% at 0.35 mm off. Only
   the coefficients' prior changes, which the running sums do not depend on. δ
   repeats when the jaw rolls over the same stretch again, so more rolling does not

@@ -19,7 +19,7 @@ import numpy as np
 from bench.methods import reactive_filter
 from bench.study import load_study
 from driver.procedures import calibrate_simulated
-from driver.reactive import localize_reactively
+from driver.reactive import ReactivePolicy, localize_reactively
 from localizer import load_part
 from sim2d import SimRig, load_noise
 
@@ -46,8 +46,9 @@ def run(part_file: Path, start: float, seed: int):
         calibration=cal,
         filter=flt,
         observer=observe,
-        confidence=study.reactive.confidence,
-        max_rotation=math.radians(study.reactive.max_rotation_deg),
+        policy=ReactivePolicy(
+            confidence=study.reactive.confidence, max_rotation=math.radians(study.reactive.max_rotation_deg)
+        ),
         approach_pose=rig.approach_pose(start, jaw_position=-40.0, standoff=1.0),
     )
     return part, res, snaps, rig.truth()["contact_arc"]

@@ -8,6 +8,7 @@ import math
 
 from localizer import ROLL_STEP, SUCCESS_RADIUS, RolltouchError
 
+from ..procedures import PRESS, PressSettings, ServoSettings
 from ..reactive import CONFIDENCE, MAX_ROTATION
 
 __all__ = [
@@ -20,7 +21,7 @@ __all__ = [
     "rig_arguments",
     "servo_arguments",
     "reactive_arguments",
-    "servo_option",
+    "pressing",
 ]
 
 
@@ -105,9 +106,10 @@ def reactive_arguments(p) -> None:
     )
 
 
-def servo_option(args) -> dict:
+def pressing(args) -> PressSettings:
+    """The presses that --servo-gain and --no-guard ask for: the paper's, then the arm's servo if given."""
     if args.servo_gain is None:
         if args.no_guard:
             raise UsageError("--no-guard needs --servo-gain: without the servo there is nothing to guard")
-        return {}
-    return {"servo": {"gain": args.servo_gain, "guard": not args.no_guard, "duration": 0.3, "max_std": 0.05}}
+        return PRESS
+    return PressSettings(servo=ServoSettings(gain=args.servo_gain, guard=not args.no_guard))

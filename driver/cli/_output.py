@@ -9,7 +9,7 @@ import sys
 from localizer import SUCCESS_RADIUS, ContactFilter
 
 from ..rig import GroundTruth
-from ._options import servo_option
+from ._options import pressing
 
 __all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run"]
 
@@ -17,19 +17,20 @@ __all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_r
 def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:
     """Run the reactive localization on ``rig``: the JSON object of 'simulate|run --reactive' and the
     :class:`driver.reactive.ReactiveRun`."""
-    from driver.reactive import localize_reactively
+    from driver.reactive import ReactivePolicy, localize_reactively
 
+    policy = ReactivePolicy(
+        step=math.radians(args.step), confidence=args.confidence, max_rotation=math.radians(args.max_rotation)
+    )
     res = localize_reactively(
         rig,
         part,
         calibration=calibration,
         filter=ContactFilter(part),
         approach_pose=approach_pose,
-        step=math.radians(args.step),
-        confidence=args.confidence,
-        max_rotation=math.radians(args.max_rotation),
+        policy=policy,
+        pressing=pressing(args),
         observer=observer,
-        **servo_option(args),
     )
     b = res.belief
     doc = {

@@ -11,7 +11,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, load_part
 
-from ._options import STEP_DEG, add_command, positive, reactive_arguments, rig_arguments, servo_arguments, servo_option
+from ._options import STEP_DEG, add_command, positive, pressing, reactive_arguments, rig_arguments, servo_arguments
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
 __all__ = ["register", "calibrate_command", "run_command"]
@@ -121,7 +121,7 @@ def run_command(args) -> int:
             calibration=calibration,
             step=math.radians(args.step),
             observer=observer,
-            **servo_option(args),
+            pressing=pressing(args),
         )
     trace = Trace.from_run(
         run,

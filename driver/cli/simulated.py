@@ -12,7 +12,7 @@ import numpy as np
 from localizer import QueryError, load_part
 
 from ..rig import RigError
-from ._options import STEP_DEG, UsageError, add_command, positive, reactive_arguments, servo_arguments, servo_option
+from ._options import STEP_DEG, UsageError, add_command, positive, pressing, reactive_arguments, servo_arguments
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
 __all__ = ["register", "simulate_command", "emulate_command"]
@@ -144,7 +144,7 @@ def simulate_command(args) -> int:
         calibration=calibration,
         step=math.radians(args.step),
         approach_pose=rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0),
-        **servo_option(args),
+        pressing=pressing(args),
     )
     first = run.rolls[0].truth[0].contact_arc
     if laid_off(part, first, args.start):

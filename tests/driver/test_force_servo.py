@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from driver.emulator import Emulator
-from driver.procedures import establish_contact, hold_force
+from driver.procedures import PressSettings, ServoSettings, establish_contact, hold_force
 from driver.rig import RigError
 from driver.serial_rig import SerialRig
 from localizer import load_part
@@ -132,7 +132,7 @@ def test_a_serial_run_holds_every_press_with_the_guarded_servo(tmp_path):
                 PART,
                 [math.radians(10)],
                 observer=log,
-                servo={"gain": 20.0, "guard": True, "duration": 0.3, "max_std": 0.05},
+                pressing=PressSettings(servo=ServoSettings(gain=20.0, guard=True, duration=0.3, max_std=0.05)),
             )
     finally:
         emu.close()

@@ -7,7 +7,7 @@ import pytest
 
 from driver.emulator import Emulator
 from driver.procedures import calibrate
-from driver.reactive import clear_ahead, localize_reactively, spread_by_direction
+from driver.reactive import ReactivePolicy, clear_ahead, localize_reactively, spread_by_direction
 from driver.rig import RigError
 from driver.serial_rig import SerialRig
 from localizer import ContactFilter, load_part
@@ -41,8 +41,8 @@ def test_it_stops_when_sure_and_is_right(trefoil):
         part,
         calibration=cal,
         filter=flt,
-        confidence=0.95,
         approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+        policy=ReactivePolicy(confidence=0.95),
     )
     assert run.stopped == "confident" and run.belief.mass >= 0.95
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
@@ -61,9 +61,8 @@ def test_it_stops_only_after_the_confidence_held_at_confirm_checks_in_a_row(tref
             part,
             calibration=cal,
             filter=flt,
-            confidence=0.95,
-            confirm=confirm,
             approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+            policy=ReactivePolicy(confidence=0.95, confirm=confirm),
         )
     for confirm, run in runs.items():
         masses = [h[2] for h in run.history]
@@ -84,9 +83,8 @@ def test_the_rotation_budget_stops_it(trefoil):
         rig,
         part,
         calibration=cal,
-        max_rotation=math.radians(2.0),
-        confidence=1 - 1e-9,
         approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+        policy=ReactivePolicy(max_rotation=math.radians(2.0), confidence=1 - 1e-9),
     )
     assert run.stopped == "max_rotation" and run.rotation == pytest.approx(math.radians(2.0), abs=1e-9)
     assert run.steps == 10
@@ -102,8 +100,8 @@ def test_on_an_ellipse_it_stays_ambiguous_and_says_so():
         part,
         calibration=cal,
         filter=flt,
-        max_rotation=math.radians(30.0),
         approach_pose=rig.approach_pose(40.0, jaw_position=-40.0, standoff=1.0),
+        policy=ReactivePolicy(max_rotation=math.radians(30.0)),
     )
     assert run.stopped == "max_rotation"
     assert run.belief.ambiguous and len(run.belief.modes) >= 2
@@ -135,19 +133,23 @@ def test_bad_arguments(trefoil):
         ({"confirm": 1.5}, "confirm=1.5"),
     ):
         with pytest.raises(RigError, match=match):
-            localize_reactively(rig, part, calibration=cal, approach_pose=pose, **kwargs)
+            localize_reactively(rig, part, calibration=cal, approach_pose=pose, policy=ReactivePolicy(**kwargs))
 
 
 def test_the_serial_rig_gives_the_simulated_run(trefoil):
     part, cal = trefoil
     direct_rig = SimRig(part, noise="paper", seed=5)
     pose = direct_rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0)
-    direct = localize_reactively(direct_rig, part, calibration=cal, max_rotation=math.radians(6.0), approach_pose=pose)
+    direct = localize_reactively(
+        direct_rig, part, calibration=cal, approach_pose=pose, policy=ReactivePolicy(max_rotation=math.radians(6.0))
+    )
     emu = Emulator(SimRig(part, noise="paper", seed=5))
     arm, daq = emu.serve_tcp(0)
     try:
         with SerialRig(arm, daq) as rig:
-            serial = localize_reactively(rig, part, calibration=cal, max_rotation=math.radians(6.0), approach_pose=pose)
+            serial = localize_reactively(
+                rig, part, calibration=cal, approach_pose=pose, policy=ReactivePolicy(max_rotation=math.radians(6.0))
+            )
     finally:
         emu.close()
     assert serial.steps == direct.steps
@@ -228,9 +230,8 @@ def test_the_two_turning_rules_do_not_rock_the_jaw():
         part,
         calibration=cal,
         filter=flt,
-        confidence=0.99,
-        max_rotation=math.radians(120.0),
         approach_pose=rig.approach_pose(203.584, jaw_position=-40.0, standoff=1.0),
+        policy=ReactivePolicy(confidence=0.99, max_rotation=math.radians(120.0)),
     )
     assert run.reversals <= 4
     assert run.stopped == "confident"
@@ -259,8 +260,8 @@ def test_a_start_deep_in_a_wide_concavity_is_not_localized_elsewhere_and_sure():
             rig,
             part,
             calibration=cal,
-            max_rotation=math.radians(90.0),
             approach_pose=rig.approach_pose(float(start), jaw_position=-40.0, standoff=1.0),
+            policy=ReactivePolicy(max_rotation=math.radians(90.0)),
         )
         err = abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))
         assert run.stopped == "confident" and err < 0.3, (start, run.stopped, err)
