@@ -5,13 +5,13 @@ from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALE
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
-from ._march import MarchGrid, MarchResult, march, march_grid
+from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
 from ._particle_filter import ParticleFilter
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._segment import DIRECTIONS, Segment
-from ._solver import METHODS, feasible_segments
+from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
 from ._tracks import ModeTracks, tracks_for
 
 __all__ = [
@@ -46,6 +46,10 @@ __all__ = [
     "UNITS_TO_MM",
     "Segment",
     "feasible_segments",
+    "ExactOptions",
+    "EXACT",
+    "MarchOptions",
+    "PAPER_MARCH",
     "METHODS",
     "DIRECTIONS",
     "Candidate",

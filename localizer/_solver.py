@@ -30,18 +30,18 @@ Bracketed roots are refined together by a safeguarded Newton iteration to
 
 from __future__ import annotations
 
-from dataclasses import replace
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
-from ._march import march
+from ._march import PAPER_MARCH, MarchOptions, march
 from ._part import _TWO_PI, Part
 from ._segment import DIRECTIONS, KINDS, Segment
 from ._table import ArcTable, arc_table
 
-__all__ = ["feasible_segments", "METHODS"]
+__all__ = ["feasible_segments", "ExactOptions", "EXACT", "METHODS"]
 
 #: Solver methods accepted by :func:`feasible_segments`.
 METHODS = ("exact", "march")
@@ -116,14 +116,47 @@ def _check_query(part: Part, length, turn, direction: str, method: str):
 
 
 # ------------------------------------------------------------------- solver
-def _solve_ccw(
-    part: Part, length: float, turn: float, *, tol: float, flat_tol: float, double_width: float, max_cells: int
-):
+@dataclass(frozen=True)
+class ExactOptions:
+    """The exact solver's settings (:func:`feasible_segments`, ``method="exact"``).
+
+    Attributes
+    ----------
+    tol : float, mm
+        Accuracy of each root's arc position.
+    flat_tol : float, rad
+        |g| below which a whole cell counts as feasible (a circular stretch).
+    double_width : float, mm
+        Width below which a cell that cannot be certified is reported as a double root.
+    max_cells : int
+        Work limit against degenerate queries.
+    """
+
+    tol: float = 1e-10
+    flat_tol: float = 1e-10
+    double_width: float = 1e-7
+    max_cells: int = 2_000_000
+
+    def __post_init__(self) -> None:
+        for name in ("tol", "flat_tol", "double_width"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise QueryError(f"{name}={value!r} must be a positive number")
+        if isinstance(self.max_cells, bool) or not isinstance(self.max_cells, int) or self.max_cells < 1:
+            raise QueryError(f"max_cells={self.max_cells!r} must be a whole number ≥ 1")
+
+
+#: The exact solver's defaults.
+EXACT = ExactOptions()
+
+
+def _solve_ccw(part: Part, length: float, turn: float, options: ExactOptions):
     """Roots of g on [0, P) for counter-clockwise travel.
 
     Returns (simple_roots, double_roots, continua): arrays of start arc
     positions, and a list of (start, span) pairs.
     """
+    flat_tol, double_width, max_cells = options.flat_tol, options.double_width, options.max_cells
     table = arc_table(part)
     P = part.perimeter
     nodes = table.sig[:-1]
@@ -341,14 +374,8 @@ def feasible_segments(
     *,
     method: str = "exact",
     direction: str = "ccw",
-    tol: float = 1e-10,
-    flat_tol: float = 1e-10,
-    double_width: float = 1e-7,
-    max_cells: int = 2_000_000,
-    step: float = 1e-5,
-    length_tol: float = LENGTH_TOL,
-    turn_tol: float = TURN_TOL,
-    min_separation: float = MIN_SEPARATION,
+    exact: ExactOptions = EXACT,
+    marching: MarchOptions = PAPER_MARCH,
 ) -> list[Segment]:
     """Every boundary segment with arc length ``length`` and total curvature ``turn``.
 
@@ -370,18 +397,11 @@ def feasible_segments(
         Direction the contact moved on the part. For ``"cw"`` the contact
         moved clockwise from ``start_arc`` to ``end_arc``; rolling clockwise
         over a convex stretch turns the jaw clockwise (Ω < 0).
-    tol : float, mm
-        Accuracy of each root's arc position.
-    flat_tol : float, rad
-        |g| below which a whole cell counts as feasible (a circular stretch).
-    double_width : float, mm
-        Width below which a cell that cannot be certified is reported as a double root.
-    max_cells : int
-        Work limit against degenerate queries.
-    step, length_tol, turn_tol, min_separation
-        ``method="march"`` only: the integration step h in the parameter
-        domain, the convergence tolerances (mm, rad) and the minimum
-        separation of starts (mm); defaults are the paper's.
+    exact : ExactOptions
+        ``method="exact"``: the roots' accuracy, the flat and double-root thresholds, the work limit.
+    marching : MarchOptions
+        ``method="march"``: the integration step h, the tolerances and the separation of starts
+        (default: the paper's, :data:`localizer.PAPER_MARCH`).
 
     Returns
     -------
@@ -392,7 +412,7 @@ def feasible_segments(
     ------
     QueryError
         ``length`` not in (0, perimeter), non-finite arguments, an unknown
-        method or direction, or a degenerate query beyond ``max_cells``.
+        method or direction, or a degenerate query beyond ``exact.max_cells``.
 
     Examples
     --------
@@ -412,9 +432,7 @@ def feasible_segments(
     P = part.perimeter
     omega = turn if direction == "ccw" else -turn
     if method == "march":
-        marched = march(
-            part, length, omega, step=step, length_tol=length_tol, turn_tol=turn_tol, min_separation=min_separation
-        )
+        marched = march(part, length, omega, marching)
         if direction == "ccw":
             return [replace(g, turn=turn) for g in marched.segments]
         # the ccw stretch was travelled from its far end
@@ -433,9 +451,8 @@ def feasible_segments(
             ),
             key=lambda g: g.start_arc,
         )
-    zeros, brackets, doubles, continua = _solve_ccw(
-        part, length, omega, tol=tol, flat_tol=flat_tol, double_width=double_width, max_cells=max_cells
-    )
+    zeros, brackets, doubles, continua = _solve_ccw(part, length, omega, exact)
+    tol, double_width = exact.tol, exact.double_width
     table = arc_table(part)
     # columns, ccw sense: start arc, kind code, span, residual, start param, end param
     found = []

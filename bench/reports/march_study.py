@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.benchmarks.baselines import random_outline, trapezoid_perimeter, trefoil_part
-from localizer import LENGTH_TOL, TURN_TOL, feasible_segments, march, march_grid, part_from_points
+from localizer import LENGTH_TOL, TURN_TOL, MarchOptions, feasible_segments, march, march_grid, part_from_points
 
 TIGHT: dict[str, float] = {"length_tol": 1e-10, "turn_tol": 1e-10}
 
@@ -64,7 +64,9 @@ def proposition_1(n_parts: int, seed: int, h: float = 1e-4, max_iterations: int 
         for _ in range(2):
             _, L, w = _query(part, rng)
             exact = feasible_segments(part, L, w)
-            res = march(part, L, w, step=h, max_iterations=max_iterations, length_tol=1e-10, turn_tol=1e-10)
+            res = march(
+                part, L, w, MarchOptions(step=h, max_iterations=max_iterations, length_tol=1e-10, turn_tol=1e-10)
+            )
             for seg in res.segments:
                 e = _nearest(part, exact, seg.start_arc)
                 ks, kt = float(part.curvature(e.start_param)), float(part.curvature(e.end_param))
@@ -114,7 +116,9 @@ def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int,
                     Ls[i + 1],
                 )
                 w = float(part.tangent_angle_at_arc(s0 + L) - part.tangent_angle_at_arc(s0))
-                res = march(part, L, w, step=h, max_iterations=max_iterations, length_tol=1e-10, turn_tol=1e-10)
+                res = march(
+                    part, L, w, MarchOptions(step=h, max_iterations=max_iterations, length_tol=1e-10, turn_tol=1e-10)
+                )
                 seg = _nearest(part, res.segments, s0) if res.segments else None
                 if seg is None or abs(part.arc_offset(seg.start_arc, s0)) > 1.0:
                     continue
@@ -144,7 +148,7 @@ def theorem_2(n_parts: int, seed: int, h: float = 1e-4):
         for convex in (True, False):
             part = _random_part(rng, convex)
             _, L, w = _query(part, rng)
-            res = march(part, L, w, step=h)
+            res = march(part, L, w, MarchOptions(step=h))
             rows.append(
                 {
                     "convex": convex,
@@ -169,7 +173,7 @@ def cost_against_step(steps=(1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, 
         march_grid(part, h)
         build = time.perf_counter() - t0
         t0 = time.perf_counter()
-        nsteps = [march(part, L, w, step=h).steps for _, L, w in qs]
+        nsteps = [march(part, L, w, MarchOptions(step=h)).steps for _, L, w in qs]
         per_query = (time.perf_counter() - t0) / n_queries
         rows.append(
             {
@@ -194,7 +198,7 @@ def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int
             for _ in range(queries_per_part):
                 s0, L, w = _query(part, rng)
                 exact = feasible_segments(part, L, w)
-                marched = march(part, L, w, step=h).segments
+                marched = march(part, L, w, MarchOptions(step=h)).segments
                 missed = []
                 for e in exact:
                     slope = abs(float(part.curvature(e.end_param) - part.curvature(e.start_param)))
@@ -239,7 +243,7 @@ def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
         ex = feasible_segments(part, L, w)
         t_exact = time.perf_counter() - t0
         t0 = time.perf_counter()
-        res = march(part, L, w, step=h)
+        res = march(part, L, w, MarchOptions(step=h))
         t_march = time.perf_counter() - t0
         ma = res.segments
         rows.append(

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from localizer import QueryError, feasible_segments, march, part_from_points
+from localizer import MarchOptions, QueryError, feasible_segments, march, part_from_points
 from tests.localizer.test_part import ellipse_points, trefoil
 
 H = 1e-4  # coarser than the paper's 1e-5 to keep the tests fast; the bench uses 1e-5
@@ -35,7 +35,7 @@ def test_tight_march_finds_the_exact_segments_to_the_step(make, starts, lengths)
     vmax = float(part.speed(np.linspace(0, part.n_knots, 20000)).max())
     for L, w in queries(part, starts, lengths):
         exact = feasible_segments(part, L, w)
-        marched = march(part, L, w, step=H, length_tol=1e-9, turn_tol=1e-9).segments
+        marched = march(part, L, w, MarchOptions(step=H, length_tol=1e-9, turn_tol=1e-9)).segments
         assert len(marched) == len(exact)
         for m, e in zip(marched, exact):
             assert abs(part.arc_offset(m.start_arc, e.start_arc)) <= H * vmax
@@ -48,7 +48,7 @@ def test_tight_march_spans_inflections():
     k = part.curvature(t)
     spanned = 0
     for L, w in queries(part, [30.0, 100.0, 200.0, 310.0], [25.0, 40.0, 10.0, 60.0]):
-        for m in march(part, L, w, step=H, length_tol=1e-9, turn_tol=1e-9).segments:
+        for m in march(part, L, w, MarchOptions(step=H, length_tol=1e-9, turn_tol=1e-9)).segments:
             inside = (t - m.start_param) % part.n_knots <= (m.end_param - m.start_param) % part.n_knots
             spanned += bool(np.any(np.diff(np.sign(k[inside])) != 0))
     assert spanned >= 10
@@ -61,7 +61,7 @@ def test_paper_tolerances(make):
     part = make()
     for L, w in queries(part, [15.0, 120.0, 180.0], [22.0, 30.0, 8.0]):
         exact = feasible_segments(part, L, w)
-        marched = march(part, L, w, step=H)
+        marched = march(part, L, w, MarchOptions(step=H))
         assert marched.segments
         for e in exact:
             allowed = 2 * 0.0004 / abs(exact_slope(part, e)) + 2 * 0.004 + 0.01
@@ -77,7 +77,7 @@ def test_iterates_converge_linearly_with_the_curvature_ratio():
     checked = 0
     for L, w in queries(part, [100.0, 200.0], [40.0, 10.0]):
         exact = feasible_segments(part, L, w)
-        for m in march(part, L, w, step=H, length_tol=1e-10, turn_tol=1e-10).segments:
+        for m in march(part, L, w, MarchOptions(step=H, length_tol=1e-10, turn_tol=1e-10)).segments:
             e = min(exact, key=lambda e: abs(part.arc_offset(m.start_arc, e.start_arc)))
             ks, kt = part.curvature(e.start_param), part.curvature(e.end_param)
             if ks * kt <= 0 or m.iterations < 10:  # mixed modes use bisection
@@ -95,7 +95,7 @@ def test_iterates_converge_linearly_with_the_curvature_ratio():
 def test_theorem_2_step_bound():
     part = trefoil()
     for L, w in queries(part, [30.0, 100.0, 200.0], [25.0, 40.0, 10.0]):
-        res = march(part, L, w, step=H)
+        res = march(part, L, w, MarchOptions(step=H))
         assert 0 < res.steps <= 6 * res.grid_cells
 
 
@@ -103,7 +103,9 @@ def test_clockwise_march_matches_exact():
     part = trefoil()
     s0, L = 40.0, 25.0
     w = float(part.tangent_angle_at_arc(s0 - L) - part.tangent_angle_at_arc(s0))
-    m = feasible_segments(part, L, w, direction="cw", method="march", step=H, length_tol=1e-9, turn_tol=1e-9)
+    m = feasible_segments(
+        part, L, w, direction="cw", method="march", marching=MarchOptions(step=H, length_tol=1e-9, turn_tol=1e-9)
+    )
     e = feasible_segments(part, L, w, direction="cw")
     assert len(m) == len(e)
     assert all(abs(part.arc_offset(a.start_arc, b.start_arc)) < 1e-3 for a, b in zip(m, e))
@@ -112,7 +114,7 @@ def test_clockwise_march_matches_exact():
 
 def test_bad_step():
     with pytest.raises(QueryError, match="step=0.3 must divide the parameter period 90"):
-        march(trefoil(), 10.0, 0.1, step=0.3)
+        march(trefoil(), 10.0, 0.1, MarchOptions(step=0.3))
 
 
 def test_a_zero_of_curvature_that_keeps_its_sign_is_no_inflection():

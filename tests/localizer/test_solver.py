@@ -3,7 +3,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from localizer import QueryError, feasible_segments, part_from_points
+from localizer import ExactOptions, QueryError, feasible_segments, part_from_points
 from tests.localizer.reference import DenseCurve, random_part_points
 from tests.localizer.test_part import circle_points, ellipse_points, trefoil
 
@@ -125,7 +125,7 @@ def test_circular_stretch_is_reported_as_continuum():
     n, R = 64, 40.0
     part = part_from_points(circle_points(n, R))
     L = part.perimeter / n * 5
-    segs = feasible_segments(part, L, 2 * np.pi * L / part.perimeter, flat_tol=1e-9)
+    segs = feasible_segments(part, L, 2 * np.pi * L / part.perimeter, exact=ExactOptions(flat_tol=1e-9))
     assert segs and all(s.kind in ("continuum", "double", "simple") for s in segs)
     covered = sum(s.span for s in segs if s.kind == "continuum")
     assert covered == pytest.approx(part.perimeter, rel=1e-6)
