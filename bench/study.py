@@ -60,6 +60,7 @@ method's failure (``<method>_stopped = "error"``, ``<method>_failure``), never t
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 import tomllib
@@ -69,7 +70,7 @@ from pathlib import Path
 import numpy as np
 
 from driver.reactive import CONFIDENCE, MAX_ROTATION
-from localizer import ROLL_STEP, SUCCESS_RADIUS, RolltouchError
+from localizer import ROLL_STEP, SUCCESS_RADIUS, Part, RolltouchError, load_part
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -432,15 +433,10 @@ class TrialSpec:
     extra: dict = field(default_factory=dict)
 
 
-_PART_CACHE: dict = {}
-
-
-def _part(path):
-    from localizer import load_part
-
-    if path not in _PART_CACHE:
-        _PART_CACHE[path] = load_part(path)
-    return _PART_CACHE[path]
+@functools.cache
+def _part(path: str) -> Part:
+    """The part file at ``path``, read once per worker process (its tables are kept with it)."""
+    return load_part(path)
 
 
 def start_sampler(part, rolls, jaw_start: float):

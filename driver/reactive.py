@@ -255,174 +255,242 @@ def localize_reactively(
     observer : callable, optional
         Called with ``{"event": "belief", ...}`` at every check.
     """
-    p = policy
-    step, n, confidence, max_rotation, direction = p.step, p.n, p.confidence, p.max_rotation, p.direction
-    check_every, lookahead, bridge_jump, end_margin = p.check_every, p.lookahead, p.bridge_jump, p.end_margin
-    backoff, min_spread, confirm = p.backoff, p.min_spread, p.confirm
     flt = filter if filter is not None else ContactFilter(part)
-    flt.reset()
-    hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, pressing=pressing)
-    offset = edge_offset(rig, hand, baseline)
-    jaw_limit = float(np.max(np.abs(calibration.positions))) - end_margin
-    readings: list[Reading] = []
-    truth: list[Truth] = []
+    return _Roller(rig, flt, calibration, policy, pressing, observer).run(approach_pose)
 
-    def read():
-        return _location(rig, baseline, calibration, n, readings, truth, hand)
 
-    def pressed() -> bool:
+class _Roller:
+    """One reactive localization: the hand, the filter, the counters and the traces it returns.
+
+    :meth:`run` rolls step by step (:meth:`_step`); a step at the end of the jaw's span is a
+    regrasp (:meth:`_regrasp`), a step that bridges a concavity is undone (:meth:`_undo_bridge`),
+    and every ``check_every`` steps the belief is checked (:meth:`_check`).
+    """
+
+    def __init__(
+        self,
+        rig: Rig,
+        flt: ContactFilter,
+        calibration: Calibration,
+        policy: ReactivePolicy,
+        pressing: PressSettings,
+        observer,
+    ) -> None:
+        self.rig, self.flt, self.calibration, self.policy = rig, flt, calibration, policy
+        self.pressing, self.observer = pressing, observer
+        self.readings: list[Reading] = []
+        self.truth: list[Truth] = []
+        self.z = self.rotation = 0.0
+        self.turn = 0.0  # net rotation at the last reading, rad
+        self.steps = self.reversals = self.regrasps = self.bridges = 0
+        self.explored = [0.0, 0.0]
+        self.blocked = {1: False, -1: False}
+        self.arcs: list[float] = [0.0]
+        self.turns: list[float] = [0.0]
+        self.history: list[tuple] = []
+        self.segments: list[int] = [0]
+        # nothing is known yet: counter-clockwise, like the paper
+        self.direction = 1 if policy.direction is None else policy.direction
+        self.belief: Belief | None = None
+        self.sure = 0  # checks in a row at or above the confidence
+
+    # ------------------------------------------------------------------ sensing
+    def read(self) -> float:
+        """The contact's place on the jaw now, mm (logs the reading)."""
+        return _location(self.rig, self.baseline, self.calibration, self.policy.n, self.readings, self.truth, self.hand)
+
+    def pressed(self) -> bool:
         """Press back to the force; False when the press was refused (overload, no contact)."""
         try:
-            press(rig, hand, baseline, target=calibration.target, n=n, pressing=pressing)
+            press(
+                self.rig,
+                self.hand,
+                self.baseline,
+                target=self.calibration.target,
+                n=self.policy.n,
+                pressing=self.pressing,
+            )
             return True
         except RigError:
             return False
 
-    d_prev = read()
-    flt.touch(d_prev)  # the first contact's place on the jaw: where the jaw could have been laid
-    phi0 = rig.pose()[2]
-    z, rotation, steps, reversals, regrasps, bridges = 0.0, 0.0, 0, 0, 0, 0
-    explored = [0.0, 0.0]
-    blocked = {1: False, -1: False}
-    arcs, turns, history = [0.0], [0.0], []
-    true_arcs = [truth[-1].contact_arc if truth else math.nan]
-    segments = [0]
-    if direction is None:
-        direction = 1  # nothing is known yet: counter-clockwise, like the paper
-    stopped = "max_rotation"
-    belief = None
-    sure = 0  # checks in a row at or above the confidence
-    while rotation < max_rotation - 1e-12:
-        s = direction * step
-        hand.rotate_by(s)
-        rotation += step
+    def true_arc(self) -> float:
+        return self.truth[-1].contact_arc if self.truth else math.nan
+
+    def turn_now(self) -> float:
+        return self.rig.pose()[2] - self.phi0
+
+    # ------------------------------------------------------------------ the run
+    def run(self, approach_pose) -> ReactiveRun:
+        """Establish contact at ``approach_pose`` and roll until sure, blocked, lost or out of budget."""
+        rig, flt, p = self.rig, self.flt, self.policy
+        flt.reset()
+        self.hand, self.baseline, _ = establish_contact(
+            rig, approach_pose, target=self.calibration.target, n=p.n, pressing=self.pressing
+        )
+        self.offset = edge_offset(rig, self.hand, self.baseline)
+        self.jaw_limit = float(np.max(np.abs(self.calibration.positions))) - p.end_margin
+        self.d_prev = self.read()
+        flt.touch(self.d_prev)  # the first contact's place on the jaw: where the jaw could have been laid
+        self.phi0 = rig.pose()[2]
+        self.true_arcs = [self.true_arc()]
+        stopped = "max_rotation"
+        while self.rotation < p.max_rotation - 1e-12:
+            outcome = self._step()
+            if outcome is not None:
+                stopped = outcome
+                break
+        belief = self.belief
+        if belief is None or belief.steps != flt.steps:
+            belief = flt.belief()
+            self.history.append((self.rotation, belief.map_arc, belief.mass, self.true_arc()))
+        return ReactiveRun(
+            belief=belief,
+            rotation=self.rotation,
+            steps=self.steps,
+            stopped=stopped,
+            reversals=self.reversals,
+            regrasps=self.regrasps,
+            bridges=self.bridges,
+            history=tuple(self.history),
+            arcs=tuple(self.arcs),
+            turns=tuple(self.turns),
+            true_arcs=tuple(self.true_arcs),
+            segments=tuple(self.segments),
+        )
+
+    def _step(self) -> str | None:
+        """Roll one step and take its reading; the stop reason, or None to roll on."""
+        p, flt = self.policy, self.flt
+        s = self.direction * p.step
+        self.hand.rotate_by(s)
+        self.rotation += p.step
         try:
-            d = read() if pressed() else math.inf
+            d = self.read() if self.pressed() else math.inf
         except RigError:
             d = math.inf  # left the calibrated span, or the press was refused: treated as a bridge
-        bridged = abs(d - d_prev) > bridge_jump or not math.isfinite(d)
+        bridged = abs(d - self.d_prev) > p.bridge_jump or not math.isfinite(d)
         regrasped = slid_off = False
-        if not bridged and abs(d) > jaw_limit:
-            # the contact reached the end of the jaw's span: lift, slide the jaw along itself so
-            # that the contact comes back near the other end, put it back on the same point
-            target_d = -math.copysign(jaw_limit - 2 * end_margin, d)
-            slide = d - target_d
-            hand.press_by(-backoff)
-            hand.slide_by(slide)
-            try:
-                d_new = read() if pressed() else math.inf
-            except RigError:
-                d_new = math.inf
-            if abs(d_new - target_d) <= bridge_jump:
-                d = d_new
-                turn = rig.pose()[2] - phi0
-                flt.regrasp(z, turn, d)
-                regrasps += 1
-                regrasped = True
-            else:
-                # the longer reach of the slid jaw found another point: the stretch ends here
-                # on the hull; put the jaw back and treat it as a bridge
-                hand.press_by(-backoff)
-                hand.slide_by(-slide)
-                pressed()
-                bridged = slid_off = True
+        if not bridged and abs(d) > self.jaw_limit:
+            d, regrasped, slid_off = self._regrasp(d)
+            bridged = slid_off
         if bridged:
-            bridges += 1
-            if not slid_off:
-                # evidence: the starts under which this turn keeps the jaw clear are less likely
-                flt.bridged(rig.pose()[2] - phi0, jump=bridge_jump)
-            # bridged a concavity: roll back, re-read, and go the other way
-            hand.rotate_by(-s)
-            rotation += step
-            try:
-                if not pressed():
-                    raise RigError("the press back was refused")
-                d_prev = read()
-            except RigError:
-                stopped = "lost"
-                break
-            # the re-read is a new base for the increments: a new segment with its own offset
-            flt.regrasp(z, rig.pose()[2] - phi0, d_prev)
-            blocked[direction] = True
-            if blocked[-direction]:
-                stopped = "blocked"
-                break
-            direction = -direction
-            reversals += 1
-            continue
-        if not regrasped:
-            turn = rig.pose()[2] - phi0
-            z += direction * arc_from_jaw_positions([d_prev, d], s, offset)
-            flt.update(z, turn, d)
-        explored = [min(explored[0], turn), max(explored[1], turn)]
-        arcs.append(z)
-        turns.append(turn)
-        true_arcs.append(truth[-1].contact_arc if truth else math.nan)
-        segments.append(flt.segment)
-        d_prev = d
-        steps += 1
-        if steps % check_every == 0:
-            belief = flt.belief()
-            true_arc = truth[-1].contact_arc if truth else math.nan
-            history.append((rotation, belief.map_arc, belief.mass, true_arc))
-            if observer is not None:
-                observer(
-                    {
-                        "event": "belief",
-                        "rotation": rotation,
-                        "map_arc": belief.map_arc,
-                        "mass": belief.mass,
-                        "modes": [(m.arc, m.mass) for m in belief.modes[:4]],
-                        "true_arc": true_arc,
-                        "direction": direction,
-                    }
-                )
-            sure = sure + 1 if belief.mass >= confidence else 0
-            if sure >= confirm:
-                stopped = "confident"
-                break
-            # a concavity ahead for most of the belief: turn round before bridging it, if the
-            # other way is clear beyond what has been rolled there (else roll on: a bridge is
-            # detected and undone all the same, and turning round towards a way that is no better
-            # only rocks the jaw in place)
-            beyond = explored[0] if direction == 1 else explored[1]
-            if (
-                not blocked[-direction]
-                and clear_ahead(flt, direction, lookahead) < 0.5
-                and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5
-            ):
-                direction = -direction
-                reversals += 1
-                continue
-            # the direction rule: when rolling on cannot separate the two leading modes, turn
-            # round if the unexplored curvature the other way separates them better, and if that
-            # way is clear (else the rule above turns it straight back, and the jaw rocks)
-            strong = [m for m in belief.modes if m.mass >= flt.mode_floor]
-            if len(strong) < 2 or blocked[-direction]:
-                continue
-            ccw, cw = spread_by_direction(flt, lookahead, tuple(explored), [m.start_arc for m in strong[:2]])
-            ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
-            if (
-                ahead < min_spread
-                and behind > 3 * min_spread
-                and clear_ahead(flt, -direction, lookahead, at=beyond) >= 0.5
-            ):
-                direction = -direction
-                reversals += 1
-    if belief is None or belief.steps != flt.steps:
-        belief = flt.belief()
-        history.append((rotation, belief.map_arc, belief.mass, truth[-1].contact_arc if truth else math.nan))
-    return ReactiveRun(
-        belief=belief,
-        rotation=rotation,
-        steps=steps,
-        stopped=stopped,
-        reversals=reversals,
-        regrasps=regrasps,
-        bridges=bridges,
-        history=tuple(history),
-        arcs=tuple(arcs),
-        turns=tuple(turns),
-        true_arcs=tuple(true_arcs),
-        segments=tuple(segments),
-    )
+            return self._undo_bridge(s, slid_off)
+        if regrasped:
+            turn = self.turn
+        else:
+            turn = self.turn_now()
+            self.z += self.direction * arc_from_jaw_positions([self.d_prev, d], s, self.offset)
+            flt.update(self.z, turn, d)
+        self.turn = turn
+        self.explored = [min(self.explored[0], turn), max(self.explored[1], turn)]
+        self.arcs.append(self.z)
+        self.turns.append(turn)
+        self.true_arcs.append(self.true_arc())
+        self.segments.append(flt.segment)
+        self.d_prev = d
+        self.steps += 1
+        if self.steps % p.check_every == 0:
+            return self._check()
+        return None
+
+    def _regrasp(self, d: float) -> tuple[float, bool, bool]:
+        """The contact reached the end of the jaw's span: lift, slide the jaw along itself so that the
+        contact comes back near the other end, put it back on the same point. Returns (the new place
+        on the jaw, regrasped, slid off: the slid jaw found another point, a bridge)."""
+        p = self.policy
+        target_d = -math.copysign(self.jaw_limit - 2 * p.end_margin, d)
+        slide = d - target_d
+        self.hand.press_by(-p.backoff)
+        self.hand.slide_by(slide)
+        try:
+            d_new = self.read() if self.pressed() else math.inf
+        except RigError:
+            d_new = math.inf
+        if abs(d_new - target_d) <= p.bridge_jump:
+            self.turn = self.turn_now()
+            self.flt.regrasp(self.z, self.turn, d_new)
+            self.regrasps += 1
+            return d_new, True, False
+        # the longer reach of the slid jaw found another point: the stretch ends here on the hull;
+        # put the jaw back and treat it as a bridge
+        self.hand.press_by(-p.backoff)
+        self.hand.slide_by(-slide)
+        self.pressed()
+        return d, False, True
+
+    def _undo_bridge(self, s: float, slid_off: bool) -> str | None:
+        """The step bridged a concavity: roll back, re-read, and go the other way ("lost" or "blocked"
+        when that is not possible)."""
+        p, flt = self.policy, self.flt
+        self.bridges += 1
+        if not slid_off:
+            # evidence: the starts under which this turn keeps the jaw clear are less likely
+            flt.bridged(self.turn_now(), jump=p.bridge_jump)
+        self.hand.rotate_by(-s)
+        self.rotation += p.step
+        try:
+            if not self.pressed():
+                raise RigError("the press back was refused")
+            self.d_prev = self.read()
+        except RigError:
+            return "lost"
+        # the re-read is a new base for the increments: a new segment with its own offset
+        flt.regrasp(self.z, self.turn_now(), self.d_prev)
+        self.blocked[self.direction] = True
+        if self.blocked[-self.direction]:
+            return "blocked"
+        self.direction = -self.direction
+        self.reversals += 1
+        return None
+
+    def _check(self) -> str | None:
+        """Look at the belief: "confident" to stop; else the direction rules may turn the jaw round."""
+        p, flt = self.policy, self.flt
+        belief = self.belief = flt.belief()
+        true_arc = self.true_arc()
+        self.history.append((self.rotation, belief.map_arc, belief.mass, true_arc))
+        if self.observer is not None:
+            self.observer(
+                {
+                    "event": "belief",
+                    "rotation": self.rotation,
+                    "map_arc": belief.map_arc,
+                    "mass": belief.mass,
+                    "modes": [(m.arc, m.mass) for m in belief.modes[:4]],
+                    "true_arc": true_arc,
+                    "direction": self.direction,
+                }
+            )
+        self.sure = self.sure + 1 if belief.mass >= p.confidence else 0
+        if self.sure >= p.confirm:
+            return "confident"
+        direction = self.direction
+        # a concavity ahead for most of the belief: turn round before bridging it, if the other way
+        # is clear beyond what has been rolled there (else roll on: a bridge is detected and undone
+        # all the same, and turning round towards a way that is no better only rocks the jaw in place)
+        beyond = self.explored[0] if direction == 1 else self.explored[1]
+        if (
+            not self.blocked[-direction]
+            and clear_ahead(flt, direction, p.lookahead) < 0.5
+            and clear_ahead(flt, -direction, p.lookahead, at=beyond) >= 0.5
+        ):
+            self.direction = -direction
+            self.reversals += 1
+            return None
+        # the direction rule: when rolling on cannot separate the two leading modes, turn round if
+        # the unexplored curvature the other way separates them better, and if that way is clear
+        # (else the rule above turns it straight back, and the jaw rocks)
+        strong = [m for m in belief.modes if m.mass >= flt.mode_floor]
+        if len(strong) < 2 or self.blocked[-direction]:
+            return None
+        ccw, cw = spread_by_direction(flt, p.lookahead, tuple(self.explored), [m.start_arc for m in strong[:2]])
+        ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
+        if (
+            ahead < p.min_spread
+            and behind > 3 * p.min_spread
+            and clear_ahead(flt, -direction, p.lookahead, at=beyond) >= 0.5
+        ):
+            self.direction = -direction
+            self.reversals += 1
+        return None

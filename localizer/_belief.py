@@ -51,7 +51,7 @@ class Belief:
     map_arc: float
     mass: float
     radius: float
-    modes: tuple
+    modes: tuple[Mode, ...]
     ambiguous: bool
     informative: bool
     steps: int

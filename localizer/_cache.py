@@ -8,7 +8,7 @@ own store (so they go when the part goes), and :meth:`localizer.Part.forget_tabl
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING, TypeVar, cast
 
 if TYPE_CHECKING:
     from ._part import Part
@@ -27,7 +27,8 @@ def per_part(kind: str, part: Part, args: Hashable, build: Callable[[], T], *, l
     store = part._tables
     key = (kind, args)
     if key in store:
-        return store[key]
+        # the store holds every kind's tables; this key's value is the one ``build`` made
+        return cast(T, store[key])
     value = build()
     if latest_only:
         for old in [k for k in store if k[0] == kind]:

@@ -97,6 +97,7 @@ all (on a circle every start predicts the same readings).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from scipy.special import ndtr
@@ -107,6 +108,7 @@ from ._errors import QueryError
 from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._tracks import tracks_for
+from ._types import ArrayLike, FloatArray, IntArray
 
 __all__ = ["ContactFilter", "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
 
@@ -140,7 +142,7 @@ SLOPE_RHO_MAX = 1000.0
 TURN_MARGIN = 0.02
 
 
-def _bspline(x: float) -> tuple:
+def _bspline(x: float) -> tuple[IntArray, FloatArray]:
     """(indices, values) of the four uniform cubic B-splines that are nonzero at ``x`` (in knot steps)."""
     i = math.floor(x)
     u = x - i
@@ -232,13 +234,13 @@ class ContactFilter:
         refresh: int = 5,
         jaw: StraightJaw = DEFAULT_JAW,
         jaw_margin: float = 2.0,
-        noise_scales=NOISE_SCALES,
+        noise_scales: ArrayLike = NOISE_SCALES,
         sd_jaw: float = 0.015,
         jaw_spacing: float = 5.0,
         sd_turn: float = ENCODER_SD,
         temper: float = TEMPER,
         sd_drift: float = 1e-4,
-    ):
+    ) -> None:
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")
@@ -307,7 +309,7 @@ class ContactFilter:
         return self._segment
 
     @property
-    def grid(self) -> np.ndarray:
+    def grid(self) -> FloatArray:
         """The hypotheses: starts of the rolling, mm."""
         return self.tracks.sigma
 
@@ -338,8 +340,8 @@ class ContactFilter:
         self._hist: list[tuple[float, float]] = []  # (z, turn) of every reading, for the reference's radii
         self._version = 0  # changes to the likelihood (its cache's key)
         self._rows = 0  # readings added
-        self._cached: dict | None = None
-        self._last_row: tuple[np.ndarray, np.ndarray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
+        self._cached: dict[str, Any] | None = None
+        self._last_row: tuple[IntArray, FloatArray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
         self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
@@ -459,7 +461,7 @@ class ContactFilter:
         self._segment += 1
         self.update(arc, turn, jaw)
 
-    def _basis(self, z: float, jaw: float | None = None) -> tuple:
+    def _basis(self, z: float, jaw: float | None = None) -> tuple[IntArray, FloatArray]:
         """(columns, values) of the basis for a reading at cumulative arc z (mm) and place ``jaw`` (mm)
         on the jaw: the segment's offset, four cubic B-splines of the slope error in z (times ρ̂)
         and four of the calibration's error in the place on the jaw."""
@@ -518,7 +520,9 @@ class ContactFilter:
             np.maximum.at(self._slope_var, first + k, (rho * self.sd_slope) ** 2)
         self._version += 1
 
-    def _add_row(self, z: float, p: np.ndarray, idx=None, jaw: float | None = None, turn: float = 0.0) -> None:
+    def _add_row(
+        self, z: float, p: FloatArray, idx: IntArray | None = None, jaw: float | None = None, turn: float = 0.0
+    ) -> None:
         """Add a reading z at net rotation ``turn`` and place ``jaw`` on the jaw with the predictions p of
         the hypotheses ``idx`` (default: all)."""
         self._version += 1
@@ -547,7 +551,7 @@ class ContactFilter:
         self._uu[np.ix_(cols, cols)] += np.outer(vals, vals)
         self._szz += z * z
 
-    def _solved(self) -> dict:
+    def _solved(self) -> dict[str, Any]:
         """The marginalisation over the live hypotheses and their log-likelihoods, once per reading
         (cached: the reference refresh, :meth:`belief` and :meth:`shift` share it)."""
         if self._cached is None or self._cached["version"] != self._version:
@@ -557,7 +561,7 @@ class ContactFilter:
             self._cached = s
         return self._cached
 
-    def _solve(self) -> dict:
+    def _solve(self) -> dict[str, Any]:
         """The closed-form marginalisation over the live hypotheses (see the module notes)."""
         cols = np.flatnonzero(self._touched)
         s2 = self.sd_position**2
@@ -577,7 +581,7 @@ class ContactFilter:
         qzz = (self._szz - wz @ gi_wz) / s2
         return {"cols": cols, "g": g, "live": live, "gi_v": gi_v, "gi_wz": gi_wz, "qpp": qpp, "qpz": qpz, "qzz": qzz}
 
-    def _log_likelihood(self, s: dict) -> np.ndarray:
+    def _log_likelihood(self, s: dict[str, Any]) -> FloatArray:
         """Log-likelihood of each start from a :meth:`_solve`, the noise scale weighed out; prunes the
         hopeless ones. Also leaves in ``s`` each live start's posterior mean of the squared scale."""
         live, qpp, qpz = s["live"], s["qpp"], s["qpz"]
@@ -611,11 +615,12 @@ class ContactFilter:
         s = self._solved()
         return float(math.sqrt(s["lam2"][int(np.argmax(s["ll"][s["live"]]))]))
 
-    def log_likelihood(self) -> np.ndarray:
+    def log_likelihood(self) -> FloatArray:
         """Log-likelihood of each start (−inf where infeasible or pruned), up to a constant."""
-        return self._solved()["ll"].copy()
+        ll: FloatArray = self._solved()["ll"]
+        return ll.copy()
 
-    def shift(self) -> tuple:
+    def shift(self) -> tuple[FloatArray, FloatArray]:
         """How far the real present contact is from each hypothesis' nominal one, mm.
 
         The slope error η moves the contact for a given jaw angle by ρ·η along the part
@@ -657,7 +662,7 @@ class ContactFilter:
         sd[live] = np.sqrt(s["lam2"] * (var0 + d_var * a_v**2) / self.temper + var_turn)
         return mean, sd
 
-    def posterior(self) -> np.ndarray:
+    def posterior(self) -> FloatArray:
         """Posterior probability of each start (sums to 1).
 
         Computed once per reading (a check asks for it several times: the belief and the
@@ -670,7 +675,8 @@ class ContactFilter:
                 raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
             w = np.exp(ll - top)
             s["w"] = w / w.sum()
-        return s["w"].copy()
+        posterior: FloatArray = s["w"]
+        return posterior.copy()
 
     def belief(self, radius: float | None = None) -> Belief:
         """The belief over the present contact (see :class:`Belief`), its mass taken within ``radius`` mm
@@ -707,7 +713,7 @@ class ContactFilter:
             steps=self.steps,
         )
 
-    def _modes(self, w, present, radius) -> list:
+    def _modes(self, w: FloatArray, present: FloatArray, radius: float) -> list[Mode]:
         """Connected groups of probable present contacts, binned at ``radius``."""
         part = self.part
         nb = max(8, int(part.perimeter / radius))

@@ -24,7 +24,9 @@ rolls, each starting where the previous one ended. Two rules:
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -32,8 +34,9 @@ from scipy.optimize import least_squares
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._part import Part
-from ._segment import DIRECTIONS
+from ._segment import DIRECTIONS, Segment
 from ._solver import feasible_segments
+from ._types import FloatArray
 
 __all__ = ["Candidate", "Localization", "localize", "RULES"]
 
@@ -70,15 +73,15 @@ class Candidate:
 
     start_arc: float
     end_arc: float
-    path: tuple
-    lengths: tuple
-    turn_residuals: tuple
+    path: tuple[float, ...]
+    lengths: tuple[float, ...]
+    turn_residuals: tuple[float, ...]
     probability: float
     score: float
     start_param: float
     end_param: float
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain-JSON form."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         d["path"], d["lengths"], d["turn_residuals"] = list(self.path), list(self.lengths), list(self.turn_residuals)
@@ -105,9 +108,9 @@ class Localization:
         Probability the best candidate needs for the result not to be ambiguous.
     """
 
-    candidates: tuple
-    segments: tuple
-    rolls: tuple
+    candidates: tuple[Candidate, ...]
+    segments: tuple[Segment, ...]
+    rolls: tuple[tuple[float, float], ...]
     rule: str
     direction: str
     confidence: float
@@ -123,7 +126,7 @@ class Localization:
         return self.best is None or self.best.probability < self.confidence
 
 
-def _check_rolls(part: Part, rolls) -> tuple:
+def _check_rolls(part: Part, rolls: Iterable[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
     try:
         chain = [(float(L), float(w)) for L, w in rolls]
     except (TypeError, ValueError):
@@ -140,7 +143,9 @@ def _check_rolls(part: Part, rolls) -> tuple:
     return tuple(chain)
 
 
-def _chain_turns(part: Part, start, lengths, sign):
+def _chain_turns(
+    part: Part, start: FloatArray | float, lengths: FloatArray, sign: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Positions and turns of consecutive segments from unrolled arc ``start``."""
     pos = start + sign * np.concatenate([[0.0], np.cumsum(lengths)])
     t = part.param_at_arc(pos)
@@ -148,7 +153,14 @@ def _chain_turns(part: Part, start, lengths, sign):
     return pos, np.diff(theta), kappa, t
 
 
-def _paper(part, chain, segs, sign, length_tol, turn_tol):
+def _paper(
+    part: Part,
+    chain: tuple[tuple[float, float], ...],
+    segs: list[Segment],
+    sign: float,
+    length_tol: float,
+    turn_tol: float,
+) -> list[Candidate]:
     rows = []
     lengths = np.array([L for L, _ in chain])
     omegas = np.array([w for _, w in chain])
@@ -183,7 +195,15 @@ def _paper(part, chain, segs, sign, length_tol, turn_tol):
     return out
 
 
-def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation):
+def _likelihood(
+    part: Part,
+    chain: tuple[tuple[float, float], ...],
+    sign: float,
+    direction: str,
+    sd_length: float,
+    sd_turn: float,
+    min_separation: float,
+) -> list[Candidate]:
     n = len(chain)
     L = np.array([c[0] for c in chain])
     W = np.array([c[1] for c in chain])
@@ -191,20 +211,20 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
     # (a rotation error moves a start by sd_turn/|g'|, a length error by about
     # sd_length·κ/|g'|: the turn-shifted queries bracket both)
     sd_eff = float(np.hypot(sd_turn, sd_length * part.curvature_bound))
-    seeds = []
+    found: list[float] = []
     for dw in (-2.0, 0.0, 2.0):
-        for s in feasible_segments(part, L[0], W[0] + dw * min(sd_eff, 10 * sd_turn), direction=direction):
-            seeds.append(s.start_arc)
-    if not seeds:
+        for seg in feasible_segments(part, L[0], W[0] + dw * min(sd_eff, 10 * sd_turn), direction=direction):
+            found.append(seg.start_arc)
+    if not found:
         return []
-    seeds = np.sort(np.array(seeds))
+    seeds = np.sort(np.array(found))
     seeds = seeds[np.concatenate([[True], np.diff(seeds) > 0.1 * min_separation])]
 
-    def resid(x):
+    def resid(x: FloatArray) -> FloatArray:
         pos, turns, _, _ = _chain_turns(part, x[0], x[1:], sign)
         return np.concatenate([(turns - W) / sd_turn, (x[1:] - L) / sd_length])
 
-    def jac(x):
+    def jac(x: FloatArray) -> FloatArray:
         pos, turns, kappa, _ = _chain_turns(part, x[0], x[1:], sign)
         J = np.zeros((2 * n, n + 1))
         dk = kappa[1:] - kappa[:-1]
@@ -227,7 +247,7 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
         neg_log_evidence = float(r.cost + 0.5 * logdet)
         fits.append((neg_log_evidence, r.x))
     fits.sort(key=lambda f: f[0])
-    kept = []
+    kept: list[tuple[float, FloatArray]] = []
     for f in fits:
         s = part.wrap_arc(f[1][0])
         if all(abs(part.arc_offset(s, k[1][0])) > min_separation for k in kept):
@@ -257,7 +277,7 @@ def _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation
 
 def localize(
     part: Part,
-    rolls,
+    rolls: Iterable[tuple[float, float]],
     *,
     rule: str = "likelihood",
     direction: str = "ccw",

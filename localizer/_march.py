@@ -35,6 +35,7 @@ from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._part import Part, _curvature
 from ._segment import Segment
+from ._types import FloatArray
 
 __all__ = ["MarchGrid", "MarchResult", "MarchOptions", "PAPER_MARCH", "march_grid", "march"]
 
@@ -59,9 +60,9 @@ class MarchGrid:
 
     h: float
     cells: int
-    length: np.ndarray
-    turn: np.ndarray
-    kappa: np.ndarray
+    length: FloatArray
+    turn: FloatArray
+    kappa: FloatArray
 
     # ---- per-part quantities, computed once per grid --------------------
     @cached_property
@@ -70,32 +71,33 @@ class MarchGrid:
         return float(np.max(np.diff(self.length))) / self.h
 
     @cached_property
-    def inflections(self):
+    def inflections(self) -> tuple[FloatArray, FloatArray]:
         """(z, sign after z): the inflections of :func:`_sign_regions`."""
         return _sign_regions(self.kappa, self.h)
 
     @cached_property
-    def negated_turn(self) -> np.ndarray:
+    def negated_turn(self) -> FloatArray:
         """-Φ(0, ih): nondecreasing over concave stretches, for concave-concave modes."""
         return -self.turn
 
     # ---- unrolled evaluation (parameter x may exceed the period) ----------
-    def _value(self, cum, x):
+    def _value(self, cum: FloatArray, x: float) -> float:
+        """The unrolled cumulative ``cum`` at parameter ``x``, interpolated linearly in the cell."""
         i = x / self.h
         lap, i = divmod(i, self.cells)
         k = min(int(i), self.cells - 1)
         f = i - k
-        return cum[k] + f * (cum[k + 1] - cum[k]) + lap * cum[-1]
+        return float(cum[k] + f * (cum[k + 1] - cum[k]) + lap * cum[-1])
 
-    def ell(self, s, t):
+    def ell(self, s: float, t: float) -> float:
         """ℓ(s, t) by the trapezoid rule, mm, between unrolled parameters ``s`` <= ``t``."""
         return self._value(self.length, t) - self._value(self.length, s)
 
-    def phi(self, s, t):
+    def phi(self, s: float, t: float) -> float:
         """Φ(s, t) by the trapezoid rule, rad, between unrolled parameters ``s`` <= ``t``."""
         return self._value(self.turn, t) - self._value(self.turn, s)
 
-    def _search(self, cum, target, x_lo, x_hi):
+    def _search(self, cum: FloatArray, target: float, x_lo: float, x_hi: float) -> float | None:
         """First x in [x_lo, x_hi] with C(x) = target, C nondecreasing there, or None.
 
         C is the unrolled cumulative ``cum``; the search is a binary search on
@@ -140,7 +142,7 @@ class MarchResult:
         Marches started (the initial one and one per ε step-over and mode).
     """
 
-    segments: list
+    segments: list[Segment]
     steps: int
     grid_cells: int
     restarts: int
@@ -165,9 +167,10 @@ def _build(part: Part, h: float) -> MarchGrid:
     prev_v = prev_w = None
     for start in range(0, M + 1, chunk):
         idx = np.arange(start, min(start + chunk, M + 1))
-        t = idx * h
+        t = (idx * h).astype(np.float64, copy=False)
         piece = np.minimum(t.astype(np.int64), n - 1)
-        dx, dy, ddx, ddy = part.derivatives(piece, t - piece)
+        u = (t - piece).astype(np.float64, copy=False)
+        dx, dy, ddx, ddy = part.derivatives(piece, u)
         v = np.hypot(dx, dy)
         k = _curvature(dx, dy, ddx, ddy)
         w = k * v
@@ -190,7 +193,7 @@ def _build(part: Part, h: float) -> MarchGrid:
     return grid
 
 
-def _sign_regions(kappa: np.ndarray, h: float):
+def _sign_regions(kappa: FloatArray, h: float) -> tuple[FloatArray, FloatArray]:
     """Inflections (parameters in [0, τ), ascending) and the sign of κ after each.
 
     κ is sampled on the grid (``kappa[-1]`` repeats ``kappa[0]``). A zero of κ
@@ -269,6 +272,10 @@ def march(part: Part, length: float, turn: float, options: MarchOptions = PAPER_
     return _Marcher(part, length, turn, options).run()
 
 
+#: A march's find: (s, t, the iterates' starts, iterations, kind).
+_Found = tuple[float, float, list[float], int, str]
+
+
 class _Marcher:
     """One march: the h-grid, the endpoints' integration counter, and the segments found so far.
 
@@ -288,10 +295,10 @@ class _Marcher:
         self.steps = 0
         self.restarts = 0
         self.cur = {"s": 0.0, "t": 0.0}  # where the two endpoints' integrals were last evaluated
-        self.found: list = []  # (s, t, iterates, iterations, kind)
+        self.found: list[_Found] = []
         # the inflections over four laps, and κ's sign after each (None: κ keeps one sign)
-        self.zz: np.ndarray | None = None
-        self.ss: np.ndarray | None = None
+        self.zz: FloatArray | None = None
+        self.ss: FloatArray | None = None
 
     # ------------------------------------------------------------------ endpoints
     def at(self, **ends: float) -> None:
@@ -300,10 +307,17 @@ class _Marcher:
             self.steps += int(abs(round(x / self.h) - round(self.cur[name] / self.h)))
             self.cur[name] = x
 
-    def end_of(self, s: float):
+    def end_of(self, s: float) -> float | None:
         """t with ℓ(s, t) = L (a numerical integration from s)."""
         grid = self.grid
         return grid._search(grid.length, grid._value(grid.length, s) + self.length, s, s + self.tau)
+
+    def end(self, s: float) -> float:
+        """:meth:`end_of` where it must exist (every s has one: L is less than the perimeter)."""
+        t = self.end_of(s)
+        if t is None:
+            raise QueryError(f"no end with ℓ(s, t) = {self.length!r} mm from s = {s!r}: the h-grid is inconsistent")
+        return t
 
     def region_end(self, t: float) -> float:
         """The next inflection after t: t may not pass it within a mode."""
@@ -318,7 +332,7 @@ class _Marcher:
         return float(self.ss[int(np.searchsorted(self.zz, x, side="right")) - 1])
 
     # ------------------------------------------------------------------ modes
-    def modes(self) -> list:
+    def modes(self) -> list[tuple[float, float, float, float]]:
         """(sa, sb, sign of κ(s), sign of κ(t)) of each mode (Appendix): the starts cut where s or
         t = s+L meets an inflection."""
         grid, tau, h = self.grid, self.tau, self.h
@@ -342,7 +356,7 @@ class _Marcher:
             if b - a <= 0.5 * h:
                 continue
             mid = 0.5 * (a + b)
-            modes.append((float(a), float(b), self.sign_at(mid), self.sign_at(self.end_of(mid))))
+            modes.append((float(a), float(b), self.sign_at(mid), self.sign_at(self.end(mid))))
         return modes
 
     def march_mode(self, sa: float, sb: float, sgn: float) -> None:
@@ -356,7 +370,7 @@ class _Marcher:
             self.found.append(found)
             s = found[0] + self.eps
 
-    def _iterate(self, s: float, sb: float, sgn: float):
+    def _iterate(self, s: float, sb: float, sgn: float) -> _Found | None:
         """One march of (7) from start s: the segment it converges (or stalls) on, None when it leaves
         the mode."""
         grid, opt, length = self.grid, self.options, self.length
@@ -422,7 +436,7 @@ class _Marcher:
         """Φ along ℓ = L is monotone on a mixed mode: one root iff Φ brackets Ω."""
         grid, turn = self.grid, self.turn
         self.restarts += 1
-        ta, tb = self.end_of(sa), self.end_of(sb)
+        ta, tb = self.end(sa), self.end(sb)
         self.at(s=sa, t=ta)
         self.at(s=sb, t=tb)
         fa = grid.phi(sa, ta) - turn
@@ -433,7 +447,7 @@ class _Marcher:
         iterates = []
         for _it in range(200):
             mid = 0.5 * (lo + hi)
-            tm = self.end_of(mid)
+            tm = self.end(mid)
             self.at(s=mid, t=tm)
             fm = grid.phi(mid, tm) - turn
             iterates.append(mid)
@@ -447,6 +461,7 @@ class _Marcher:
 
     # ------------------------------------------------------------------ the whole march
     def run(self) -> MarchResult:
+        """March every mode and collect the segments."""
         for sa, sb, s_sign, t_sign in self.modes():
             if s_sign == t_sign:
                 self.march_mode(sa, sb, s_sign)
@@ -456,7 +471,7 @@ class _Marcher:
             segments=self.segments(), steps=self.steps, grid_cells=self.grid.cells, restarts=self.restarts
         )
 
-    def segments(self) -> list:
+    def segments(self) -> list[Segment]:
         """The segments found, sorted by start; a root found at the end of one mode and the start of
         the next is one root."""
         part, tau = self.part, self.tau

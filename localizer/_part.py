@@ -15,14 +15,18 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+from collections.abc import Hashable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ._errors import PartError
 from ._poly import bernstein_bounds, horner, poly_der, poly_mul
+from ._types import ArrayLike, FloatArray, IntArray
 
 __all__ = ["Part", "load_part", "part_from_points", "UNITS_TO_MM"]
 
@@ -37,12 +41,12 @@ _GL8_X, _GL8_W = np.polynomial.legendre.leggauss(8)
 _GL8_X, _GL8_W = 0.5 * (_GL8_X + 1.0), 0.5 * _GL8_W
 
 
-def _wrap(angle: np.ndarray) -> np.ndarray:
+def _wrap(angle: FloatArray) -> FloatArray:
     """Map angles to [-pi, pi)."""
     return (angle + np.pi) % _TWO_PI - np.pi
 
 
-def _curvature(dx, dy, ddx, ddy):
+def _curvature(dx: FloatArray, dy: FloatArray, ddx: FloatArray, ddy: FloatArray) -> FloatArray:
     """Signed curvature from first and second derivatives, 1/mm."""
     v2 = dx * dx + dy * dy
     return (dx * ddy - dy * ddx) / (v2 * np.sqrt(v2))
@@ -83,28 +87,28 @@ class Part:
     6.283185307179586
     """
 
-    points: np.ndarray
+    points: FloatArray
     name: str = "part"
     cells_per_piece: int = 4
     n_knots: int = field(init=False)
     perimeter: float = field(init=False)
     # the spline's polynomial coefficients per piece and its cell tables, built once here
-    _cx: np.ndarray = field(init=False, repr=False)  # x(u), ascending powers, (N, 4)
-    _cy: np.ndarray = field(init=False, repr=False)
-    _num: np.ndarray = field(init=False, repr=False)  # x'y'' − y'x''
-    _den: np.ndarray = field(init=False, repr=False)  # |α'|²
-    _dkappa: np.ndarray = field(init=False, repr=False)  # numerator of dκ/dt·den^2.5
-    _dcols: np.ndarray = field(init=False, repr=False)  # x', y' coefficients as rows (6, N)
-    _t_nodes: np.ndarray = field(init=False, repr=False)  # cell boundaries: parameter
-    _sig_nodes: np.ndarray = field(init=False, repr=False)  # ... arc position, mm
-    _theta_nodes: np.ndarray = field(init=False, repr=False)  # ... unwrapped tangent angle, rad
-    _dtds_nodes: np.ndarray = field(init=False, repr=False)  # ... dt/dσ, 1/mm
-    _kappa_abs: np.ndarray = field(init=False, repr=False)  # bound on |κ| per cell, 1/mm
+    _cx: FloatArray = field(init=False, repr=False)  # x(u), ascending powers, (N, 4)
+    _cy: FloatArray = field(init=False, repr=False)
+    _num: FloatArray = field(init=False, repr=False)  # x'y'' − y'x''
+    _den: FloatArray = field(init=False, repr=False)  # |α'|²
+    _dkappa: FloatArray = field(init=False, repr=False)  # numerator of dκ/dt·den^2.5
+    _dcols: FloatArray = field(init=False, repr=False)  # x', y' coefficients as rows (6, N)
+    _t_nodes: FloatArray = field(init=False, repr=False)  # cell boundaries: parameter
+    _sig_nodes: FloatArray = field(init=False, repr=False)  # ... arc position, mm
+    _theta_nodes: FloatArray = field(init=False, repr=False)  # ... unwrapped tangent angle, rad
+    _dtds_nodes: FloatArray = field(init=False, repr=False)  # ... dt/dσ, 1/mm
+    _kappa_abs: FloatArray = field(init=False, repr=False)  # bound on |κ| per cell, 1/mm
     _turning: float = field(init=False, repr=False)  # total turning, rad (2π for a simple outline)
     # tables the solvers and filters build per part (localizer._cache.per_part); freed with the part
-    _tables: dict = field(init=False, repr=False)
+    _tables: dict[tuple[str, Hashable], Any] = field(init=False, repr=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "_tables", {})
         pts = np.array(self.points, dtype=float)
         pts.setflags(write=False)
@@ -184,7 +188,9 @@ class Part:
     # ---------------------------------------------- evaluation for the solvers
     # The exact solver, the march, the arc tables and the disambiguation evaluate the spline
     # piece by piece through these four, and through nothing else of its inside.
-    def derivatives(self, piece, u) -> tuple:
+    def derivatives(
+        self, piece: IntArray | int, u: FloatArray | float
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """x', y', x'', y'' of spline pieces ``piece`` (int) at local parameters ``u`` in [0, 1]
         (broadcast), mm per unit parameter and per unit parameter squared."""
         c = self._dcols[:, piece]
@@ -192,7 +198,7 @@ class Part:
         dy = (c[5] * u + c[4]) * u + c[3]
         return dx, dy, 2.0 * c[2] * u + c[1], 2.0 * c[5] * u + c[4]
 
-    def curvature_slope(self, piece, u) -> np.ndarray:
+    def curvature_slope(self, piece: IntArray | int, u: FloatArray | float) -> FloatArray:
         """dκ/dσ, 1/mm², of spline pieces ``piece`` at local parameters ``u`` (broadcast)."""
         den = horner(self._den[piece], u)
         return horner(self._dkappa[piece], u) / (den * den * den)
@@ -207,12 +213,13 @@ class Part:
         72 MB per million cells); they are built again when next needed."""
         self._tables.clear()
 
-    def _speed_piece(self, piece, u):
+    def _speed_piece(self, piece: IntArray | int, u: FloatArray | float) -> FloatArray:
         c = self._dcols[:, piece]
-        return np.hypot((c[2] * u + c[1]) * u + c[0], (c[5] * u + c[4]) * u + c[3])
+        speed: FloatArray = np.hypot((c[2] * u + c[1]) * u + c[0], (c[5] * u + c[4]) * u + c[3])
+        return speed
 
     # --------------------------------------------------------------- locating
-    def _split(self, t):
+    def _split(self, t: ArrayLike) -> tuple[FloatArray, IntArray, FloatArray, IntArray]:
         """Unrolled parameter -> (lap, piece, u in [0, 1), cell index)."""
         t = np.asarray(t, dtype=float)
         n = self.n_knots
@@ -224,61 +231,63 @@ class Part:
         return lap, piece, u, cell
 
     # -------------------------------------------------------- functions of t
-    def point(self, t) -> np.ndarray:
+    def point(self, t: ArrayLike) -> FloatArray:
         """Boundary point at parameter ``t``; shape ``t.shape + (2,)``, mm."""
         _, piece, u, _ = self._split(t)
         return np.stack([horner(self._cx[piece], u), horner(self._cy[piece], u)], axis=-1)
 
-    def derivative(self, t) -> np.ndarray:
+    def derivative(self, t: ArrayLike) -> FloatArray:
         """Curve derivative dα/dt at ``t``; shape ``t.shape + (2,)``, mm per unit parameter."""
         _, piece, u, _ = self._split(t)
         dx, dy, _, _ = self.derivatives(piece, u)
         return np.stack([dx, dy], axis=-1)
 
-    def speed(self, t) -> np.ndarray:
+    def speed(self, t: ArrayLike) -> FloatArray:
         """Curve speed ``|dα/dt|`` at ``t``, mm per unit parameter."""
         _, piece, u, _ = self._split(t)
         return self._speed_piece(piece, u)
 
-    def tangent(self, t) -> np.ndarray:
+    def tangent(self, t: ArrayLike) -> FloatArray:
         """Unit tangent (counter-clockwise direction) at ``t``; shape ``t.shape + (2,)``."""
         d = self.derivative(t)
-        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+        unit: FloatArray = d / np.linalg.norm(d, axis=-1, keepdims=True)
+        return unit
 
-    def normal(self, t) -> np.ndarray:
+    def normal(self, t: ArrayLike) -> FloatArray:
         """Unit outward normal at ``t`` (the tangent turned clockwise)."""
         tg = self.tangent(t)
         return np.stack([tg[..., 1], -tg[..., 0]], axis=-1)
 
-    def tangent_angle(self, t) -> np.ndarray:
+    def tangent_angle(self, t: ArrayLike) -> FloatArray:
         """Unwrapped tangent angle θ(t), rad, at unrolled parameters ``t``: continuous, θ(t + N) = θ(t) + 2π."""
         lap, piece, u, cell = self._split(t)
         dx, dy, _, _ = self.derivatives(piece, u)
         return self._unwrap(np.arctan2(dy, dx), cell, lap)
 
-    def _unwrap(self, raw, cell, lap):
+    def _unwrap(self, raw: FloatArray, cell: IntArray, lap: FloatArray) -> FloatArray:
         """Unwrapped angle from atan2 ``raw``: the cell's start angle turns < 1 rad across the cell."""
         base = self._theta_nodes[cell]
         return base + _wrap(raw - base) + _TWO_PI * lap
 
-    def curvature(self, t) -> np.ndarray:
+    def curvature(self, t: ArrayLike) -> FloatArray:
         """Signed curvature κ(t), 1/mm, at unrolled parameters ``t``: positive where the boundary is convex."""
         _, piece, u, _ = self._split(t)
         return _curvature(*self.derivatives(piece, u))
 
-    def arc_at_param(self, t) -> np.ndarray:
+    def arc_at_param(self, t: ArrayLike) -> FloatArray:
         """Unrolled arc position Λ(t) = ℓ(0, t), mm, at unrolled parameters ``t`` (grows by the perimeter per lap)."""
         lap, piece, u, cell = self._split(t)
         return self._sig_nodes[cell] + self._partial_arc(piece, cell, u) + self.perimeter * lap
 
-    def _partial_arc(self, piece, cell, u):
+    def _partial_arc(self, piece: IntArray, cell: IntArray, u: FloatArray) -> FloatArray:
         """Arc length from the start of ``cell`` to ``u`` within ``piece``."""
         u0 = (cell - piece * self.cells_per_piece) / self.cells_per_piece
         w = u - u0
         uu = u0[..., None] + w[..., None] * _GL8_X
-        return (self._speed_piece(piece[..., None], uu) * _GL8_W).sum(axis=-1) * w
+        arc: FloatArray = (self._speed_piece(piece[..., None], uu) * _GL8_W).sum(axis=-1) * w
+        return arc
 
-    def arc_length(self, s, t) -> np.ndarray:
+    def arc_length(self, s: ArrayLike, t: ArrayLike) -> FloatArray:
         """Arc length ℓ(s, t) of the counter-clockwise stretch from ``s`` to ``t``, mm.
 
         Parameters are unrolled; when ``t < s`` the stretch wraps past the
@@ -289,7 +298,7 @@ class Part:
         laps = np.where(t < s, np.ceil((s - t) / self.n_knots), 0.0)
         return self.arc_at_param(t + laps * self.n_knots) - self.arc_at_param(s)
 
-    def total_curvature(self, s, t) -> np.ndarray:
+    def total_curvature(self, s: ArrayLike, t: ArrayLike) -> FloatArray:
         """Total curvature Φ(s, t) = ∫ κ dℓ of the stretch from ``s`` to ``t``, rad.
 
         Exact: the difference of unwrapped tangent angles. ``t < s`` wraps as
@@ -300,7 +309,7 @@ class Part:
         laps = np.where(t < s, np.ceil((s - t) / self.n_knots), 0.0)
         return self.tangent_angle(t + laps * self.n_knots) - self.tangent_angle(s)
 
-    def state(self, t) -> tuple:
+    def state(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Exact (unrolled arc position mm, unwrapped tangent angle rad, curvature 1/mm, speed mm per
         unit parameter) at unrolled parameters ``t``, in one pass."""
         lap, piece, u, cell = self._split(t)
@@ -310,7 +319,7 @@ class Part:
         return sigma, theta, _curvature(dx, dy, ddx, ddy), np.hypot(dx, dy)
 
     # ---------------------------------------------------- functions of arc
-    def param_at_arc(self, sigma, *, newton_steps: int = 2) -> np.ndarray:
+    def param_at_arc(self, sigma: ArrayLike, *, newton_steps: int = 2) -> FloatArray:
         """Unrolled parameter at unrolled arc position ``sigma`` (mm): the inverse of ℓ(0, ·), refined by
         ``newton_steps`` Newton steps.
 
@@ -319,7 +328,7 @@ class Part:
         """
         sigma = np.asarray(sigma, dtype=float)
         P = self.perimeter
-        lap = np.floor(sigma / P)
+        lap: FloatArray = np.floor(sigma / P)
         ss = sigma - lap * P
         nodes = self._sig_nodes
         ncell = len(nodes) - 1
@@ -334,7 +343,7 @@ class Part:
         d1 = self._dtds_nodes[cell + 1] * h
         # cubic Hermite in x on [0, 1] for t(sigma)
         x2, x3 = x * x, x * x * x
-        t = t0 + dt * (3 * x2 - 2 * x3) + d0 * (x3 - 2 * x2 + x) + d1 * (x3 - x2)
+        t: FloatArray = t0 + dt * (3 * x2 - 2 * x3) + d0 * (x3 - 2 * x2 + x) + d1 * (x3 - x2)
         piece = cell // m
         lo, hi = t0, t0 + dt
         target = ss - s0
@@ -344,33 +353,36 @@ class Part:
             t = np.clip(t - f / self._speed_piece(piece, u), lo, hi)
         return t + lap * self.n_knots
 
-    def point_at_arc(self, sigma) -> np.ndarray:
+    def point_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Boundary point at arc position ``sigma`` (mm); shape ``sigma.shape + (2,)``."""
         return self.point(self.param_at_arc(sigma))
 
-    def tangent_angle_at_arc(self, sigma) -> np.ndarray:
+    def tangent_angle_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Unwrapped tangent angle at arc position ``sigma``, rad (grows 2π per lap)."""
         return self.tangent_angle(self.param_at_arc(sigma))
 
-    def curvature_at_arc(self, sigma) -> np.ndarray:
+    def curvature_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Signed curvature at arc position ``sigma``, 1/mm."""
         return self.curvature(self.param_at_arc(sigma))
 
-    def wrap_arc(self, sigma) -> np.ndarray:
+    def wrap_arc(self, sigma: ArrayLike) -> FloatArray:
         """Arc positions ``sigma`` (mm) reduced to ``[0, perimeter)``."""
         w = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
         return np.where(w >= self.perimeter, 0.0, w)
 
-    def arc_offset(self, a, b) -> np.ndarray:
+    def arc_offset(self, a: ArrayLike, b: ArrayLike) -> FloatArray:
         """Signed shortest offset from arc position ``b`` to ``a`` around the boundary, mm.
 
         In ``[-perimeter/2, perimeter/2)``; its absolute value is the distance
         along the boundary.
         """
         half = 0.5 * self.perimeter
-        return np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
+        offset: FloatArray = (
+            np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
+        )
+        return offset
 
-    def sample(self, per_piece: int = 16) -> np.ndarray:
+    def sample(self, per_piece: int = 16) -> FloatArray:
         """Dense closed polyline of the boundary, ``per_piece`` points per spline piece, mm.
 
         Returns an array of shape (N*per_piece + 1, 2), its last point the first."""
@@ -379,7 +391,7 @@ class Part:
 
 
 # ------------------------------------------------------------------ loading
-def _check_points(points, source: str) -> np.ndarray:
+def _check_points(points: ArrayLike, source: str) -> FloatArray:
     try:
         pts = np.array(points, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -405,7 +417,7 @@ def _check_points(points, source: str) -> np.ndarray:
     return pts
 
 
-def _segments_cross(poly: np.ndarray):
+def _segments_cross(poly: FloatArray) -> tuple[int, int] | None:
     """First pair of non-adjacent crossing edges of a closed polyline, or None."""
     a = poly[:-1]
     b = poly[1:]
@@ -437,7 +449,7 @@ def _segments_cross(poly: np.ndarray):
     return None
 
 
-def part_from_points(points, *, name: str = "part", units: str = "mm", source: str | None = None) -> Part:
+def part_from_points(points: ArrayLike, *, name: str = "part", units: str = "mm", source: str | None = None) -> Part:
     """Validate a point list and build its :class:`Part`.
 
     Parameters
@@ -492,7 +504,7 @@ def part_from_points(points, *, name: str = "part", units: str = "mm", source: s
     return part
 
 
-def load_part(path) -> Part:
+def load_part(path: str | os.PathLike[str]) -> Part:
     """Read and validate a part file.
 
     Parameters

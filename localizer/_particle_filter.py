@@ -16,6 +16,7 @@ from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
 from ._tracks import tracks_for
+from ._types import BoolArray, FloatArray
 
 __all__ = ["ParticleFilter"]
 
@@ -60,7 +61,7 @@ class ParticleFilter:
         radius: float = SUCCESS_RADIUS,
         seed: int = 0,
         spacing: float = 0.02,
-    ):
+    ) -> None:
         if particles < 2:
             raise QueryError(f"particles={particles!r} must be at least 2")
         for name, value in (("sd_position", sd_position), ("radius", radius)):
@@ -88,7 +89,7 @@ class ParticleFilter:
         self._turn = 0.0
         self.steps = 0
 
-    def _advance(self, x, turn):
+    def _advance(self, x: FloatArray, turn: float) -> tuple[FloatArray, BoolArray]:
         """Move particles at arc x by a rotation ``turn`` along their convex stretch."""
         t = self.tracks
         i = np.minimum(np.rint(np.mod(x, self.part.perimeter) / t.h).astype(int), t.sigma.size - 1)
@@ -120,7 +121,7 @@ class ParticleFilter:
             self.x, self.rolled, self.offset = self.x[idx], self.rolled[idx], self.offset[idx]
             self.w = np.full(self.n, 1.0 / self.n)
 
-    def estimate(self) -> tuple:
+    def estimate(self) -> tuple[float, float]:
         """(most probable present contact mm, probability within the radius of it).
 
         The estimate is the particle with the most weight within ``radius`` around it.

@@ -8,10 +8,12 @@ from math import comb
 
 import numpy as np
 
+from ._types import FloatArray
+
 __all__ = ["horner", "poly_mul", "poly_der", "bernstein_bounds"]
 
 
-def horner(coef: np.ndarray, u: np.ndarray) -> np.ndarray:
+def horner(coef: FloatArray, u: FloatArray | float) -> FloatArray:
     """Evaluate polynomials ``coef`` (shape (..., n+1), ascending) at ``u`` (broadcast with ``coef[..., 0]``)."""
     out = coef[..., -1]
     for k in range(coef.shape[-1] - 2, -1, -1):
@@ -19,7 +21,7 @@ def horner(coef: np.ndarray, u: np.ndarray) -> np.ndarray:
     return out
 
 
-def poly_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def poly_mul(a: FloatArray, b: FloatArray) -> FloatArray:
     """Product of two stacks of ascending polynomials (shapes (M, p+1), (M, q+1))."""
     p, q = a.shape[-1], b.shape[-1]
     out = np.zeros(a.shape[:-1] + (p + q - 1,))
@@ -28,7 +30,7 @@ def poly_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def poly_der(a: np.ndarray) -> np.ndarray:
+def poly_der(a: FloatArray) -> FloatArray:
     """Derivative of a stack of ascending polynomials."""
     n = a.shape[-1]
     if n == 1:
@@ -36,7 +38,7 @@ def poly_der(a: np.ndarray) -> np.ndarray:
     return a[..., 1:] * np.arange(1, n)
 
 
-def bernstein_bounds(coef: np.ndarray, u0: np.ndarray, u1: np.ndarray):
+def bernstein_bounds(coef: FloatArray, u0: FloatArray, u1: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Guaranteed lower and upper bounds of polynomials over intervals.
 
     Parameters

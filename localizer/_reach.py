@@ -40,6 +40,7 @@ from scipy.spatial import ConvexHull
 from ._cache import per_part
 from ._errors import QueryError
 from ._part import Part
+from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc"]
 
@@ -56,7 +57,7 @@ class StraightJaw:
 
     length: float = 100.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not (math.isfinite(self.length) and self.length > 0):
             raise QueryError(f"jaw length={self.length!r} mm must be a positive number")
 
@@ -109,7 +110,9 @@ class Reach:
     (True, True)
     """
 
-    def __init__(self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2, clearance: float = 0.1):
+    def __init__(
+        self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2, clearance: float = 0.1
+    ) -> None:
         if not (math.isfinite(spacing) and spacing > 0):
             raise QueryError(f"spacing={spacing!r} mm must be a positive number")
         if not (math.isfinite(clearance) and clearance >= 0):
@@ -128,7 +131,7 @@ class Reach:
         for j0 in range(0, len(eq), 256):
             e = eq[j0 : j0 + 256]
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
-        self.hull_depth = np.maximum(-depth, 0.0)
+        self.hull_depth: FloatArray = np.maximum(-depth, 0.0)
         half = jaw.half
         c = self.clearance
         tiny = 1e-9 * max(1.0, float(np.ptp(pts)))  # rounding of the depth
@@ -159,21 +162,21 @@ class Reach:
             arr.setflags(write=False)
 
     @staticmethod
-    def _interval(w, block, half: float) -> tuple:
+    def _interval(w: FloatArray, block: BoolArray, half: float) -> tuple[FloatArray, FloatArray]:
         """(lo, hi) per row from the blocking points' places ``w`` along the tangent (module notes)."""
         w_plus = np.where(block & (w > 0), w, np.inf).min(axis=1)
         w_minus = np.where(block & (w < 0), w, -np.inf).max(axis=1)
         here = (block & (w == 0)).any(axis=1)
         return np.where(here, np.inf, half - w_plus), np.where(here, -np.inf, -half - w_minus)
 
-    def _bracket(self, arc) -> tuple:
+    def _bracket(self, arc: ArrayLike) -> tuple[IntArray, IntArray]:
         """Indices of the two grid points on either side of arc position(s) ``arc`` (mm)."""
         x = np.asarray(arc, dtype=float) / self.h
         i = np.floor(x).astype(np.int64)
         n = self.sigma.size
         return np.mod(i, n), np.mod(i + 1, n)
 
-    def interval(self, arc, sure: bool = False) -> tuple:
+    def interval(self, arc: ArrayLike, sure: bool = False) -> tuple[FloatArray, FloatArray]:
         """(lo, hi) jaw positions, mm, at which the jaw can touch at arc position(s) ``arc`` (mm).
 
         The generous interval (default) counts as blocking only points deeper than the
@@ -189,7 +192,7 @@ class Reach:
             return np.maximum(self.lo_sure[i], self.lo_sure[j]), np.minimum(self.hi_sure[i], self.hi_sure[j])
         return np.minimum(self.lo[i], self.lo[j]), np.maximum(self.hi[i], self.hi[j])
 
-    def touchable(self, arc, jaw=None, margin: float = 0.0) -> np.ndarray:
+    def touchable(self, arc: ArrayLike, jaw: ArrayLike | None = None, margin: float = 0.0) -> BoolArray:
         """Whether the jaw can touch at ``arc`` (mm) with the contact at jaw position ``jaw`` (mm).
 
         ``jaw`` None: at some place on the jaw. ``margin`` (mm) widens the interval (a measured
@@ -198,21 +201,25 @@ class Reach:
         lo, hi = self.interval(arc)
         half = self.jaw.half
         if jaw is None:
-            return np.maximum(lo, -half) - margin < np.minimum(hi, half) + margin
+            somewhere: BoolArray = np.maximum(lo, -half) - margin < np.minimum(hi, half) + margin
+            return somewhere
         d = np.asarray(jaw, dtype=float)
-        return (lo - margin < d) & (d < hi + margin) & (np.abs(d) <= half + margin)
+        there: BoolArray = (lo - margin < d) & (d < hi + margin) & (np.abs(d) <= half + margin)
+        return there
 
-    def clear(self, arc, jaw, margin: float = 0.0) -> np.ndarray:
+    def clear(self, arc: ArrayLike, jaw: ArrayLike, margin: float = 0.0) -> BoolArray:
         """Whether the jaw surely touches at ``arc`` (mm) with the contact at ``jaw`` (mm), with ``margin`` mm
         to spare on both sides (a roll there does not bridge)."""
         lo, hi = self.interval(arc, sure=True)
         d = np.asarray(jaw, dtype=float)
-        return (lo + margin < d) & (d < hi - margin) & (np.abs(d) <= self.jaw.half - margin)
+        surely: BoolArray = (lo + margin < d) & (d < hi - margin) & (np.abs(d) <= self.jaw.half - margin)
+        return surely
 
     @property
-    def full(self) -> np.ndarray:
+    def full(self) -> BoolArray:
         """Points the jaw surely touches at every place along it (as the calibration's taps need)."""
-        return (self.lo_sure <= -self.jaw.half) & (self.hi_sure >= self.jaw.half)
+        whole_jaw: BoolArray = (self.lo_sure <= -self.jaw.half) & (self.hi_sure >= self.jaw.half)
+        return whole_jaw
 
 
 def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, clearance: float = 0.1) -> Reach:

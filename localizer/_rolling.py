@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from ._errors import QueryError
+from ._types import ArrayLike
 
 __all__ = ["arc_from_jaw_positions"]
 
 
-def arc_from_jaw_positions(positions, step: float, offset: float = 0.0) -> float:
+def arc_from_jaw_positions(positions: ArrayLike, step: float, offset: float = 0.0) -> float:
     """Arc length rolled over on the part, from contact locations on the jaw, mm.
 
     The rolling strategy rotates the jaw by ``step`` about the tool axis, then

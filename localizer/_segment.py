@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 __all__ = ["Segment", "DIRECTIONS", "KINDS"]
 
@@ -59,10 +60,10 @@ class Segment:
     kind: str = "simple"
     span: float = 0.0
     residual: float = 0.0
-    iterates: tuple = ()
+    iterates: tuple[float, ...] = ()
     iterations: int = 0
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain-JSON form."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         d["iterates"] = list(self.iterates)

@@ -31,6 +31,7 @@ Bracketed roots are refined together by a safeguarded Newton iteration to
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -48,14 +49,16 @@ METHODS = ("exact", "march")
 
 
 # ---------------------------------------------------------------- evaluators
-def _g_table(table: ArcTable, sigma, length, turn):
+def _g_table(table: ArcTable, sigma: np.ndarray, length: float, turn: float) -> tuple[np.ndarray, np.ndarray]:
     """Tabulated g and g' at arc positions ``sigma``."""
     th_s, k_s = table.theta_kappa(sigma)
     th_e, k_e = table.theta_kappa(sigma + length)
     return th_e - th_s - turn, k_e - k_s
 
 
-def _g_exact(part: Part, sigma, length, turn):
+def _g_exact(
+    part: Part, sigma: np.ndarray, length: float, turn: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Exact g, g' and the parameters of both ends at arc positions ``sigma``."""
     ts = part.param_at_arc(sigma)
     te = part.param_at_arc(sigma + length)
@@ -64,7 +67,9 @@ def _g_exact(part: Part, sigma, length, turn):
     return th_e - th_s - turn, k_e - k_s, ts, te
 
 
-def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
+def _polish(
+    part: Part, table: ArcTable, sigma: np.ndarray, length: float, turn: float, tol: float, max_iter: int = 6
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Newton on the exact system ℓ(s, e) = L, Φ(s, e) = Ω in the spline parameters.
 
     Starts from the tabulated parameters of a root of the tabulated g; each
@@ -93,7 +98,7 @@ def _polish(part: Part, table: ArcTable, sigma, length, turn, tol, max_iter=6):
 
 
 # ------------------------------------------------------------------ checks
-def _check_query(part: Part, length, turn, direction: str, method: str):
+def _check_query(part: Part, length: float, turn: float, direction: str, method: str) -> tuple[float, float]:
     if not isinstance(part, Part):
         raise QueryError(f"part must be a localizer.Part (use load_part), got {type(part).__name__}")
     if method not in METHODS:
@@ -150,7 +155,9 @@ class ExactOptions:
 EXACT = ExactOptions()
 
 
-def _solve_ccw(part: Part, length: float, turn: float, options: ExactOptions):
+def _solve_ccw(
+    part: Part, length: float, turn: float, options: ExactOptions
+) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None, np.ndarray, list[tuple[float, float]]]:
     """Roots of g on [0, P) for counter-clockwise travel.
 
     Returns (simple_roots, double_roots, continua): arrays of start arc
@@ -252,7 +259,7 @@ def _solve_ccw(part: Part, length: float, turn: float, options: ExactOptions):
     return zeros, joined, double_roots, continua
 
 
-def _hermite_root(g0, g1, d0, d1, iterations=2):
+def _hermite_root(g0: np.ndarray, g1: np.ndarray, d0: np.ndarray, d1: np.ndarray, iterations: int = 2) -> np.ndarray:
     """Root in [0, 1] of the cubic Hermite through (0, g0, d0) and (1, g1, d1); g0·g1 < 0.
 
     Newton on the cubic from the secant point, kept inside [0, 1].
@@ -267,7 +274,9 @@ def _hermite_root(g0, g1, d0, d1, iterations=2):
     return np.where(np.isfinite(x), np.clip(x, 0.0, 1.0), 0.5)
 
 
-def _roots_from_brackets(part, table, brackets, length, turn, tol):
+def _roots_from_brackets(
+    part: Part, table: ArcTable, brackets: tuple[np.ndarray, ...], length: float, turn: float, tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Exact roots in certified single-root brackets.
 
     The start point is the root of the cubic Hermite interpolant of g on the
@@ -290,7 +299,14 @@ def _roots_from_brackets(part, table, brackets, length, turn, tol):
     return lam, ps, pe, ok & ~dbl, res
 
 
-def _refine(fun, lo, hi, glo, ghi, tol):
+def _refine(
+    fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+    lo: np.ndarray,
+    hi: np.ndarray,
+    glo: np.ndarray,
+    ghi: np.ndarray,
+    tol: float,
+) -> np.ndarray:
     """Safeguarded Newton on bracketed roots, all at once, to ``tol`` mm.
 
     A Newton step that leaves the bracket is replaced by the secant of the
@@ -298,7 +314,7 @@ def _refine(fun, lo, hi, glo, ghi, tol):
     """
     lo, hi, glo, ghi = lo.copy(), hi.copy(), glo.copy(), ghi.copy()
     with np.errstate(divide="ignore", invalid="ignore"):
-        x = lo - glo * (hi - lo) / (ghi - glo)
+        x: np.ndarray = lo - glo * (hi - lo) / (ghi - glo)
     x = np.where(np.isfinite(x) & (x > lo) & (x < hi), x, 0.5 * (lo + hi))
     active = np.ones(x.shape, bool)
     for _ in range(100):
@@ -331,7 +347,8 @@ def _refine(fun, lo, hi, glo, ghi, tol):
     return x
 
 
-def _merge_flats(cells: np.ndarray, P: float):
+def _merge_flats(cells: np.ndarray, P: float) -> list[tuple[float, float]]:
+    """Overlapping flat cells (start, end) merged, across σ = 0 too: (start, span) pairs, mm."""
     if len(cells) == 0:
         return []
     cells = cells[np.argsort(cells[:, 0])]
@@ -356,7 +373,7 @@ def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
     if x.size < 2:
         return np.arange(x.size)
     xm = np.mod(x, P)
-    order = np.argsort(xm, kind="stable")
+    order: np.ndarray = np.argsort(xm, kind="stable")
     xs = xm[order]
     gaps = np.diff(xs)
     if gaps.min() > sep and xs[0] + P - xs[-1] > sep:  # the usual case: nothing to merge
@@ -364,7 +381,8 @@ def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
     keep = np.concatenate([[True], gaps > sep])
     if keep.sum() > 1 and xs[0] + P - xs[np.flatnonzero(keep)[-1]] <= sep:
         keep[np.flatnonzero(keep)[-1]] = False
-    return order[keep]
+    kept: np.ndarray = order[keep]
+    return kept
 
 
 def feasible_segments(

@@ -16,6 +16,7 @@ import numpy as np
 from ._cache import per_part
 from ._part import _TWO_PI, Part, _curvature, _wrap
 from ._poly import bernstein_bounds, horner
+from ._types import ArrayLike, FloatArray, IntArray
 
 __all__ = ["ArcTable", "arc_table"]
 
@@ -59,28 +60,28 @@ class ArcTable:
     """
 
     perimeter: float
-    sig: np.ndarray
-    h: np.ndarray
-    theta: np.ndarray
-    dtheta: np.ndarray
-    param: np.ndarray
-    kappa_slope: np.ndarray
+    sig: FloatArray
+    h: FloatArray
+    theta: FloatArray
+    dtheta: FloatArray
+    param: FloatArray
+    kappa_slope: FloatArray
     theta_error: float
     param_error: float
-    theta_cols: np.ndarray = field(init=False, repr=False)
-    kappa_cols: np.ndarray = field(init=False, repr=False)
-    param_cols: np.ndarray = field(init=False, repr=False)
-    _inv_h: np.ndarray = field(init=False, repr=False)
+    theta_cols: FloatArray = field(init=False, repr=False)
+    kappa_cols: FloatArray = field(init=False, repr=False)
+    param_cols: FloatArray = field(init=False, repr=False)
+    _inv_h: FloatArray = field(init=False, repr=False)
     _last: int = field(init=False, repr=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "theta_cols", np.ascontiguousarray(self.theta.T))
         object.__setattr__(self, "kappa_cols", np.ascontiguousarray(self.dtheta.T))
         object.__setattr__(self, "param_cols", np.ascontiguousarray(self.param.T))
         object.__setattr__(self, "_inv_h", 1.0 / self.h)
         object.__setattr__(self, "_last", len(self.h) - 1)
 
-    def locate(self, sigma):
+    def locate(self, sigma: ArrayLike) -> tuple[FloatArray, IntArray, FloatArray]:
         """(lap, cell, x) for unrolled arc positions."""
         sigma = np.asarray(sigma, dtype=float)
         lap = np.floor(sigma * (1.0 / self.perimeter))
@@ -90,11 +91,11 @@ class ArcTable:
         x = (ss - self.sig[cell]) * self._inv_h[cell]
         return lap, cell, x
 
-    def theta_kappa(self, sigma):
+    def theta_kappa(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """Tabulated unwrapped tangent angle (rad) and curvature (1/mm) at ``sigma``."""
         return self.theta_kappa_cell(sigma)[:2]
 
-    def theta_kappa_cell(self, sigma):
+    def theta_kappa_cell(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray, IntArray]:
         """As :meth:`theta_kappa`, plus the table cell of each point."""
         lap, cell, x = self.locate(sigma)
         c = self.theta_cols
@@ -107,7 +108,7 @@ class ArcTable:
             ka = ka * x + c[k][cell]
         return th + _TWO_PI * lap, ka, cell
 
-    def param_at(self, sigma):
+    def param_at(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """Tabulated unrolled spline parameter at ``sigma`` (add ``lap * N`` outside)."""
         lap, cell, x = self.locate(sigma)
         c = self.param_cols
@@ -117,7 +118,9 @@ class ArcTable:
         return t, lap
 
 
-def _node_state(part: Part, piece, u):
+def _node_state(
+    part: Part, piece: IntArray, u: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """θ, κ, dκ/dσ, t, dt/dσ, d²t/dσ² from one spline piece at u (one-sided at knots)."""
     dx, dy, ddx, ddy = part.derivatives(piece, u)
     v2 = dx * dx + dy * dy

@@ -10,6 +10,7 @@ import numpy as np
 from ._cache import per_part
 from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
+from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = ["ModeTracks", "tracks_for"]
 
@@ -47,13 +48,14 @@ class ModeTracks:
         The jaw whose reach is tabulated.
     """
 
-    def __init__(self, part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW):
+    def __init__(self, part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> None:
         self.part = part
         self.jaw = jaw
         p = part.perimeter
         n = max(64, int(math.ceil(p / spacing)))
         self.h = p / n
-        sigma = np.arange(n) * self.h
+        # typed float64 (np.asarray is a no-op here: the product is float64 already)
+        sigma: FloatArray = np.asarray(np.arange(n) * self.h, dtype=float)
         theta = np.asarray(part.tangent_angle_at_arc(sigma), dtype=float)
         kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
         self.sigma, self.theta, self.kappa = sigma, theta, kappa
@@ -89,7 +91,7 @@ class ModeTracks:
         self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
         self.lo_sure, self.hi_sure = (np.array(v) for v in self.reach.interval(sigma, sure=True))
         self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
-        self.convex = rising[a][self._run] & (kappa > 0) & self.touchable
+        self.convex: BoolArray = rising[a][self._run] & (kappa > 0) & self.touchable
         for arr in (
             self.sigma,
             self.theta,
@@ -108,7 +110,9 @@ class ModeTracks:
         ):
             arr.setflags(write=False)
 
-    def advance(self, index: np.ndarray, turn, *, turn_margin: float = 0.0) -> tuple:
+    def advance(
+        self, index: IntArray, turn: FloatArray | float, *, turn_margin: float = 0.0
+    ) -> tuple[FloatArray, BoolArray]:
         """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``, along their
         convex stretches (no check of where the jaw reaches: :meth:`touches`, :meth:`roll`).
 
@@ -142,7 +146,9 @@ class ModeTracks:
         arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
         return np.where(ok, arc, np.nan), ok
 
-    def touches(self, arc, jaw=None, margin: float = 0.0, sure: bool = False) -> np.ndarray:
+    def touches(
+        self, arc: ArrayLike, jaw: ArrayLike | None = None, margin: float = 0.0, sure: bool = False
+    ) -> BoolArray:
         """Whether the jaw can touch at arc positions ``arc`` (mm, unwrapped; nan: no) with the contact
         at jaw position(s) ``jaw`` (mm; None: at some place on the jaw), within ``margin`` mm (negative:
         with that much to spare). ``sure`` takes the reach's sure interval (:meth:`Reach.interval`)."""
@@ -150,14 +156,25 @@ class ModeTracks:
         finite = np.isfinite(arc)
         land = np.mod(np.rint(np.where(finite, arc, 0.0) / self.h).astype(np.int64), self.sigma.size)
         if jaw is None:
-            return finite & self.touchable[land]
+            somewhere: BoolArray = finite & self.touchable[land]
+            return somewhere
         lo, hi = (self.lo_sure, self.hi_sure) if sure else (self.lo, self.hi)
         d = np.asarray(jaw, dtype=float)
-        return finite & (lo[land] - margin < d) & (d < hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
+        there: BoolArray = (
+            finite & (lo[land] - margin < d) & (d < hi[land] + margin) & (np.abs(d) <= self.jaw.half + margin)
+        )
+        return there
 
     def roll(
-        self, index: np.ndarray, turn, *, jaw=None, at=None, margin: float = 0.0, turn_margin: float = 0.0
-    ) -> tuple:
+        self,
+        index: IntArray,
+        turn: FloatArray | float,
+        *,
+        jaw: ArrayLike | None = None,
+        at: ArrayLike | None = None,
+        margin: float = 0.0,
+        turn_margin: float = 0.0,
+    ) -> tuple[FloatArray, BoolArray]:
         """:meth:`advance` the hypotheses ``index`` (grid indices) by net rotation ``turn`` (rad, at most
         ``turn_margin`` rad past a convex stretch's end), and the landing must be touchable.
 
@@ -174,11 +191,11 @@ class ModeTracks:
         ok = ok & self.touches(arc, jaw, margin)
         return np.where(ok, arc, np.nan), ok
 
-    def rollable(self, turns, jaw: float, margin: float = 0.0) -> np.ndarray:
+    def rollable(self, turns: ArrayLike, jaw: float, margin: float = 0.0) -> BoolArray:
         """Grid points from which the jaw, laid with the contact at ``jaw`` (mm on it), can roll through
         every net rotation of ``turns`` (rad, in order, one sign) without bridging, with ``margin``
         mm to spare on the jaw all along (boolean mask over the grid)."""
-        ok = self.convex & self.touches(self.sigma, jaw, -margin, sure=True)
+        ok: BoolArray = self.convex & self.touches(self.sigma, jaw, -margin, sure=True)
         for t in np.atleast_1d(np.asarray(turns, dtype=float)):
             idx = np.flatnonzero(ok)
             arc, moved = self.advance(idx, float(t))
