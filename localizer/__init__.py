@@ -6,8 +6,10 @@ from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TU
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
+from ._outline import Corner, Outline, outline_from_pieces
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
 from ._particle_filter import ParticleFilter
+from ._pieces import CircularArc, CubicBezier, Line
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._segment import DIRECTIONS, Segment
@@ -15,6 +17,12 @@ from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
 from ._tracks import ModeTracks, tracks_for
 
 __all__ = [
+    "Line",
+    "CircularArc",
+    "CubicBezier",
+    "Outline",
+    "Corner",
+    "outline_from_pieces",
     "LENGTH_TOL",
     "TURN_TOL",
     "MIN_SEPARATION",

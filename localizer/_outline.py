@@ -1,0 +1,217 @@
+"""A closed outline made of exact pieces, with corners: the geometry of a part drawn in CAD.
+
+The pieces (:mod:`localizer._pieces`) are chained end to start; the outline is counter-clockwise
+(a clockwise chain is reversed, its first point kept first) and its arc position σ runs from the
+first piece's start over [0, perimeter). The unwrapped tangent angle θ(σ) is continuous along a
+piece and jumps at a **corner** by the exterior angle (positive: a convex corner, where a straight
+jaw pivots; negative: a concave one, which a straight jaw cannot touch). At a corner's arc position
+θ is the value after the corner; :meth:`Outline.tangent_angle_at_arc` with ``side="before"`` gives
+the value before it. Over one lap θ grows by 2π, jumps included.
+
+This is the geometry only; issue 16 plugs it into the solver, the filter and the rigs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from ._errors import PartError
+from ._part import _segments_cross
+from ._pieces import Piece
+from ._types import ArrayLike, FloatArray
+
+__all__ = ["Outline", "Corner", "outline_from_pieces"]
+
+#: Two pieces meet when the end of one is this close to the start of the next, mm, and a tangent
+#: that turns by less than this, rad, across a meeting point is smooth there (no corner).
+JOIN_TOL = 1e-6
+SMOOTH_TOL = 1e-9
+
+
+class Corner(NamedTuple):
+    """Where the tangent jumps: the arc position (mm) and the exterior angle (rad; > 0 convex)."""
+
+    arc: float
+    angle: float
+
+
+@dataclass(frozen=True, eq=False)
+class Outline:
+    """A closed counter-clockwise chain of exact pieces (build one with :func:`outline_from_pieces`).
+
+    Attributes
+    ----------
+    pieces : tuple of Line, CircularArc, CubicBezier
+        In order, each starting where the previous one ends.
+    name : str
+    perimeter : float, mm
+    corners : tuple of Corner
+        The points where the tangent jumps, by arc position.
+    starts : ndarray, shape (n + 1,), mm
+        Arc position of each piece's start, and the perimeter.
+    """
+
+    pieces: tuple[Piece, ...]
+    name: str = "outline"
+    perimeter: float = field(init=False)
+    corners: tuple[Corner, ...] = field(init=False)
+    starts: FloatArray = field(init=False, repr=False)
+    _theta0: FloatArray = field(init=False, repr=False)  # unwrapped θ at each piece's start (after its corner)
+
+    def __post_init__(self) -> None:
+        lengths = np.array([p.length for p in self.pieces])
+        starts = np.concatenate([[0.0], np.cumsum(lengths)])
+        object.__setattr__(self, "starts", starts)
+        object.__setattr__(self, "perimeter", float(starts[-1]))
+        theta0 = np.empty(len(self.pieces))
+        corners = []
+        theta = float(self.pieces[0].tangent_angle(0.0))
+        for i, piece in enumerate(self.pieces):
+            local0 = float(piece.tangent_angle(0.0))
+            if i > 0:
+                jump = float(_wrap_scalar(local0 - theta))
+                if abs(jump) > SMOOTH_TOL:
+                    corners.append(Corner(float(starts[i]), jump))
+                theta += jump
+            theta0[i] = theta
+            theta += float(piece.tangent_angle(piece.length)) - local0
+        jump = float(_wrap_scalar(float(self.pieces[0].tangent_angle(0.0)) - theta))
+        if abs(jump) > SMOOTH_TOL:
+            corners.insert(0, Corner(0.0, jump))
+        object.__setattr__(self, "_theta0", theta0)
+        object.__setattr__(self, "corners", tuple(corners))
+
+    @property
+    def turning(self) -> float:
+        """Total turning over one lap, jumps included, rad (2π for a simple counter-clockwise outline)."""
+        last = self.pieces[-1]
+        end = self._theta0[-1] + float(last.tangent_angle(last.length)) - float(last.tangent_angle(0.0))
+        first_corner = self.corners[0].angle if self.corners and self.corners[0].arc == 0.0 else 0.0
+        return float(end + first_corner - self._theta0[0])
+
+    def _locate(self, sigma: ArrayLike) -> tuple[FloatArray, np.ndarray, FloatArray]:
+        """(laps, piece index, arc within the piece) of unrolled arc positions ``sigma`` (mm)."""
+        s = np.asarray(sigma, dtype=float)
+        lap = np.floor(s / self.perimeter)
+        ss = s - lap * self.perimeter
+        k = np.clip(np.searchsorted(self.starts, ss, side="right") - 1, 0, len(self.pieces) - 1)
+        local: FloatArray = ss - self.starts[k]
+        return lap, k, local
+
+    def point_at_arc(self, sigma: ArrayLike) -> FloatArray:
+        """Points at arc positions ``sigma`` (mm, any real: wraps), shape (..., 2), mm."""
+        _, k, local = self._locate(sigma)
+        out = np.empty(np.shape(local) + (2,))
+        for i in np.unique(k):
+            sel = k == i
+            out[sel] = self.pieces[int(i)].point(local[sel])
+        return out
+
+    def tangent_angle_at_arc(self, sigma: ArrayLike, side: str = "after") -> FloatArray:
+        """Unwrapped tangent angle θ at arc positions ``sigma`` (mm), rad: θ(σ + P) = θ(σ) + 2π. At a
+        corner ``side`` says which value: ``"after"`` (default) or ``"before"`` the jump."""
+        if side not in ("after", "before"):
+            raise PartError(f"side={side!r}: use 'after' or 'before'")
+        lap, k, local = self._locate(sigma)
+        out = np.empty(np.shape(local))
+        for i in np.unique(k):
+            sel = k == i
+            piece = self.pieces[int(i)]
+            out[sel] = self._theta0[int(i)] + piece.tangent_angle(local[sel]) - float(piece.tangent_angle(0.0))
+        out = out + 2.0 * np.pi * lap
+        if side == "before" and self.corners:
+            arcs = np.array([c.arc for c in self.corners])
+            angles = np.array([c.angle for c in self.corners])
+            s = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
+            at = np.abs(s[..., None] - arcs) <= 1e-12 * max(1.0, self.perimeter)
+            out = out - (at * angles).sum(axis=-1)
+        result: FloatArray = out
+        return result
+
+    def curvature_at_arc(self, sigma: ArrayLike) -> FloatArray:
+        """Signed curvature at arc positions ``sigma`` (mm), 1/mm (zero on lines, ±1/r on arcs)."""
+        _, k, local = self._locate(sigma)
+        out = np.empty(np.shape(local))
+        for i in np.unique(k):
+            sel = k == i
+            out[sel] = self.pieces[int(i)].curvature(local[sel])
+        return out
+
+    def sample(self, spacing: float = 0.5) -> FloatArray:
+        """A closed polyline through the outline every ``spacing`` mm or less (every piece's ends
+        included), shape (M + 1, 2), mm, its last point the first."""
+        pts = []
+        for piece in self.pieces:
+            n = max(2, int(math.ceil(piece.length / spacing)))
+            pts.append(piece.point(np.linspace(0.0, piece.length, n + 1)[:-1]))
+        poly = np.concatenate(pts)
+        out: FloatArray = np.vstack([poly, poly[:1]])
+        return out
+
+
+def _wrap_scalar(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def outline_from_pieces(pieces: list[Piece] | tuple[Piece, ...], *, name: str = "outline") -> Outline:
+    """The closed outline of ``pieces`` chained in order, made counter-clockwise.
+
+    Parameters
+    ----------
+    pieces : sequence of Line, CircularArc, CubicBezier
+        Each must start where the previous one ends (within :data:`JOIN_TOL` mm), and the last
+        end where the first starts.
+    name : str
+        For messages and plots.
+
+    Raises
+    ------
+    PartError
+        No pieces, a gap between pieces (which, where, how wide), an outline that crosses itself,
+        or one that does not turn once.
+
+    Examples
+    --------
+    A 40 × 20 mm rectangle with 5 mm fillets, drawn clockwise: made counter-clockwise, first point
+    kept.
+
+    >>> import math
+    >>> from localizer import CircularArc, Line
+    >>> r, w, h = 5.0, 40.0, 20.0
+    >>> pieces = [Line((r, 0), (w - r, 0)), CircularArc((w - r, r), r, -math.pi / 2, math.pi / 2),
+    ...           Line((w, r), (w, h - r)), CircularArc((w - r, h - r), r, 0.0, math.pi / 2),
+    ...           Line((w - r, h), (r, h)), CircularArc((r, h - r), r, math.pi / 2, math.pi / 2),
+    ...           Line((0, h - r), (0, r)), CircularArc((r, r), r, math.pi, math.pi / 2)]
+    >>> o = outline_from_pieces([p.reversed() for p in reversed(pieces)])
+    >>> round(o.perimeter, 9) == round(2 * (w + h) - 8 * r + 2 * math.pi * r, 9), o.corners
+    (True, ())
+    >>> [round(float(v), 6) for v in o.point_at_arc(0.0)], round(o.turning, 12) == round(2 * math.pi, 12)
+    ([5.0, 0.0], True)
+    """
+    pieces = tuple(pieces)
+    if not pieces:
+        raise PartError(f"outline {name!r}: no pieces")
+    for i, piece in enumerate(pieces):
+        nxt = pieces[(i + 1) % len(pieces)]
+        gap = math.dist(piece.end, nxt.start)
+        if gap > JOIN_TOL:
+            raise PartError(
+                f"outline {name!r}: piece {i} ends at {piece.end} but piece {(i + 1) % len(pieces)} starts at "
+                f"{nxt.start}, {gap:.3g} mm away (more than {JOIN_TOL} mm): the outline is not closed there"
+            )
+    outline = Outline(pieces, name)
+    poly = outline.sample(max(outline.perimeter / 4000.0, 1e-3))
+    crossing = _segments_cross(poly)
+    if crossing is not None:
+        where = poly[crossing[0]]
+        raise PartError(f"outline {name!r} crosses itself near ({where[0]:.3f}, {where[1]:.3f}) mm")
+    turning = outline.turning
+    if abs(abs(turning) - 2.0 * math.pi) > 1e-6:
+        raise PartError(f"outline {name!r} turns by {turning:.6f} rad, not one full turn: not a simple closed outline")
+    if turning < 0:  # clockwise: travel it the other way, from the same first point
+        outline = Outline(tuple(p.reversed() for p in reversed(pieces)), name)
+    return outline
