@@ -1,6 +1,7 @@
 """Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
 
 from ._belief import Belief, Mode
+from ._cad import CAD_SUFFIXES, load_outline
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, ContactFilter
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
 from ._disambiguate import RULES, Candidate, Localization, localize
@@ -23,6 +24,8 @@ __all__ = [
     "Outline",
     "Corner",
     "outline_from_pieces",
+    "load_outline",
+    "CAD_SUFFIXES",
     "LENGTH_TOL",
     "TURN_TOL",
     "MIN_SEPARATION",

@@ -51,12 +51,15 @@ class Outline:
     perimeter : float, mm
     corners : tuple of Corner
         The points where the tangent jumps, by arc position.
+    ignored : tuple of str
+        What the file the outline was read from held besides it (other loops, text, layers).
     starts : ndarray, shape (n + 1,), mm
         Arc position of each piece's start, and the perimeter.
     """
 
     pieces: tuple[Piece, ...]
     name: str = "outline"
+    ignored: tuple[str, ...] = ()
     perimeter: float = field(init=False)
     corners: tuple[Corner, ...] = field(init=False)
     starts: FloatArray = field(init=False, repr=False)

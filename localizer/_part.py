@@ -526,6 +526,11 @@ def load_part(path: str | os.PathLike[str]) -> Part:
     """
     path = Path(path)
     src = str(path)
+    if path.suffix.lower() in (".dxf", ".svg"):
+        raise PartError(
+            f"{src}: a CAD outline; read it with localizer.load_outline (localizing on outlines with corners "
+            "is not built yet: issue 16)"
+        )
     try:
         text = path.read_text()
     except OSError as exc:

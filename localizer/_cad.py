@@ -1,0 +1,380 @@
+"""Outlines read from CAD files: DXF (ezdxf) and SVG (svgelements), as exact pieces.
+
+Conventions (docs/cad.md): millimetres; y up (an SVG's y axis points down and is flipped, so the
+part is not mirrored); the outline is the outer closed loop, the one of largest area, unless a DXF
+layer or an SVG element id is named; the first point is the first vertex of the DXF entity or the
+first ``M`` of the SVG path the loop starts with. Everything else in the file (holes, text,
+dimensions, other layers) is ignored and listed in :attr:`localizer.Outline.ignored`.
+
+The readers are imported only when a CAD file is read: ``import localizer`` needs neither.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._errors import PartError
+from ._outline import JOIN_TOL, Outline, outline_from_pieces
+from ._pieces import CircularArc, CubicBezier, Line, Piece
+
+__all__ = ["load_outline", "CAD_SUFFIXES"]
+
+#: File suffixes read as CAD outlines.
+CAD_SUFFIXES = (".dxf", ".svg")
+#: DXF ``$INSUNITS`` codes and their size in mm (0, unitless, is taken as mm).
+DXF_UNITS = {0: 1.0, 1: 25.4, 2: 304.8, 4: 1.0, 5: 10.0, 6: 1000.0, 13: 1e-3}
+#: SVG length units in mm.
+SVG_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4, "pt": 25.4 / 72.0, "pc": 25.4 / 6.0, "px": 25.4 / 96.0, "": None}
+#: DXF entities that are not part of an outline: skipped and reported.
+DXF_NOTES = {
+    "TEXT",
+    "MTEXT",
+    "DIMENSION",
+    "HATCH",
+    "INSERT",
+    "POINT",
+    "LEADER",
+    "MLEADER",
+    "ATTDEF",
+    "SOLID",
+    "VIEWPORT",
+}
+
+
+def load_outline(path: str | Path, *, layer: str | None = None, element: str | None = None) -> Outline:
+    """The outline of the CAD file at ``path`` (``.dxf`` or ``.svg``), in mm, counter-clockwise.
+
+    Parameters
+    ----------
+    path : str or Path
+    layer : str, optional
+        DXF only: read the outline from this layer (default: every layer).
+    element : str, optional
+        SVG only: read the outline from the element with this id (default: every path and shape).
+
+    Raises
+    ------
+    PartError
+        Unreadable file, unknown units, an entity kind that cannot be read exactly (named), a
+        zero-length piece, no closed loop, several largest loops of equal area, a loop that
+        crosses itself.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".dxf":
+        if element is not None:
+            raise PartError(f"{path}: element={element!r} is for SVG files; a DXF names a layer")
+        loops, ignored = _read_dxf(path, layer)
+    elif suffix == ".svg":
+        if layer is not None:
+            raise PartError(f"{path}: layer={layer!r} is for DXF files; an SVG names an element id")
+        loops, ignored = _read_svg(path, element)
+    else:
+        raise PartError(f"{path}: not a CAD file (use one of {list(CAD_SUFFIXES)})")
+    chosen, rest = _outer(loops, str(path))
+    if rest:
+        ignored.append(f"{rest} other closed loop(s) (holes or other outlines)")
+    outline = outline_from_pieces(chosen, name=path.stem)
+    return Outline(outline.pieces, outline.name, ignored=tuple(ignored))
+
+
+# ------------------------------------------------------------------ DXF
+def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[str]]:
+    try:
+        from ezdxf.filemanagement import readfile
+        from ezdxf.lldxf.const import DXFError
+    except ImportError:  # pragma: no cover - a dependency of the package
+        raise PartError("reading DXF needs ezdxf: pip install ezdxf") from None
+    try:
+        doc = readfile(str(path))
+    except (OSError, DXFError) as exc:
+        raise PartError(f"{path}: cannot read the DXF file ({exc})") from None
+    code = int(doc.header.get("$INSUNITS", 0))
+    if code not in DXF_UNITS:
+        raise PartError(f"{path}: $INSUNITS={code} is not a length unit rolltouch reads (use mm, cm, m, in, ft or µm)")
+    k = DXF_UNITS[code]
+    msp = doc.modelspace()
+    layers = {e.dxf.layer for e in msp}
+    if layer is not None and layer not in layers:
+        raise PartError(f"{path}: no entity on layer {layer!r}; layers: {sorted(layers)}")
+    pieces: list[Piece] = []
+    loops: list[list[Piece]] = []
+    ignored: list[str] = []
+    for e in msp:
+        kind = e.dxftype()
+        if layer is not None and e.dxf.layer != layer:
+            ignored.append(f"{kind} on layer {e.dxf.layer!r}")
+            continue
+        if kind in DXF_NOTES:
+            ignored.append(f"{kind} on layer {e.dxf.layer!r}")
+            continue
+        where = f"{path}: {kind} (handle {e.dxf.handle}, layer {e.dxf.layer!r})"
+        if kind == "LINE":
+            pieces.append(_line(_pt(e.dxf.start, k), _pt(e.dxf.end, k), where))
+        elif kind == "ARC":
+            sweep = (float(e.dxf.end_angle) - float(e.dxf.start_angle)) % 360.0 or 360.0
+            pieces.append(
+                CircularArc(
+                    _pt(e.dxf.center, k), float(e.dxf.radius) * k, math.radians(e.dxf.start_angle), math.radians(sweep)
+                )
+            )
+        elif kind == "CIRCLE":
+            loops.append([CircularArc(_pt(e.dxf.center, k), float(e.dxf.radius) * k, 0.0, 2.0 * math.pi)])
+        elif kind in ("LWPOLYLINE", "POLYLINE"):
+            chain = _polyline(e, kind, k, where)
+            if _closed(e, kind):
+                loops.append(chain)
+            else:
+                pieces.extend(chain)
+        elif kind == "SPLINE":
+            pieces.extend(_spline(e, k, where))
+        elif kind == "ELLIPSE" and abs(float(e.dxf.ratio) - 1.0) <= 1e-12:
+            c, major = e.dxf.center, e.dxf.major_axis
+            r = math.hypot(major.x, major.y) * k
+            a0 = math.atan2(major.y, major.x) + float(e.dxf.start_param)
+            sweep = (float(e.dxf.end_param) - float(e.dxf.start_param)) % (2 * math.pi) or 2 * math.pi
+            arc = CircularArc(_pt(c, k), r, a0, sweep)
+            if sweep >= 2 * math.pi - 1e-12:
+                loops.append([arc])
+            else:
+                pieces.append(arc)
+        else:
+            raise PartError(
+                f"{where}: cannot be read exactly"
+                + (" (an ellipse that is not a circle)" if kind == "ELLIPSE" else "")
+                + "; rolltouch reads LINE, ARC, CIRCLE, LWPOLYLINE, POLYLINE and SPLINE outlines"
+            )
+    loops.extend(_chain(pieces, str(path), ignored))
+    return loops, ignored
+
+
+def _pt(v: Any, k: float) -> tuple[float, float]:
+    return float(v[0]) * k, float(v[1]) * k
+
+
+def _line(a: tuple[float, float], b: tuple[float, float], where: str) -> Line:
+    if math.dist(a, b) <= 1e-12:
+        raise PartError(f"{where}: a piece of zero length at ({a[0]:.6g}, {a[1]:.6g}) mm; remove the repeated point")
+    return Line(a, b)
+
+
+def _bulge(a: tuple[float, float], b: tuple[float, float], bulge: float, where: str) -> Piece:
+    """The piece from a to b with DXF ``bulge`` (tan of a quarter of the included angle; > 0 counter-clockwise)."""
+    if abs(bulge) <= 1e-15:
+        return _line(a, b, where)
+    chord = math.dist(a, b)
+    if chord <= 1e-12:
+        raise PartError(f"{where}: an arc of zero chord at ({a[0]:.6g}, {a[1]:.6g}) mm")
+    theta = 4.0 * math.atan(bulge)
+    radius = chord / (2.0 * abs(math.sin(theta / 2.0)))
+    h = (chord / 2.0) / math.tan(theta / 2.0)  # from the chord's midpoint to the centre, to its left
+    mx, my = (a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0
+    nx, ny = -(b[1] - a[1]) / chord, (b[0] - a[0]) / chord
+    cx, cy = mx + h * nx, my + h * ny
+    return CircularArc((cx, cy), radius, math.atan2(a[1] - cy, a[0] - cx), theta)
+
+
+def _closed(e: Any, kind: str) -> bool:
+    return bool(e.closed) if kind == "LWPOLYLINE" else bool(e.is_closed)
+
+
+def _polyline(e: Any, kind: str, k: float, where: str) -> list[Piece]:
+    if kind == "LWPOLYLINE":
+        verts = [(float(x) * k, float(y) * k, float(b)) for x, y, b in e.get_points("xyb")]
+    else:
+        verts = [(float(v.dxf.location[0]) * k, float(v.dxf.location[1]) * k, float(v.dxf.bulge)) for v in e.vertices]
+    n = len(verts)
+    last = n if _closed(e, kind) else n - 1
+    return [_bulge(verts[i][:2], verts[(i + 1) % n][:2], verts[i][2], f"{where}, vertex {i}") for i in range(last)]
+
+
+def _spline(e: Any, k: float, where: str) -> list[Piece]:
+    bs = e.construction_tool()
+    if bs.is_rational:
+        raise PartError(f"{where}: a rational SPLINE (NURBS weights) cannot be read exactly yet")
+    degree = int(bs.degree)
+    out: list[Piece] = []
+    try:
+        parts = list(bs.bezier_decomposition())
+    except Exception as exc:  # ezdxf refuses splines it cannot split (e.g. unclamped)
+        raise PartError(f"{where}: cannot split the SPLINE into Bézier pieces ({exc})") from None
+    for cps in parts:
+        p = [_pt(c, k) for c in cps]
+        if degree == 1:
+            out.append(_line(p[0], p[1], where))
+        elif degree == 2:
+            c1 = (p[0][0] + 2 / 3 * (p[1][0] - p[0][0]), p[0][1] + 2 / 3 * (p[1][1] - p[0][1]))
+            c2 = (p[2][0] + 2 / 3 * (p[1][0] - p[2][0]), p[2][1] + 2 / 3 * (p[1][1] - p[2][1]))
+            out.append(CubicBezier(p[0], c1, c2, p[2]))
+        elif degree == 3:
+            out.append(CubicBezier(p[0], p[1], p[2], p[3]))
+        else:
+            raise PartError(f"{where}: a SPLINE of degree {degree}; rolltouch reads degrees 1 to 3")
+    return out
+
+
+# ------------------------------------------------------------------ SVG
+def _svg_scale(text: str, path: Path) -> tuple[float, tuple[float, float], str]:
+    """mm per user unit from the root's width and viewBox, the viewBox's origin (user units: the
+    parser moves it to 0, 0 and it is put back), and the text with the root's width and height
+    removed (so the parser maps the viewBox one to one)."""
+    m = re.search(r"<svg\b[^>]*>", text)
+    if m is None:
+        raise PartError(f"{path}: no <svg> element")
+    root = m.group(0)
+
+    def attr(name: str) -> str | None:
+        a = re.search(rf'\s{name}\s*=\s*["\']([^"\']*)["\']', root)
+        return a.group(1).strip() if a else None
+
+    width, box = attr("width"), attr("viewBox")
+    scale = 1.0  # user unit = 1 mm without a physical size
+    origin = (0.0, 0.0)
+    if box is not None:
+        vb = [float(v) for v in re.split(r"[\s,]+", box) if v]
+        if len(vb) != 4 or vb[2] <= 0 or vb[3] <= 0:
+            raise PartError(f"{path}: viewBox={box!r} is not 'min-x min-y width height'")
+        origin = (vb[0], vb[1])
+    if width is not None and not width.endswith("%"):
+        w = re.fullmatch(r"([0-9.eE+-]+)\s*([a-z]*)", width)
+        if w is None or w.group(2) not in SVG_UNITS:
+            raise PartError(f"{path}: width={width!r}: use a number with mm, cm, in, pt, pc or px")
+        unit = SVG_UNITS[w.group(2)]
+        if unit is not None:
+            width_mm = float(w.group(1)) * unit
+            # a physical size without a viewBox: user units are CSS px
+            scale = width_mm / vb[2] if box is not None else 25.4 / 96.0
+    stripped = root
+    for name in ("width", "height"):
+        stripped = re.sub(rf'\s{name}\s*=\s*["\'][^"\']*["\']', "", stripped)
+    return scale, origin, text.replace(root, stripped, 1)
+
+
+def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[str]]:
+    try:
+        import svgelements as se
+    except ImportError:  # pragma: no cover - a dependency of the package
+        raise PartError("reading SVG needs svgelements: pip install svgelements") from None
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise PartError(f"{path}: cannot read the SVG file ({exc})") from None
+    k, origin, text = _svg_scale(text, path)
+
+    def pt(p: Any) -> tuple[float, float]:
+        """A parsed point in mm, y up, in the drawing's own user coordinates."""
+        return (float(p[0]) + origin[0]) * k, -(float(p[1]) + origin[1]) * k
+
+    import io
+
+    try:
+        doc = se.SVG.parse(io.StringIO(text))
+    except Exception as exc:  # the parser raises many kinds on malformed XML
+        raise PartError(f"{path}: cannot parse the SVG ({exc})") from None
+    shapes = [e for e in doc.elements() if isinstance(e, se.Shape)]
+    ids = {e.id for e in shapes if e.id}
+    if element is not None and element not in ids:
+        raise PartError(f"{path}: no path or shape with id {element!r}; ids: {sorted(ids)}")
+    loops: list[list[Piece]] = []
+    loose: list[Piece] = []
+    ignored: list[str] = [f"{type(e).__name__} element" for e in doc.elements() if isinstance(e, se.Text)]
+    for shape in shapes:
+        if element is not None and shape.id != element:
+            ignored.append(f"{type(shape).__name__} {shape.id or '(no id)'}")
+            continue
+        where = f"{path}: {type(shape).__name__} {shape.id or '(no id)'}"
+        current: list[Piece] = []
+        for seg in se.Path(shape).segments():
+            if isinstance(seg, se.Move):
+                loose.extend(current)
+                current = []
+                continue
+            if isinstance(seg, (se.Close, se.Line)):
+                a, b = pt(seg.start), pt(seg.end)
+                if math.dist(a, b) <= 1e-12:
+                    if isinstance(seg, se.Close):
+                        if current:
+                            loops.append(current)
+                        current = []
+                        continue
+                    raise PartError(f"{where}: a line of zero length at ({a[0]:.6g}, {a[1]:.6g}) mm")
+                current.append(Line(a, b))
+                if isinstance(seg, se.Close):
+                    loops.append(current)
+                    current = []
+            elif isinstance(seg, se.CubicBezier):
+                current.append(CubicBezier(*(pt(q) for q in (seg.start, seg.control1, seg.control2, seg.end))))
+            elif isinstance(seg, se.QuadraticBezier):
+                p0, p1, p2 = (pt(q) for q in (seg.start, seg.control, seg.end))
+                c1 = (p0[0] + 2 / 3 * (p1[0] - p0[0]), p0[1] + 2 / 3 * (p1[1] - p0[1]))
+                c2 = (p2[0] + 2 / 3 * (p1[0] - p2[0]), p2[1] + 2 / 3 * (p1[1] - p2[1]))
+                current.append(CubicBezier(p0, c1, c2, p2))
+            elif isinstance(seg, se.Arc):
+                if abs(float(seg.rx) - float(seg.ry)) > 1e-9 * max(float(seg.rx), float(seg.ry)):
+                    raise PartError(f"{where}: an elliptical arc (rx={seg.rx:g}, ry={seg.ry:g}) cannot be read exactly")
+                cx, cy = pt(seg.center)
+                sx, sy = pt(seg.start)
+                # y flipped: angles and the sense of the sweep change sign
+                current.append(
+                    CircularArc((cx, cy), float(seg.rx) * k, math.atan2(sy - cy, sx - cx), -float(seg.sweep))
+                )
+            else:
+                raise PartError(f"{where}: a {type(seg).__name__} segment cannot be read")
+        if current:
+            if math.dist(current[0].start, current[-1].end) <= JOIN_TOL:
+                loops.append(current)
+            else:
+                loose.extend(current)
+    loops.extend(_chain(loose, str(path), ignored))
+    return loops, ignored
+
+
+# ------------------------------------------------------------------ loops
+def _chain(pieces: list[Piece], source: str, ignored: list[str]) -> list[list[Piece]]:
+    """Loose pieces chained end to start (reversing pieces where needed) into closed loops; what
+    does not close is reported in ``ignored``."""
+    unused = list(pieces)
+    loops = []
+    while unused:
+        loop = [unused.pop(0)]
+        while math.dist(loop[-1].end, loop[0].start) > JOIN_TOL:
+            end = loop[-1].end
+            for i, p in enumerate(unused):
+                if math.dist(p.start, end) <= JOIN_TOL:
+                    loop.append(unused.pop(i))
+                    break
+                if math.dist(p.end, end) <= JOIN_TOL:
+                    loop.append(unused.pop(i).reversed())
+                    break
+            else:
+                ignored.append(f"an open chain of {len(loop)} piece(s) from {loop[0].start} to {end}")
+                loop = []
+                break
+        if loop:
+            loops.append(loop)
+    return loops
+
+
+def _area(loop: list[Piece]) -> float:
+    pts = np.concatenate([p.point(np.linspace(0.0, p.length, 65)[:-1]) for p in loop])
+    x, y = pts[:, 0], pts[:, 1]
+    return float(0.5 * abs(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)))
+
+
+def _outer(loops: list[list[Piece]], source: str) -> tuple[list[Piece], int]:
+    """The loop of largest area, and how many others there were."""
+    if not loops:
+        raise PartError(f"{source}: no closed loop (the outline's pieces do not meet end to start)")
+    areas = np.array([_area(loop) for loop in loops])
+    order = np.argsort(-areas)
+    if len(loops) > 1 and areas[order[1]] >= areas[order[0]] * (1.0 - 1e-9):
+        raise PartError(
+            f"{source}: {int(np.sum(areas >= areas[order[0]] * (1 - 1e-9)))} loops of equal area "
+            f"{areas[order[0]]:.6g} mm²: name the layer (DXF) or the element id (SVG)"
+        )
+    return loops[int(order[0])], len(loops) - 1

@@ -1,0 +1,198 @@
+"""CAD outlines read from DXF (written here with ezdxf) and SVG (written here as text): perimeters
+against closed forms, units, the y flip, the outer loop, the first point, and the errors."""
+
+import math
+
+import ezdxf
+import numpy as np
+import pytest
+
+from localizer import PartError, load_outline
+
+W, H, R = 60.0, 40.0, 6.0
+FILLETED = 2 * (W + H) - 8 * R + 2 * math.pi * R  # four quarter-circle fillets
+
+
+def bulge(quarter_ccw=True):
+    return math.tan(math.radians(90.0) / 4.0) * (1 if quarter_ccw else -1)
+
+
+def bracket_dxf(path, units=4, scale=1.0):
+    """A filleted rectangle as one closed LWPOLYLINE with bulges (layer OUTLINE), a hole and a title
+    on other layers."""
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = units
+    msp = doc.modelspace()
+    b = bulge()
+    pts = [
+        (R, 0, 0),
+        (W - R, 0, b),
+        (W, R, 0),
+        (W, H - R, b),
+        (W - R, H, 0),
+        (R, H, b),
+        (0, H - R, 0),
+        (0, R, b),
+    ]
+    pts = [(x * scale, y * scale, bb) for x, y, bb in pts]
+    msp.add_lwpolyline(pts, format="xyb", close=True, dxfattribs={"layer": "OUTLINE"})
+    msp.add_circle((W / 2 * scale, H / 2 * scale), 5 * scale, dxfattribs={"layer": "HOLES"})
+    msp.add_text("BRACKET", dxfattribs={"layer": "TITLE"})
+    doc.saveas(path)
+    return path
+
+
+def test_a_filleted_polyline_has_its_closed_form_perimeter_and_no_corner(tmp_path):
+    o = load_outline(bracket_dxf(tmp_path / "bracket.dxf"))
+    assert o.perimeter == pytest.approx(FILLETED, abs=1e-9)
+    assert o.corners == ()
+    assert o.point_at_arc(0.0) == pytest.approx([R, 0.0])
+    assert any("CIRCLE" in note or "loop" in note for note in o.ignored)
+    assert any("TEXT" in note for note in o.ignored)
+
+
+@pytest.mark.parametrize("units, size", [(1, 25.4), (5, 10.0), (4, 1.0)])
+def test_dxf_units_are_read_into_millimetres(tmp_path, units, size):
+    o = load_outline(bracket_dxf(tmp_path / "b.dxf", units=units))
+    assert o.perimeter == pytest.approx(FILLETED * size, rel=1e-12)
+
+
+def test_loose_lines_and_arcs_are_chained_into_the_loop(tmp_path):
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    # a 30 x 20 plate with a 10 mm half-circle bump on its top edge; some pieces drawn backwards
+    msp.add_line((0, 0), (30, 0))
+    msp.add_line((30, 20), (30, 0))  # backwards
+    msp.add_line((30, 20), (20, 20))
+    msp.add_arc((15, 20), 5, 0, 180)  # counter-clockwise from (20, 20) to (10, 20)
+    msp.add_line((0, 20), (10, 20))  # backwards
+    msp.add_line((0, 20), (0, 0))
+    doc.saveas(tmp_path / "plate.dxf")
+    o = load_outline(tmp_path / "plate.dxf")
+    assert o.perimeter == pytest.approx(30 + 20 + 10 + math.pi * 5 + 10 + 20, abs=1e-9)
+    # corners: four of the plate (+π/2 each) and two where the bump leaves and rejoins the edge (−π/2)
+    assert sorted(round(c.angle, 12) for c in o.corners) == sorted(
+        [round(-math.pi / 2, 12)] * 2 + [round(math.pi / 2, 12)] * 4
+    )
+
+
+def test_a_layer_can_be_chosen_and_a_missing_one_is_named(tmp_path):
+    path = bracket_dxf(tmp_path / "b.dxf")
+    hole = load_outline(path, layer="HOLES")
+    assert hole.perimeter == pytest.approx(2 * math.pi * 5, abs=1e-9)
+    with pytest.raises(PartError, match="no entity on layer 'NOPE'; layers: .*OUTLINE"):
+        load_outline(path, layer="NOPE")
+
+
+def test_a_cubic_spline_is_read_as_bezier_pieces(tmp_path):
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    ctrl = [(0, 0), (20, -10), (40, 10), (60, 0)]
+    spline = msp.add_open_spline(ctrl, degree=3)
+    msp.add_line((60, 0), (60, 30))
+    msp.add_line((60, 30), (0, 30))
+    msp.add_line((0, 30), (0, 0))
+    doc.saveas(tmp_path / "s.dxf")
+    o = load_outline(tmp_path / "s.dxf")
+    # independent: ezdxf's own dense flattening of the spline, plus the three lines
+    pts = np.array([(v.x, v.y) for v in spline.construction_tool().approximate(200_000)])
+    dense = float(np.hypot(*np.diff(pts, axis=0).T).sum())
+    assert o.perimeter == pytest.approx(dense + 30 + 60 + 30, abs=1e-6)
+
+
+def test_unreadable_entities_and_units_are_named(tmp_path):
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_ellipse((0, 0), major_axis=(10, 0), ratio=0.5)
+    doc.saveas(tmp_path / "e.dxf")
+    with pytest.raises(PartError, match="ELLIPSE .*an ellipse that is not a circle"):
+        load_outline(tmp_path / "e.dxf")
+    bracket_dxf(tmp_path / "u.dxf", units=3)  # miles
+    with pytest.raises(PartError, match=r"\$INSUNITS=3"):
+        load_outline(tmp_path / "u.dxf")
+    doc = ezdxf.new()
+    doc.modelspace().add_line((0, 0), (10, 0))
+    doc.saveas(tmp_path / "open.dxf")
+    with pytest.raises(PartError, match="no closed loop"):
+        load_outline(tmp_path / "open.dxf")
+
+
+SVG = """<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {vw} {vh}">
+  <text x="0" y="10">PROFILE</text>
+  <g transform="translate(10, 10)">
+    <path id="profile" d="M 0 0 L 60 0 A 10 10 0 0 1 70 10 L 70 40 Q 70 50 60 50 L 0 50 Z"/>
+  </g>
+  <circle id="hole" cx="40" cy="35" r="4"/>
+</svg>"""
+# the quadratic's length: from (70, 40) via (70, 50) to (60, 50)
+_t = np.linspace(0, 1, 400_001)[:, None]
+_q = (1 - _t) ** 2 * np.array([70, 40]) + 2 * (1 - _t) * _t * np.array([70, 50]) + _t**2 * np.array([60, 50])
+QUAD = float(np.hypot(*np.diff(_q, axis=0).T).sum())
+PROFILE = 60 + math.pi * 10 / 2 + 30 + QUAD + 60 + 50
+
+
+def test_an_svg_path_in_user_units_is_millimetres_with_y_up(tmp_path):
+    (tmp_path / "p.svg").write_text(SVG.format(w="100", h="80", vw=100, vh=80))
+    o = load_outline(tmp_path / "p.svg")
+    assert o.perimeter == pytest.approx(PROFILE, abs=1e-6)
+    # the path's first M, transformed and flipped
+    assert o.point_at_arc(0.0) == pytest.approx([10.0, -10.0], abs=1e-12)
+    poly = o.sample(0.5)
+    assert 0.5 * np.sum(poly[:-1, 0] * poly[1:, 1] - poly[1:, 0] * poly[:-1, 1]) > 0  # counter-clockwise
+    # the arc and the quadratic join their lines tangentially: the only corners are the two ends of
+    # the closing line, both convex quarter turns
+    assert [c.angle for c in o.corners] == pytest.approx([math.pi / 2] * 2)
+
+
+def test_an_svg_with_a_physical_size_is_scaled_exactly(tmp_path):
+    (tmp_path / "p.svg").write_text(SVG.format(w="50mm", h="40mm", vw=100, vh=80))
+    o = load_outline(tmp_path / "p.svg")
+    assert o.perimeter == pytest.approx(PROFILE / 2, abs=1e-6)
+    assert o.point_at_arc(0.0) == pytest.approx([5.0, -5.0], abs=1e-12)
+
+
+def test_an_svg_element_can_be_chosen(tmp_path):
+    (tmp_path / "p.svg").write_text(SVG.format(w="100", h="80", vw=100, vh=80))
+    assert load_outline(tmp_path / "p.svg", element="hole").perimeter == pytest.approx(8 * math.pi, abs=1e-6)
+    with pytest.raises(PartError, match="no path or shape with id 'x'; ids: \\['hole', 'profile'\\]"):
+        load_outline(tmp_path / "p.svg", element="x")
+
+
+def test_an_elliptical_svg_arc_is_named(tmp_path):
+    svg = '<svg xmlns="http://www.w3.org/2000/svg"><path id="e" d="M 0 0 L 50 0 A 20 10 0 0 1 50 20 L 0 20 Z"/></svg>'
+    (tmp_path / "e.svg").write_text(svg)
+    with pytest.raises(PartError, match="Path e: an elliptical arc"):
+        load_outline(tmp_path / "e.svg")
+
+
+def test_two_equal_loops_need_a_choice(tmp_path):
+    svg = (
+        '<svg xmlns="http://www.w3.org/2000/svg"><rect id="a" x="0" y="0" width="10" height="10"/>'
+        '<rect id="b" x="20" y="0" width="10" height="10"/></svg>'
+    )
+    (tmp_path / "two.svg").write_text(svg)
+    with pytest.raises(PartError, match="2 loops of equal area .*name the layer"):
+        load_outline(tmp_path / "two.svg")
+    assert load_outline(tmp_path / "two.svg", element="b").perimeter == pytest.approx(40.0, abs=1e-12)
+
+
+def test_the_shipped_bracket_and_profile():
+    from pathlib import Path
+
+    parts = Path(__file__).resolve().parents[2] / "parts"
+    bracket = load_outline(parts / "bracket.dxf")
+    # faces plus three quarter-circle fillets (R8, R8, R10): the closed form, to 1e-9 mm
+    assert bracket.perimeter == pytest.approx(72 + 24 + 22 + 10 + 20 + 10 + 20 + 30 + math.pi / 2 * 26, abs=1e-9)
+    assert sorted(round(c.angle, 12) for c in bracket.corners) == sorted(
+        [round(math.pi / 2, 12)] * 3 + [round(-math.pi / 2, 12)] * 2
+    )
+    assert bracket.point_at_arc(0.0) == pytest.approx([0.0, 0.0])
+    profile = load_outline(parts / "profile.svg")
+    assert profile.point_at_arc(0.0) == pytest.approx([0.0, 0.0], abs=1e-12)  # the path's first M, y up
+    assert len(profile.corners) == 3 and all(c.angle > 0 for c in profile.corners)
+    with pytest.raises(PartError, match="load_outline"):
+        from localizer import load_part
+
+        load_part(parts / "bracket.dxf")
