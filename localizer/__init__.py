@@ -8,6 +8,7 @@ from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
+from ._outline_solver import outline_segments
 from ._part import UNITS_TO_MM, Part, load_part, part_from_points
 from ._particle_filter import ParticleFilter
 from ._pieces import CircularArc, CubicBezier, Line
@@ -24,6 +25,7 @@ __all__ = [
     "Outline",
     "Corner",
     "outline_from_pieces",
+    "outline_segments",
     "load_outline",
     "CAD_SUFFIXES",
     "LENGTH_TOL",

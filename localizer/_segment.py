@@ -10,7 +10,7 @@ __all__ = ["Segment", "DIRECTIONS", "KINDS"]
 #: Rolling directions: the contact moves counter-clockwise or clockwise on the part.
 DIRECTIONS = ("ccw", "cw")
 #: What a segment is: a transversal root, a near-double root, or a circular stretch.
-KINDS = ("simple", "double", "continuum")
+KINDS = ("simple", "double", "continuum", "corner")
 
 
 @dataclass(frozen=True)
@@ -33,12 +33,14 @@ class Segment:
         Signed jaw rotation Ω (counter-clockwise positive), the query's.
     direction : {"ccw", "cw"}
         Direction the contact moved on the part.
-    kind : {"simple", "double", "continuum"}
+    kind : {"simple", "double", "continuum", "corner"}
         ``"simple"``: a transversal root, refined to the solver's tolerance.
         ``"double"``: g touches zero here (two roots closer than the solver's
         resolution, or a tangency); the segment is feasible to within
         ``residual``. ``"continuum"``: every start from ``start_arc`` over ``span`` mm
-        in the rolling direction is feasible (a circular stretch).
+        in the rolling direction is feasible (a circular stretch, or on an outline two lines or
+        equal arcs). ``"corner"`` (outlines): the start or the end is at a corner, where the jaw
+        touches at every angle within the corner's jump (:func:`localizer.outline_segments`).
     span : float, mm
         Extent of a continuum, 0 otherwise.
     residual : float, rad

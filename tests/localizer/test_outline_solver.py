@@ -1,0 +1,106 @@
+"""Feasible segments on outlines with corners, against an independent reference: the tangent angle
+of a dense polyline through the outline (chord directions, unwrapped), not the outline's own θ."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from localizer import Line, QueryError, load_outline, outline_from_pieces, outline_segments
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+H = 0.002  # mm between the reference's points
+
+
+class ChordAngle:
+    """θ by arc position from the directions of a dense polyline's chords (independent of Outline's
+    bookkeeping of corners and pieces)."""
+
+    def __init__(self, outline):
+        self.P = outline.perimeter
+        s = np.arange(0.0, self.P, H)
+        xy = outline.point_at_arc(s)
+        d = np.diff(np.vstack([xy, xy[:1]]), axis=0)
+        raw = np.arctan2(d[:, 1], d[:, 0])
+        self.theta = raw[0] + np.concatenate([[0.0], np.cumsum((np.diff(raw) + np.pi) % (2 * np.pi) - np.pi)])
+        self.mid = s + H / 2  # a chord's direction is the tangent's at its middle (to O(H²))
+
+    def __call__(self, sigma):
+        sigma = np.asarray(sigma, dtype=float)
+        lap = np.floor(sigma / self.P)
+        return np.interp(sigma - lap * self.P, self.mid, self.theta) + 2 * np.pi * lap
+
+
+def near_a_piece_end(outline, sigma, margin):
+    d = np.abs(
+        (np.asarray(sigma)[..., None] - outline.starts[None, :-1] + outline.perimeter / 2) % outline.perimeter
+        - outline.perimeter / 2
+    )
+    return (d < margin).any(axis=-1)
+
+
+@pytest.fixture(scope="module", params=["bracket.dxf", "profile.svg"])
+def outline(request):
+    return load_outline(PARTS / request.param)
+
+
+def test_a_roll_is_found_where_it_was_made(outline):
+    ref = ChordAngle(outline)
+    rng = np.random.default_rng(16)
+    tried = 0
+    while tried < 40:
+        s0, L = rng.uniform(0, outline.perimeter), rng.uniform(3.0, 40.0)
+        if near_a_piece_end(outline, [s0, s0 + L], 0.5).any():
+            continue
+        tried += 1
+        omega = float(ref(s0 + L) - ref(s0))
+        segs = outline_segments(outline, L, omega)
+        hit = [
+            g
+            for g in segs
+            if abs(((g.start_arc - s0 + outline.perimeter / 2) % outline.perimeter) - outline.perimeter / 2) < 0.02
+            or (g.kind == "continuum" and (s0 - g.start_arc) % outline.perimeter <= g.span + 0.02)
+        ]
+        assert hit, (s0, L, omega, [(g.start_arc, g.kind) for g in segs])
+
+
+def test_every_segment_found_fits_the_reference(outline):
+    ref = ChordAngle(outline)
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(30):
+        L, omega = rng.uniform(3.0, 40.0), rng.uniform(-0.5, 1.5)
+        for g in outline_segments(outline, L, omega):
+            if g.kind != "simple" or near_a_piece_end(outline, [g.start_arc, g.start_arc + L], 0.05).any():
+                continue
+            assert float(ref(g.start_arc + L) - ref(g.start_arc)) == pytest.approx(omega, abs=2e-3)
+            checked += 1
+    assert checked > 10
+
+
+def test_clockwise_rolling_reverses_the_stretch():
+    o = load_outline(PARTS / "profile.svg")
+    ccw = outline_segments(o, 12.0, 0.3)
+    cw = outline_segments(o, 12.0, -0.3, direction="cw")
+    assert sorted(round(g.end_arc, 9) for g in cw) == sorted(round(g.start_arc, 9) for g in ccw)
+
+
+def test_a_corner_start_fits_every_rotation_of_its_jump():
+    pts = [(0, 0), (40, 0), (40, 20), (0, 20)]
+    box = outline_from_pieces([Line(pts[i], pts[(i + 1) % 4]) for i in range(4)])
+    for omega in (0.1, 0.7, 1.5):
+        corners = sorted(round(g.start_arc, 9) for g in outline_segments(box, 10.0, omega) if g.kind == "corner")
+        # starting at a corner, or ending at one 10 mm on
+        assert corners == [0.0, 30.0, 40.0, 50.0, 60.0, 90.0, 100.0, 110.0]
+    # more than the jump: nothing
+    assert outline_segments(box, 10.0, 1.7) == []
+
+
+def test_bad_queries():
+    o = load_outline(PARTS / "bracket.dxf")
+    with pytest.raises(QueryError, match="length=0"):
+        outline_segments(o, 0.0, 0.1)
+    with pytest.raises(QueryError, match="direction"):
+        outline_segments(o, 5.0, 0.1, direction="up")
+    assert math.isfinite(o.perimeter)
