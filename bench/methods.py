@@ -261,6 +261,21 @@ def reactive_filter(study, part, noise, filter_class=None):
     return cls(part, radius=study.success_radius, confidence=o.confidence, **given)
 
 
+def reactive_policy(study):
+    """The :class:`driver.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
+    from driver.reactive import CONFIRM, ReactivePolicy
+
+    o = study.reactive
+    return ReactivePolicy(
+        step=math.radians(study.step_deg),
+        confidence=o.confidence,
+        max_rotation=math.radians(o.max_rotation_deg),
+        check_every=o.check_every,
+        min_spread=o.min_spread,
+        confirm=CONFIRM if o.confirm is None else o.confirm,
+    )
+
+
 def reactive_stop(run) -> str:
     """A reactive run's stop as trials.csv says it: confident, ambiguous (the belief ended with two or
     more strong modes) or budget (not sure otherwise: the rotation budget, or blocked both ways)."""
@@ -271,7 +286,7 @@ def reactive_stop(run) -> str:
 
 def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None) -> dict:
     """The reactive filter from the same start on a rig with the same seed."""
-    from driver.reactive import CONFIRM, ReactivePolicy, localize_reactively
+    from driver.reactive import localize_reactively
     from sim2d import SimRig
 
     o = study.reactive
@@ -282,14 +297,7 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
         calibration=cal,
         filter=reactive_filter(study, part, noise, filter_class),
         approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
-        policy=ReactivePolicy(
-            step=math.radians(study.step_deg),
-            confidence=o.confidence,
-            max_rotation=math.radians(o.max_rotation_deg),
-            check_every=o.check_every,
-            min_spread=o.min_spread,
-            confirm=CONFIRM if o.confirm is None else o.confirm,
-        ),
+        policy=reactive_policy(study),
     )
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)

@@ -208,9 +208,7 @@ def _spline(e: Any, k: float, where: str) -> list[Piece]:
         if degree == 1:
             out.append(_line(p[0], p[1], where))
         elif degree == 2:
-            c1 = (p[0][0] + 2 / 3 * (p[1][0] - p[0][0]), p[0][1] + 2 / 3 * (p[1][1] - p[0][1]))
-            c2 = (p[2][0] + 2 / 3 * (p[1][0] - p[2][0]), p[2][1] + 2 / 3 * (p[1][1] - p[2][1]))
-            out.append(CubicBezier(p[0], c1, c2, p[2]))
+            out.append(CubicBezier.from_quadratic(p[0], p[1], p[2]))
         elif degree == 3:
             out.append(CubicBezier(p[0], p[1], p[2], p[3]))
         else:
@@ -311,9 +309,7 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
                 current.append(CubicBezier(*(pt(q) for q in (seg.start, seg.control1, seg.control2, seg.end))))
             elif isinstance(seg, se.QuadraticBezier):
                 p0, p1, p2 = (pt(q) for q in (seg.start, seg.control, seg.end))
-                c1 = (p0[0] + 2 / 3 * (p1[0] - p0[0]), p0[1] + 2 / 3 * (p1[1] - p0[1]))
-                c2 = (p2[0] + 2 / 3 * (p1[0] - p2[0]), p2[1] + 2 / 3 * (p1[1] - p2[1]))
-                current.append(CubicBezier(p0, c1, c2, p2))
+                current.append(CubicBezier.from_quadratic(p0, p1, p2))
             elif isinstance(seg, se.Arc):
                 if abs(float(seg.rx) - float(seg.ry)) > 1e-9 * max(float(seg.rx), float(seg.ry)):
                     raise PartError(f"{where}: an elliptical arc (rx={seg.rx:g}, ry={seg.ry:g}) cannot be read exactly")

@@ -19,18 +19,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._errors import PartError
+from ._part import _wrap
 from ._types import ArrayLike, FloatArray
 
 __all__ = ["Line", "CircularArc", "CubicBezier", "Piece"]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
 _GL_X, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W
-
-
-def _wrap(angle: FloatArray) -> FloatArray:
-    """Angles mapped to [-π, π)."""
-    out: FloatArray = (angle + np.pi) % (2.0 * np.pi) - np.pi
-    return out
 
 
 def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
@@ -268,6 +263,13 @@ class CubicBezier:
         d1, d2 = self._d1(u), self._d2(u)
         out: FloatArray = (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]) / self._speed(u) ** 3
         return out
+
+    @classmethod
+    def from_quadratic(cls, p0: tuple[float, float], p1: tuple[float, float], p2: tuple[float, float]) -> CubicBezier:
+        """The quadratic Bézier ``p0``, ``p1``, ``p2`` (mm) as the cubic it is exactly (degree elevation)."""
+        c1 = (p0[0] + 2 / 3 * (p1[0] - p0[0]), p0[1] + 2 / 3 * (p1[1] - p0[1]))
+        c2 = (p2[0] + 2 / 3 * (p1[0] - p2[0]), p2[1] + 2 / 3 * (p1[1] - p2[1]))
+        return cls(p0, c1, c2, p2)
 
     def reversed(self) -> CubicBezier:
         """The same curve travelled from ``p3`` to ``p0``."""

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.methods import reactive_filter
+from bench.methods import reactive_filter, reactive_policy
 from bench.study import load_study
 from driver.procedures import calibrate_simulated
-from driver.reactive import ReactivePolicy, localize_reactively
+from driver.reactive import localize_reactively
 from localizer import load_part
 from sim2d import SimRig, load_noise
 
@@ -46,9 +46,7 @@ def run(part_file: Path, start: float, seed: int):
         calibration=cal,
         filter=flt,
         observer=observe,
-        policy=ReactivePolicy(
-            confidence=study.reactive.confidence, max_rotation=math.radians(study.reactive.max_rotation_deg)
-        ),
+        policy=reactive_policy(study),
         approach_pose=rig.approach_pose(start, jaw_position=-40.0, standoff=1.0),
     )
     return part, res, snaps, rig.truth()["contact_arc"]

@@ -42,25 +42,25 @@ def add_command(sub, name: str, run, **kwargs) -> argparse.ArgumentParser:
     return p
 
 
-def probability(text: str) -> float:
-    """A probability strictly between 0 and 1 (argparse type)."""
+def _number(text: str, ok, what: str) -> float:
+    """``text`` as a float that ``ok`` accepts (argparse type; else its error naming the value)."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not 0 < value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} must be between 0 and 1")
+    if not (math.isfinite(value) and ok(value)):
+        raise argparse.ArgumentTypeError(f"{text!r} must be {what}")
     return value
+
+
+def probability(text: str) -> float:
+    """A probability strictly between 0 and 1 (argparse type)."""
+    return _number(text, lambda v: 0 < v < 1, "between 0 and 1")
 
 
 def positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"{text!r} must be a positive number")
-    return value
+    """A positive finite number (argparse type)."""
+    return _number(text, lambda v: v > 0, "a positive number")
 
 
 def rig_arguments(p) -> None:
