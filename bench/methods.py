@@ -252,8 +252,9 @@ def reactive_filter(study, part, noise, filter_class=None):
         given["sd_slope"] = max(
             5.0 * machining_slope(noise.machining_error, noise.machining_wavelength, part.perimeter), 5e-4
         )
-    if o.noise_scales is not None:
-        given["noise_scales"] = o.noise_scales
+    for key in ("noise_scales", "slope_envelope"):
+        if getattr(o, key) is not None:
+            given[key] = getattr(o, key)
     for key in ("temper", "shape_spacing"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)

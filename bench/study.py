@@ -37,6 +37,9 @@ Several methods on the same trials (instead of ``method``)::
                                          #   ("auto": from the study's noise model)  weighed out
     noise_scales = [1.0]                 # optional: the factors on those it weighs (default
                                          #   localizer.NOISE_SCALES; [1.0] trusts them)
+    slope_envelope = [0.25]              # optional: other factors on sd_slope under which the
+                                         #   stated mass must hold too (default
+                                         #   localizer.SLOPE_ENVELOPE; [] the slope prior alone)
 
     [particle]                           # the peer baseline, over the fixed rolls' readings
     particles = 2000
@@ -149,6 +152,7 @@ class ReactiveOptions:
     noise_scales: tuple | None = None  # None: localizer.NOISE_SCALES
     temper: float | None = None  # None: the filter's default
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
+    slope_envelope: tuple | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
 
 
 @dataclass(frozen=True)
@@ -394,16 +398,16 @@ def _options(path, table, cls, name):
         if key == "sd_slope" and value == "auto":
             values[key] = "auto"
             continue
-        if key == "noise_scales":
+        if key in ("noise_scales", "slope_envelope"):
             if (
                 not isinstance(value, list)
-                or not value
+                or (not value and key == "noise_scales")
                 or not all(
                     isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
                     for v in value
                 )
             ):
-                raise StudyError(f"study {path}: [{name}] noise_scales={value!r} must be a list of positive factors")
+                raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a list of positive factors")
             values[key] = tuple(float(v) for v in value)
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):

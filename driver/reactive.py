@@ -131,7 +131,7 @@ def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = 
     """
     if starts is None:
         starts = [m.start_arc for m in flt.belief().modes[:2]]
-    idx = np.mod(np.rint(np.asarray(starts, dtype=float) / flt.tracks.h).astype(int), flt.grid.size)
+    idx = flt.tracks.node_at(starts)
     jaw = _jaw_now(flt, idx)
     out = []
     for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):

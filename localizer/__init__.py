@@ -2,7 +2,7 @@
 
 from ._belief import Belief, Mode
 from ._cad import CAD_SUFFIXES, load_outline
-from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, TEMPER, ContactFilter
+from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, SLOPE_ENVELOPE, TEMPER, ContactFilter
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
@@ -40,6 +40,7 @@ __all__ = [
     "ModeTracks",
     "tracks_for",
     "NOISE_SCALES",
+    "SLOPE_ENVELOPE",
     "TEMPER",
     "CONTRADICTION",
     "BRIDGE_MISS",

@@ -11,14 +11,14 @@ from collections.abc import Callable, Hashable
 from typing import TYPE_CHECKING, TypeVar, cast
 
 if TYPE_CHECKING:
-    from ._part import Part
+    from ._boundary import Boundary
 
 T = TypeVar("T")
 
 __all__ = ["per_part"]
 
 
-def per_part(kind: str, part: Part, args: Hashable, build: Callable[[], T], *, latest_only: bool = False) -> T:
+def per_part(kind: str, part: Boundary, args: Hashable, build: Callable[[], T], *, latest_only: bool = False) -> T:
     """The table ``kind`` of ``part`` for ``args``, built by ``build()`` on first use.
 
     ``latest_only``: keep only the latest ``args`` of this kind (a table too large to keep several

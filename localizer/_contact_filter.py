@@ -103,14 +103,23 @@ import numpy as np
 from scipy.special import ndtr
 
 from ._belief import Belief, Mode
+from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
-from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._tracks import tracks_for
 from ._types import ArrayLike, FloatArray, IntArray
 
-__all__ = ["ContactFilter", "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_MISS", "ENCODER_SD", "TURN_MARGIN"]
+__all__ = [
+    "ContactFilter",
+    "NOISE_SCALES",
+    "TEMPER",
+    "SLOPE_ENVELOPE",
+    "CONTRADICTION",
+    "BRIDGE_MISS",
+    "ENCODER_SD",
+    "TURN_MARGIN",
+]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
 #: log-uniform prior in steps of 2^(1/4) from a quarter to sixteen times what it was told. The
@@ -119,6 +128,9 @@ __all__ = ["ContactFilter", "NOISE_SCALES", "TEMPER", "CONTRADICTION", "BRIDGE_M
 NOISE_SCALES = tuple(float(2.0 ** (k / 4)) for k in range(-8, 17))
 #: The power on the readings' likelihood: the evidence counts half (module notes, "Trust").
 TEMPER = 0.5
+#: Other factors on ``sd_slope`` under which the stated mass must hold as well (module notes, "Trust"):
+#: the belief's mass is the least over the slope priors (1, then these).
+SLOPE_ENVELOPE = (0.25,)
 #: Probability that one reading puts the contact where the jaw cannot touch under the true start
 #: (a jaw position misread by more than ``jaw_margin``, a model error in the part's reach).
 CONTRADICTION = 1e-3
@@ -155,7 +167,7 @@ class ContactFilter:
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
     spacing : float, mm
         Grid step of the hypotheses (default 0.02 mm, 1/15 of the paper's 0.3 mm radius).
     sd_position : float, mm
@@ -200,6 +212,11 @@ class ContactFilter:
         Standard deviation of one reading of the net rotation (default: the arm encoder's
         0.03° step, uniform: 0.03°/√12). It moves the contact by ρ·e, which on a flat stretch
         (ρ of hundreds of mm) is more than the reading's own error.
+    slope_envelope : sequence of float
+        Other factors (> 0) on ``sd_slope``: the mass :meth:`belief` states is the least, over the
+        slope prior and these, of the probability within ``radius`` of the most probable present
+        contact (a lower probability over a set of priors; module notes, "Trust"). ``()``: the
+        slope prior alone.
     noise_scales : sequence of float
         Common factors on ``sd_position``, ``sd_scale``, ``sd_slope`` and ``sd_jaw`` that the filter weighs
         with equal prior probability (the real noise is rarely what the settings say; module
@@ -220,7 +237,7 @@ class ContactFilter:
 
     def __init__(
         self,
-        part: Part,
+        part: Boundary,
         *,
         spacing: float = 0.02,
         sd_position: float = 0.035,
@@ -235,6 +252,7 @@ class ContactFilter:
         jaw: StraightJaw = DEFAULT_JAW,
         jaw_margin: float = 2.0,
         noise_scales: ArrayLike = NOISE_SCALES,
+        slope_envelope: ArrayLike = SLOPE_ENVELOPE,
         sd_jaw: float = 0.015,
         jaw_spacing: float = 5.0,
         sd_turn: float = ENCODER_SD,
@@ -263,6 +281,9 @@ class ContactFilter:
         scales = np.asarray(noise_scales, dtype=float).ravel()
         if scales.size == 0 or not np.all(np.isfinite(scales) & (scales > 0)):
             raise QueryError(f"noise_scales={noise_scales!r} must be positive factors")
+        envelope = np.asarray(slope_envelope, dtype=float).ravel()
+        if not np.all(np.isfinite(envelope) & (envelope > 0)):
+            raise QueryError(f"slope_envelope={slope_envelope!r} must be positive factors")
         if not (math.isfinite(temper) and 0 < temper <= 1):
             raise QueryError(f"temper={temper!r} must be in (0, 1]")
         if not (math.isfinite(jaw_margin) and jaw_margin >= 0):
@@ -272,6 +293,7 @@ class ContactFilter:
         self.jaw_margin = float(jaw_margin)
         self.temper = float(temper)
         self.noise_scales = tuple(float(v) for v in scales)
+        self.slope_envelope = tuple(float(v) for v in envelope if v != 1.0) if sd_slope > 0 else ()
         self.tracks = tracks_for(part, spacing, jaw)
         self.sd_position = float(sd_position)
         self.sd_scale = float(sd_scale)
@@ -284,7 +306,7 @@ class ContactFilter:
         self.prune = float(prune)
         self.refresh = int(refresh)
         # before the first reference hypothesis: the median radius over the stretches a jaw touches
-        convex = self.tracks.kappa[self.tracks.convex]
+        convex = self.tracks.kappa[self.tracks.convex & (self.tracks.kappa > 0)]
         self._rho_prior = float(np.clip(np.median(1.0 / convex), 5.0, 500.0)) if convex.size else 50.0
         # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
         self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
@@ -340,7 +362,7 @@ class ContactFilter:
         self._hist: list[tuple[float, float]] = []  # (z, turn) of every reading, for the reference's radii
         self._version = 0  # changes to the likelihood (its cache's key)
         self._rows = 0  # readings added
-        self._cached: dict[str, Any] | None = None
+        self._cached: dict[float, dict[str, Any]] = {}  # per factor on the slope prior
         self._last_row: tuple[IntArray, FloatArray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
         self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
@@ -491,7 +513,7 @@ class ContactFilter:
         if self._ref is None:
             return self._rho_prior
         t = self.tracks
-        k = t.kappa[int(np.rint(self.current[self._ref] / t.h)) % t.sigma.size]
+        k = t.kappa[int(t.node_at(self.current[self._ref]))]
         return float(np.clip(1.0 / k, 5.0, RHO_MAX)) if k > 0 else RHO_MAX
 
     def _slope_priors(self) -> None:
@@ -511,7 +533,7 @@ class ContactFilter:
             return
         z, turn = new.T
         arc, ok = self.tracks.advance(np.full(z.size, self._ref), turn, turn_margin=TURN_MARGIN)
-        land = np.mod(np.rint(np.where(ok, arc, self.grid[self._ref]) / self.tracks.h).astype(np.int64), self.grid.size)
+        land = self.tracks.node_at(np.where(ok, arc, self.grid[self._ref]))
         kappa = self.tracks.kappa[land]
         rho = np.where(kappa > 0, np.clip(1.0 / np.maximum(kappa, 1e-12), 5.0, SLOPE_RHO_MAX), SLOPE_RHO_MAX)
         # column c (relative) is nonzero for z/spacing in [c - 3, c + 1): the largest radius there
@@ -551,21 +573,24 @@ class ContactFilter:
         self._uu[np.ix_(cols, cols)] += np.outer(vals, vals)
         self._szz += z * z
 
-    def _solved(self) -> dict[str, Any]:
-        """The marginalisation over the live hypotheses and their log-likelihoods, once per reading
-        (cached: the reference refresh, :meth:`belief` and :meth:`shift` share it)."""
-        if self._cached is None or self._cached["version"] != self._version:
-            s = self._solve()
+    def _solved(self, factor: float = 1.0) -> dict[str, Any]:
+        """The marginalisation over the live hypotheses and their log-likelihoods, with the slope
+        prior's standard deviations times ``factor``, once per reading (cached: the reference
+        refresh, :meth:`belief` and :meth:`shift` share it)."""
+        s = self._cached.get(factor)
+        if s is None or s["version"] != self._version:
+            s = self._solve(factor)
             s["version"] = self._version
-            s["ll"] = self._log_likelihood(s)
-            self._cached = s
-        return self._cached
+            # only the slope prior itself prunes: the envelope's others judge what it keeps
+            s["ll"] = self._log_likelihood(s, prune=factor == 1.0)
+            self._cached[factor] = s
+        return s
 
-    def _solve(self) -> dict[str, Any]:
+    def _solve(self, factor: float = 1.0) -> dict[str, Any]:
         """The closed-form marginalisation over the live hypotheses (see the module notes)."""
         cols = np.flatnonzero(self._touched)
         s2 = self.sd_position**2
-        prior = self._slope_var[cols].copy()  # the contact's offset ρ·η: (ρ·sd_slope)²
+        prior = self._slope_var[cols] * factor**2  # the contact's offset ρ·η: (ρ·sd_slope)²
         prior[cols < self._segments] = 1e6  # the segments' offsets: flat
         prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw**2
         prior[cols == self._drift] = self.sd_drift**2
@@ -581,7 +606,7 @@ class ContactFilter:
         qzz = (self._szz - wz @ gi_wz) / s2
         return {"cols": cols, "g": g, "live": live, "gi_v": gi_v, "gi_wz": gi_wz, "qpp": qpp, "qpz": qpz, "qzz": qzz}
 
-    def _log_likelihood(self, s: dict[str, Any]) -> FloatArray:
+    def _log_likelihood(self, s: dict[str, Any], prune: bool = True) -> FloatArray:
         """Log-likelihood of each start from a :meth:`_solve`, the noise scale weighed out; prunes the
         hopeless ones. Also leaves in ``s`` each live start's posterior mean of the squared scale."""
         live, qpp, qpz = s["live"], s["qpp"], s["qpz"]
@@ -601,7 +626,7 @@ class ContactFilter:
         ll_live = self.temper * (top + np.log(total / lam.size) - 0.5 * np.log1p(t2 * qpp)) + self._penalty[live]
         ll = np.full(self.grid.size, -np.inf)
         ll[live] = ll_live
-        if self.prune > 0 and live.size:
+        if prune and self.prune > 0 and live.size:
             # hypotheses this far below the best are dropped from later evaluations
             drop = live[ll_live < ll_live.max() - self.prune]
             if drop.size:
@@ -634,12 +659,16 @@ class ContactFilter:
         mean, sd : ndarray, mm
             Over the grid (0 where infeasible or pruned).
         """
-        s = self._solved()
+        return self._shift(1.0)
+
+    def _shift(self, factor: float) -> tuple[FloatArray, FloatArray]:
+        """:meth:`shift` with the slope prior's standard deviations times ``factor``."""
+        s = self._solved(factor)
         n = self.grid.size
         mean, sd = np.zeros(n), np.zeros(n)
         live = s["live"]
         # the last rotation reading's error moves the present contact by ρ·e
-        kappa = self.tracks.kappa[np.mod(np.rint(self.current[live] / self.tracks.h).astype(np.int64), n)]
+        kappa = self.tracks.kappa[self.tracks.node_at(self.current[live])]
         var_turn = (self.sd_turn / np.maximum(kappa, 1.0 / RHO_MAX)) ** 2
         if self.sd_slope <= 0:
             sd[live] = np.sqrt(var_turn)
@@ -667,7 +696,11 @@ class ContactFilter:
 
         Computed once per reading (a check asks for it several times: the belief and the
         rolling procedure's look-ahead rules)."""
-        s = self._solved()
+        return self._posterior(1.0)
+
+    def _posterior(self, factor: float) -> FloatArray:
+        """:meth:`posterior` with the slope prior's standard deviations times ``factor``."""
+        s = self._solved(factor)
         if "w" not in s:
             ll = s["ll"]
             top = ll.max()
@@ -688,12 +721,12 @@ class ContactFilter:
         present = part.wrap_arc(self.current + mean)
         i = int(np.argmax(w))
         map_arc = float(present[i])
-        # each start's present contact is N(nominal + shift, sd²): the mass within ±radius of the MAP
-        sel = np.flatnonzero(w > 1e-12 * w[i])
-        off, s = np.asarray(part.arc_offset(present[sel], map_arc)), sd[sel]
-        spread = np.where(s > 0, s, 1.0)
-        inside = np.where(s > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius)
-        mass = float(np.sum(w[sel] * inside))
+        mass = self._mass_near(w, present, sd, map_arc, radius)
+        # the same event under the envelope's other slope priors: the stated mass is the least
+        for factor in self.slope_envelope:
+            w_f = self._posterior(factor)
+            mean_f, sd_f = self._shift(factor)
+            mass = min(mass, self._mass_near(w_f, part.wrap_arc(self.current + mean_f), sd_f, map_arc, radius))
         modes = self._modes(w, present, radius)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
         prior /= prior.sum()
@@ -712,6 +745,16 @@ class ContactFilter:
             informative=informative,
             steps=self.steps,
         )
+
+    def _mass_near(self, w: FloatArray, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> float:
+        """Probability that the present contact is within ``radius`` mm of ``arc``: each start's (weight
+        ``w``) is N(``present``, ``sd``²) along the part."""
+        i = int(np.argmax(w))
+        sel = np.flatnonzero(w > 1e-12 * w[i])
+        off, s = np.asarray(self.part.arc_offset(present[sel], arc)), sd[sel]
+        spread = np.where(s > 0, s, 1.0)
+        inside = np.where(s > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius)
+        return float(np.sum(w[sel] * inside))
 
     def _modes(self, w: FloatArray, present: FloatArray, radius: float) -> list[Mode]:
         """Connected groups of probable present contacts, binned at ``radius``."""

@@ -14,11 +14,13 @@ This is the geometry only; issue 16 plugs it into the solver, the filter and the
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
+from ._boundary import ArcPositions
 from ._errors import PartError
 from ._part import _segments_cross
 from ._pieces import Piece
@@ -40,7 +42,7 @@ class Corner(NamedTuple):
 
 
 @dataclass(frozen=True, eq=False)
-class Outline:
+class Outline(ArcPositions):
     """A closed counter-clockwise chain of exact pieces (build one with :func:`outline_from_pieces`).
 
     Attributes
@@ -64,6 +66,7 @@ class Outline:
     corners: tuple[Corner, ...] = field(init=False)
     starts: FloatArray = field(init=False, repr=False)
     _theta0: FloatArray = field(init=False, repr=False)  # unwrapped θ at each piece's start (after its corner)
+    _tables: dict[tuple[str, Hashable], Any] = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
         lengths = np.array([p.length for p in self.pieces])

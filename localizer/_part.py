@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from ._boundary import ArcPositions
 from ._errors import PartError
 from ._poly import bernstein_bounds, horner, poly_der, poly_mul
 from ._types import ArrayLike, FloatArray, IntArray
@@ -53,7 +54,7 @@ def _curvature(dx: FloatArray, dy: FloatArray, ddx: FloatArray, ddy: FloatArray)
 
 
 @dataclass(frozen=True, eq=False)
-class Part:
+class Part(ArcPositions):
     """A part's boundary: the closed, counter-clockwise C2 cubic spline through its points.
 
     Build one with :func:`load_part` or :func:`part_from_points`, which
@@ -204,14 +205,14 @@ class Part:
         return horner(self._dkappa[piece], u) / (den * den * den)
 
     @property
+    def corners(self) -> tuple[()]:
+        """A C2 spline has no corners (the interface it shares with :class:`localizer.Outline`)."""
+        return ()
+
+    @property
     def curvature_bound(self) -> float:
         """An upper bound on |κ| over the whole boundary, 1/mm (from the cells' Bernstein bounds)."""
         return float(np.abs(self._kappa_abs).max())
-
-    def forget_tables(self) -> None:
-        """Drop the tables built for this part by the solvers and filters (the march's grid takes
-        72 MB per million cells); they are built again when next needed."""
-        self._tables.clear()
 
     def _speed_piece(self, piece: IntArray | int, u: FloatArray | float) -> FloatArray:
         c = self._dcols[:, piece]
@@ -364,23 +365,6 @@ class Part:
     def curvature_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Signed curvature at arc position ``sigma``, 1/mm."""
         return self.curvature(self.param_at_arc(sigma))
-
-    def wrap_arc(self, sigma: ArrayLike) -> FloatArray:
-        """Arc positions ``sigma`` (mm) reduced to ``[0, perimeter)``."""
-        w = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
-        return np.where(w >= self.perimeter, 0.0, w)
-
-    def arc_offset(self, a: ArrayLike, b: ArrayLike) -> FloatArray:
-        """Signed shortest offset from arc position ``b`` to ``a`` around the boundary, mm.
-
-        In ``[-perimeter/2, perimeter/2)``; its absolute value is the distance
-        along the boundary.
-        """
-        half = 0.5 * self.perimeter
-        offset: FloatArray = (
-            np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
-        )
-        return offset
 
     def sample(self, per_piece: int = 16) -> FloatArray:
         """Dense closed polyline of the boundary, ``per_piece`` points per spline piece, mm.

@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
+from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
-from ._part import Part
 from ._tracks import tracks_for
 from ._types import BoolArray, FloatArray
 
@@ -36,7 +36,7 @@ class ParticleFilter:
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
     particles : int
         Number of particles.
     sd_position : float, mm
@@ -53,7 +53,7 @@ class ParticleFilter:
 
     def __init__(
         self,
-        part: Part,
+        part: Boundary,
         *,
         particles: int = 2000,
         sd_position: float = 0.04,
@@ -92,7 +92,7 @@ class ParticleFilter:
     def _advance(self, x: FloatArray, turn: float) -> tuple[FloatArray, BoolArray]:
         """Move particles at arc x by a rotation ``turn`` along their convex stretch."""
         t = self.tracks
-        i = np.minimum(np.rint(np.mod(x, self.part.perimeter) / t.h).astype(int), t.sigma.size - 1)
+        i = t.node_at(x)
         moved, ok = t.roll(i, turn)
         return moved - t.sigma[i], ok
 

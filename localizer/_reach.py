@@ -37,9 +37,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull
 
+from ._boundary import Boundary
 from ._cache import per_part
 from ._errors import QueryError
-from ._part import Part
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc"]
@@ -79,7 +79,7 @@ class Reach:
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
     jaw : StraightJaw
     spacing : float, mm
         Grid step along the boundary (default 0.2 mm).
@@ -111,7 +111,7 @@ class Reach:
     """
 
     def __init__(
-        self, part: Part, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2, clearance: float = 0.1
+        self, part: Boundary, jaw: StraightJaw = DEFAULT_JAW, *, spacing: float = 0.2, clearance: float = 0.1
     ) -> None:
         if not (math.isfinite(spacing) and spacing > 0):
             raise QueryError(f"spacing={spacing!r} mm must be a positive number")
@@ -123,9 +123,9 @@ class Reach:
         n = max(64, int(math.ceil(p / spacing)))
         self.h = p / n
         self.sigma = np.arange(n) * self.h
-        t = part.param_at_arc(self.sigma)
-        pts = np.asarray(part.point(t))
-        tan = np.asarray(part.tangent(t))
+        pts = np.asarray(part.point_at_arc(self.sigma))
+        theta = np.asarray(part.tangent_angle_at_arc(self.sigma))
+        tan = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
         eq = ConvexHull(pts).equations  # n·x + d ≤ 0 inside
         depth = np.full(n, -np.inf)
         for j0 in range(0, len(eq), 256):
@@ -222,7 +222,7 @@ class Reach:
         return whole_jaw
 
 
-def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, clearance: float = 0.1) -> Reach:
+def reach_for(part: Boundary, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, clearance: float = 0.1) -> Reach:
     """The ``part``'s :class:`Reach` for ``jaw`` (grid ``spacing`` mm, ``clearance`` mm), built once per part and
     settings (shared, read-only)."""
     return per_part(
@@ -233,7 +233,7 @@ def reach_for(part: Part, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0.2, 
     )
 
 
-def calibration_arc(part: Part, jaw: StraightJaw = DEFAULT_JAW) -> float:
+def calibration_arc(part: Boundary, jaw: StraightJaw = DEFAULT_JAW) -> float:
     """Where to calibrate on ``part``: the most curved point the ``jaw`` touches at every place along it, mm.
 
     The calibration taps one object point with the contact at 11 places from one end of

@@ -7,15 +7,22 @@ import math
 
 import numpy as np
 
+from ._boundary import Boundary
 from ._cache import per_part
-from ._part import Part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
-__all__ = ["ModeTracks", "tracks_for"]
+__all__ = ["ModeTracks", "tracks_for", "PIVOT_SPREAD"]
+
+#: How far, mm of the rolling coordinate per radian of jump, a convex corner is spread in the filter's
+#: grid: at the grid's 0.02 mm, one start per 0.2° of jaw angle at the corner.
+PIVOT_SPREAD = 0.02 / math.radians(0.2)
+#: The curvature tabulated on a pivot, 1/mm: the contact stays at the corner as the jaw turns
+#: (a radius of 1 µm, finite so that the error terms' ρ stay numbers).
+PIVOT_KAPPA = 1e3
 
 
-def tracks_for(part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> ModeTracks:
+def tracks_for(part: Boundary, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> ModeTracks:
     """The ``part``'s :class:`ModeTracks` at ``spacing`` mm for ``jaw``, built once per part, spacing and jaw.
 
     Building them takes most of a second (the dense sample, the jaw's reach, the banded
@@ -31,7 +38,10 @@ class ModeTracks:
     Attributes
     ----------
     sigma, theta, kappa : ndarray, shape (n,)
-        The grid's arc positions (mm), unwrapped tangent angles (rad) and curvatures (1/mm).
+        The grid's arc positions (mm), unwrapped tangent angles (rad) and curvatures (1/mm). The
+        grid is uniform in the rolling coordinate (step ``h``, mm): the arc itself on a smooth
+        boundary; on an outline each convex corner is also spread over :data:`PIVOT_SPREAD` mm per
+        radian, its points all at the corner's arc, one per jaw angle within the jump.
     lo, hi : ndarray, shape (n,), mm
         The jaw positions at which the jaw can touch each grid point (:class:`localizer.Reach`).
     touchable : ndarray of bool
@@ -41,29 +51,57 @@ class ModeTracks:
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
     spacing : float, mm
         Grid step (at least 64 points over the perimeter).
     jaw : StraightJaw
         The jaw whose reach is tabulated.
     """
 
-    def __init__(self, part: Part, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> None:
+    def __init__(self, part: Boundary, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> None:
         self.part = part
         self.jaw = jaw
         p = part.perimeter
-        n = max(64, int(math.ceil(p / spacing)))
-        self.h = p / n
-        # typed float64 (np.asarray is a no-op here: the product is float64 already)
-        sigma: FloatArray = np.asarray(np.arange(n) * self.h, dtype=float)
-        theta = np.asarray(part.tangent_angle_at_arc(sigma), dtype=float)
-        kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
+        # a convex corner is a pivot: the contact stays while the jaw turns through the jump. The grid
+        # runs over the rolling coordinate u, the arc with each convex corner spread over
+        # PIVOT_SPREAD mm per radian of its jump, so that the starts at a corner (one per jaw angle)
+        # are hypotheses like any other; sigma, theta and kappa are tabulated over it
+        pivots = [c for c in part.corners if c.angle > 0]
+        spread = np.array([PIVOT_SPREAD * c.angle for c in pivots])
+        total = p + float(spread.sum())
+        n = max(64, int(math.ceil(total / spacing)))
+        self.h = total / n
+        self._uniform = not pivots
+        u = np.arange(n) * self.h
+        if pivots:
+            corner_arc = np.array([c.arc for c in pivots])
+            u_begin = corner_arc + np.concatenate([[0.0], np.cumsum(spread)[:-1]])  # where each pivot starts in u
+            k = np.searchsorted(u_begin, u, side="right") - 1  # the last pivot begun (-1: none)
+            within = (k >= 0) & (u < u_begin[np.maximum(k, 0)] + spread[np.maximum(k, 0)])
+            passed = np.where(k >= 0, np.cumsum(spread)[np.maximum(k, 0)], 0.0)  # spread fully behind u
+            sigma = np.where(within, corner_arc[np.maximum(k, 0)], u - passed)
+            theta = np.asarray(part.tangent_angle_at_arc(sigma), dtype=float)
+            kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
+            # on a pivot: from the angle before the jump to the angle after it; the contact does not
+            # move with the angle (ρ = 0)
+            kk = np.maximum(k, 0)
+            frac = np.where(within, (u - u_begin[kk]) / spread[kk], 1.0)
+            jump = np.array([c.angle for c in pivots])[kk]
+            theta = np.where(within, theta - (1.0 - frac) * jump, theta)
+            kappa = np.where(within, PIVOT_KAPPA, kappa)
+        else:
+            sigma = u
+            theta = np.asarray(part.tangent_angle_at_arc(sigma), dtype=float)
+            kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
+        sigma = np.asarray(sigma, dtype=float)
         self.sigma, self.theta, self.kappa = sigma, theta, kappa
         # three laps so that any rotation of less than a lap stays on the table
         turn = 2.0 * math.pi
         arcs = np.concatenate([sigma - p, sigma, sigma + p, [2 * p]])
         th = np.concatenate([theta - turn, theta, theta + turn, [theta[0] + 2 * turn]])
-        rising = np.diff(th) > 0
+        # a flat face (θ constant) belongs to the convex stretch around it: the jaw passes it flush,
+        # at one angle, and the contact jumps from one end to the other
+        rising = np.diff(th) >= 0
         # runs of cells with rising θ (convex stretches) or not; run r spans nodes a_r..b_r
         change = np.flatnonzero(np.diff(rising.astype(np.int8)) != 0) + 1
         a = np.concatenate([[0], change])
@@ -91,7 +129,9 @@ class ModeTracks:
         self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
         self.lo_sure, self.hi_sure = (np.array(v) for v in self.reach.interval(sigma, sure=True))
         self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
-        self.convex: BoolArray = rising[a][self._run] & (kappa > 0) & self.touchable
+        # a start on a flat face (κ = 0 within a convex stretch) is where the jaw lay flush: the wrist
+        # read the centre of pressure there, and the first turn takes the contact to the face's end
+        self.convex: BoolArray = rising[a][self._run] & (kappa >= 0) & self.touchable
         for arr in (
             self.sigma,
             self.theta,
@@ -109,6 +149,22 @@ class ModeTracks:
             self._run,
         ):
             arr.setflags(write=False)
+
+    def node_at(self, arc: ArrayLike) -> IntArray:
+        """The grid point nearest arc position(s) ``arc`` (mm, unwrapped; at a pivot, its first)."""
+        a = np.asarray(arc, dtype=float)
+        if self._uniform:
+            uniform: IntArray = np.mod(np.rint(a / self.h).astype(np.int64), self.sigma.size)
+            return uniform
+        p = self.part.perimeter
+        w = np.mod(a, p)
+        j = np.clip(np.searchsorted(self.sigma, w), 1, self.sigma.size - 1)
+        nearer_left = (w - self.sigma[j - 1]) <= (self.sigma[j] - w)
+        node: IntArray = np.where(nearer_left, j - 1, j)
+        # the last node is nearer to the lap's end than to its predecessor: it may be the first
+        wrap = (p - w) < np.abs(w - self.sigma[node])
+        result: IntArray = np.where(wrap, 0, node)
+        return result
 
     def advance(
         self, index: IntArray, turn: FloatArray | float, *, turn_margin: float = 0.0
@@ -154,7 +210,7 @@ class ModeTracks:
         with that much to spare). ``sure`` takes the reach's sure interval (:meth:`Reach.interval`)."""
         arc = np.asarray(arc, dtype=float)
         finite = np.isfinite(arc)
-        land = np.mod(np.rint(np.where(finite, arc, 0.0) / self.h).astype(np.int64), self.sigma.size)
+        land = self.node_at(np.where(finite, arc, 0.0))
         if jaw is None:
             somewhere: BoolArray = finite & self.touchable[land]
             return somewhere

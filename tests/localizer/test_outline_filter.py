@@ -1,0 +1,122 @@
+"""The sequential filter on outlines with faces and corners (issue 16), against an independent reference:
+where the contact is after a turn, from the chord directions of a dense polyline through the outline
+(not the filter's tables nor the outline's own θ)."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from localizer import ContactFilter, load_outline
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+H = 0.002  # mm between the reference's points
+STEP = math.radians(0.2)
+
+
+class Rolling:
+    """Where a straight jaw rolled counter-clockwise puts the contact: the first point at or after the
+    start whose tangent (chord direction, unwrapped) reaches the start's angle plus the turn. A
+    corner is a jump of the chords' direction, so the contact waits there while the jaw pivots."""
+
+    def __init__(self, outline):
+        self.P = outline.perimeter
+        s = np.arange(0.0, 2 * self.P, H)
+        xy = outline.point_at_arc(s)
+        d = np.diff(np.vstack([xy, xy[:1]]), axis=0)[:-1]
+        raw = np.arctan2(d[:, 1], d[:, 0])
+        self.theta = raw[0] + np.concatenate([[0.0], np.cumsum((np.diff(raw) + np.pi) % (2 * np.pi) - np.pi)])
+        self.s = s[:-1]
+
+    def contact(self, start, theta0, turn):
+        """Arc (mm, unwrapped) of the contact after ``turn`` (rad) from ``start`` laid at angle ``theta0``;
+        None where the roll would leave the convex stretch (the chords' direction falls on the way)."""
+        i0 = int(np.searchsorted(self.s, start))
+        ahead = self.theta[i0:]
+        j = int(np.argmax(ahead >= theta0 + turn - 1e-9))
+        if ahead[j] < theta0 + turn - 1e-9 or np.any(np.diff(ahead[: j + 1]) < -1e-6):
+            return None
+        return float(self.s[i0 + j])
+
+
+@pytest.fixture(scope="module")
+def bracket():
+    return load_outline(PARTS / "bracket.dxf")
+
+
+@pytest.fixture(scope="module")
+def rolling(bracket):
+    return Rolling(bracket)
+
+
+def roll_and_check(outline, rolling, start, theta0, sd=0.0, seed=0, max_steps=600):
+    """Feed the filter a counter-clockwise roll; returns (mass, error mm, degrees rolled) at its first
+    belief at 95% (or the end)."""
+    flt = ContactFilter(outline, sd_position=max(sd, 0.01))
+    rng = np.random.default_rng(seed)
+    e0 = sd * rng.standard_normal()
+    for k in range(1, max_steps + 1):
+        c = rolling.contact(start, theta0, k * STEP)
+        assert c is not None, "the test's roll must stay on a convex stretch"
+        flt.update(c - start + sd * rng.standard_normal() - e0, k * STEP)
+        if k % 5 == 0:
+            b = flt.belief()
+            if b.mass >= 0.95:
+                break
+    return b.mass, abs(float(outline.arc_offset(b.map_arc, c))), math.degrees(k * STEP)
+
+
+@pytest.mark.parametrize(
+    "start, where",
+    [(75.0, "fillet"), (210.0, "fillet"), (100.0, "face"), (60.0, "face"), (230.0, "face")],
+)
+def test_noise_free_localization_from_fillets_and_faces(bracket, rolling, start, where):
+    theta0 = float(bracket.tangent_angle_at_arc(start))
+    mass, error, rolled = roll_and_check(bracket, rolling, start, theta0)
+    assert mass >= 0.95 and error < 0.05, (where, mass, error, rolled)
+
+
+@pytest.mark.parametrize("corner_index, fraction", [(0, 0.3), (0, 0.8), (4, 0.5)])
+def test_noise_free_localization_from_a_corner_at_any_angle_within_its_jump(bracket, rolling, corner_index, fraction):
+    # the jaw laid on a convex corner at an angle within the jump: it pivots there, then rolls on
+    corner = bracket.corners[corner_index]
+    assert corner.angle > 0
+    theta0 = float(bracket.tangent_angle_at_arc(corner.arc, side="before")) + fraction * corner.angle
+    mass, error, rolled = roll_and_check(bracket, rolling, corner.arc, theta0)
+    assert mass >= 0.95 and error < 0.05, (corner, mass, error, rolled)
+
+
+def test_with_reading_noise_the_stated_belief_holds_on_the_bracket(bracket, rolling):
+    # 0.03 mm per reading: wherever it stops sure, it is right
+    sure = 0
+    for seed, start in enumerate((75.0, 100.0, 210.0, 230.0)):
+        theta0 = float(bracket.tangent_angle_at_arc(start))
+        mass, error, _ = roll_and_check(bracket, rolling, start, theta0, sd=0.03, seed=seed)
+        if mass >= 0.95:
+            sure += 1
+            assert error < 0.3, (start, mass, error)
+    assert sure >= 2
+
+
+def test_a_corner_is_a_pivot_in_the_filters_tables(bracket, rolling):
+    # the tables move a start at a convex corner nowhere until the jaw has turned through the jump,
+    # and the reference agrees on random starts and turns along convex stretches
+    flt = ContactFilter(bracket)
+    t = flt.tracks
+    corner = bracket.corners[0]
+    at_corner = np.flatnonzero(np.abs(bracket.arc_offset(t.sigma, corner.arc)) < 1e-9)
+    assert at_corner.size >= int(corner.angle / math.radians(0.2)) - 1  # one start per 0.2° of jaw angle
+    rng = np.random.default_rng(5)
+    checked = 0
+    for _ in range(400):
+        i = int(rng.choice(np.flatnonzero(t.convex)))
+        turn = float(rng.uniform(0.0, math.radians(60)))
+        ref = rolling.contact(float(t.sigma[i]), float(t.theta[i]), turn)
+        if ref is None:
+            continue
+        arc, ok = t.advance(np.array([i]), turn)
+        assert ok[0]
+        assert abs(float(bracket.arc_offset(arc[0], ref))) < 0.03, (t.sigma[i], turn, arc[0], ref)
+        checked += 1
+    assert checked > 150
