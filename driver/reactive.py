@@ -369,7 +369,7 @@ class _Roller:
             d = self.read() if self.pressed() else math.inf
         except RigError:
             d = math.inf  # left the calibrated span, or the press was refused: treated as a bridge
-        bridged = abs(d - self.d_prev) > p.bridge_jump or not math.isfinite(d)
+        bridged = not math.isfinite(d) or (abs(d - self.d_prev) > p.bridge_jump and not self._crossed_face(d, s))
         regrasped = slid_off = False
         if not bridged and abs(d) > self.jaw_limit:
             d, regrasped, slid_off = self._regrasp(d)
@@ -393,6 +393,25 @@ class _Roller:
         if self.steps % p.check_every == 0:
             return self._check()
         return None
+
+    def _crossed_face(self, d: float, s: float) -> bool:
+        """Whether a jump of the contact along the jaw, to ``d`` mm after a turn of ``s`` rad, is the jaw
+        tipping over a flat face (the contact passes the face at one jaw angle) rather than a bridge.
+
+        A flat face is crossed in one step: the jump is then a reading. The belief judges: the
+        hypotheses that predict a step of about the measured arc (within 1 mm or 10%) against those
+        under which the turn leaves their convex stretch (a bridge). A part without faces has none.
+        """
+        tracks = self.flt.tracks
+        if not tracks.has_faces:
+            return False
+        arc = self.direction * arc_from_jaw_positions([self.d_prev, d], s, self.offset)
+        idx = np.flatnonzero(self.flt.posterior() > 0)
+        moved, _, ok = tracks.step(idx, self.turn_now(), jaw=self.d_prev, at=self.flt.current[idx])
+        w = self.flt.posterior()[idx]
+        step = np.where(ok, moved - self.flt.current[idx], np.nan)
+        fits = ok & (np.abs(step - arc) <= max(1.0, 0.1 * abs(arc)))
+        return bool(w[fits].sum() > w[~ok].sum())
 
     def _regrasp(self, d: float) -> tuple[float, bool, bool]:
         """The contact reached the end of the jaw's span: lift, slide the jaw along itself so that the

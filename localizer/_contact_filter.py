@@ -339,6 +339,7 @@ class ContactFilter:
         """Back to the prior: every start the jaw can touch equally likely, nothing measured."""
         n = self.grid.size
         self.current = self.grid.copy()  # present contact of each hypothesis, mm (unwrapped)
+        self.node = np.arange(n)  # ... and its grid point (on a pivot, the jaw's angle too)
         self.feasible = self.tracks.convex.copy()
         m = self._m
         self._up = np.zeros((m, n))  # Uᵀp per hypothesis (row 0: Σp)
@@ -389,7 +390,11 @@ class ContactFilter:
         # only the hypotheses still in the running are moved and summed (the pruned ones are
         # never evaluated again)
         idx = self._live_idx
-        current, ok = self.tracks.advance(idx, turn, turn_margin=TURN_MARGIN)
+        # the contact's last place on the jaw says where a jaw laid flush on a face presses it
+        known = math.isfinite(self.jaw_position)
+        current, node, ok = self.tracks.step(
+            idx, turn, turn_margin=TURN_MARGIN, jaw=self.jaw_position if known else None, at=self.current[idx]
+        )
         if not ok.all():
             out = idx[~ok]
             self.feasible[out] = False
@@ -397,6 +402,7 @@ class ContactFilter:
             self._live_idx = np.flatnonzero(self._live)
         p = np.where(ok, current - self.grid[idx], 0.0)
         self.current[idx] = np.where(ok, current, self.current[idx])
+        self.node[idx] = np.where(ok, node, self.node[idx])
         z = float(arc)
         self._add_row(z, p, idx, jaw, float(turn))
         self.steps += 1
@@ -430,7 +436,7 @@ class ContactFilter:
             self._last_row = (cols, vals)
             self._version += 1
         idx = self._live_idx
-        ok = self.tracks.touches(self.current[idx], float(jaw), self.jaw_margin)
+        ok = self.tracks.touches(self.current[idx], float(jaw), self.jaw_margin, node=self.node[idx])
         if not ok.all():
             self._penalty[idx[~ok]] += math.log(CONTRADICTION)
             self._version += 1
@@ -458,9 +464,9 @@ class ContactFilter:
         further = turn + math.copysign(TURN_MARGIN, turn - self.turn)
         clear = np.ones(idx.size, dtype=bool)
         for t in (turn, further):
-            land, ok = self.tracks.advance(idx, t)
+            land, node, ok = self.tracks.step(idx, t)
             moved = land - self.current[idx]
-            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin, sure=True)
+            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin, sure=True, node=node)
             if t == turn:
                 clear &= np.abs(moved) < 0.5 * jump
         if clear.any():

@@ -147,6 +147,24 @@ class Outline(ArcPositions):
             out[sel] = self.pieces[int(i)].curvature(local[sel])
         return out
 
+    # an outline's parameter is its arc position: the parametric interface of a spline Part, so that
+    # what places a jaw by parameter (the simulated rig) takes either
+    def param_at_arc(self, sigma: ArrayLike) -> FloatArray:
+        """The parameter at arc positions ``sigma`` (mm): the arc itself, wrapped to [0, perimeter)."""
+        return self.wrap_arc(sigma)
+
+    def arc_at_param(self, t: ArrayLike) -> FloatArray:
+        """The arc position (mm) at parameter ``t``: ``t`` itself."""
+        return np.asarray(t, dtype=float)
+
+    def point(self, t: ArrayLike) -> FloatArray:
+        """:meth:`point_at_arc` (the parameter is the arc position, mm)."""
+        return self.point_at_arc(t)
+
+    def tangent_angle(self, t: ArrayLike) -> FloatArray:
+        """:meth:`tangent_angle_at_arc` (the parameter is the arc position, mm)."""
+        return self.tangent_angle_at_arc(t)
+
     def sample(self, spacing: float = 0.5) -> FloatArray:
         """A closed polyline through the outline every ``spacing`` mm or less (every piece's ends
         included), shape (M + 1, 2), mm, its last point the first."""

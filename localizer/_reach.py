@@ -132,22 +132,38 @@ class Reach:
             e = eq[j0 : j0 + 256]
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
         self.hull_depth: FloatArray = np.maximum(-depth, 0.0)
-        half = jaw.half
-        c = self.clearance
         tiny = 1e-9 * max(1.0, float(np.ptp(pts)))  # rounding of the depth
-        lo, hi = np.full(n, -np.inf), np.full(n, np.inf)
-        lo_sure, hi_sure = np.full(n, -np.inf), np.full(n, np.inf)
+        self._pts = pts
+        lo, hi, lo_sure, hi_sure = self._intervals(np.arange(n), tan, tiny)
+        self.lo, self.hi = lo, hi
+        self.lo_sure, self.hi_sure = np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
+        self._tiny = tiny
+        for arr in (self.sigma, self.lo, self.hi, self.lo_sure, self.hi_sure, self.hull_depth):
+            arr.setflags(write=False)
+
+    def _intervals(
+        self, points: IntArray, tangents: FloatArray, tiny: float, origins: FloatArray | None = None
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """(lo, hi, lo_sure, hi_sure) for the jaw along unit ``tangents`` touching the grid points ``points``
+        (or the points ``origins``, mm, near them), the sure interval not yet intersected with the
+        generous one."""
+        pts, n, half, c = self._pts, self.sigma.size, self.jaw.half, self.clearance
+        m = points.size
+        lo, hi = np.full(m, -np.inf), np.full(m, np.inf)
+        lo_sure, hi_sure = np.full(m, -np.inf), np.full(m, np.inf)
         k = np.arange(n)
-        for start in range(0, n, 128):
-            i = np.arange(start, min(start + 128, n))
+        for start in range(0, m, 128):
+            rows = np.arange(start, min(start + 128, m))
+            i = points[rows]
             # the boundary in arc order from each P: column k is the point k grid steps ahead of P
-            q = pts[(i[:, None] + k[None, :]) % n] - pts[i, None, :]  # (b, n, 2): Q − P
-            e = tan[i, None, :]
+            here = pts[i] if origins is None else origins[rows]
+            q = pts[(i[:, None] + k[None, :]) % n] - here[:, None, :]  # (b, n, 2): Q − P
+            e = tangents[rows, None, :]
             w = np.einsum("bnk,bnk->bn", q, e)  # along the tangent
             dep = q[..., 0] * e[..., 1] - q[..., 1] * e[..., 0]  # −(Q−P)·m, m the inner normal
             # generous: blocked by a point deeper than the clearance
             block = dep > c
-            lo[i], hi[i] = self._interval(w, block, half)
+            lo[rows], hi[rows] = self._interval(w, block, half)
             # sure: also by a point within the clearance of the edge, except P's own cap (the
             # stretch around P that stays within it below the edge, which is the contact itself)
             clear_of = dep < -c
@@ -155,11 +171,20 @@ class Reach:
             behind = np.where(clear_of[:, :0:-1].any(axis=1), np.argmax(clear_of[:, :0:-1], axis=1) + 1, n)
             cap = (k[None, :] < ahead[:, None]) | (k[None, :] > n - behind[:, None])
             cap &= dep <= tiny  # rising above the edge blocks
-            lo_sure[i], hi_sure[i] = self._interval(w, (dep > -c) & ~cap, half)
-        self.lo, self.hi = lo, hi
-        self.lo_sure, self.hi_sure = np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
-        for arr in (self.sigma, self.lo, self.hi, self.lo_sure, self.hi_sure, self.hull_depth):
-            arr.setflags(write=False)
+            lo_sure[rows], hi_sure[rows] = self._interval(w, (dep > -c) & ~cap, half)
+        return lo, hi, lo_sure, hi_sure
+
+    def at_angle(self, arc: ArrayLike, angle: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """(lo, hi, lo_sure, hi_sure), mm: where on the jaw it touches the boundary at ``arc`` (mm) when the
+        jaw lies at ``angle`` (rad) there instead of along the tangent: on a convex corner of an
+        outline, any angle within its jump."""
+        a = np.atleast_1d(np.asarray(arc, dtype=float))
+        i = np.mod(np.rint(a / self.h).astype(np.int64), self.sigma.size)
+        th = np.broadcast_to(np.asarray(angle, dtype=float), a.shape)
+        tan = np.stack([np.cos(th), np.sin(th)], axis=-1)
+        origins = np.asarray(self.part.point_at_arc(a), dtype=float).reshape(-1, 2)
+        lo, hi, lo_sure, hi_sure = self._intervals(i, tan, self._tiny, origins)
+        return lo, hi, np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
 
     @staticmethod
     def _interval(w: FloatArray, block: BoolArray, half: float) -> tuple[FloatArray, FloatArray]:

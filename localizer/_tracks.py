@@ -20,6 +20,12 @@ PIVOT_SPREAD = 0.02 / math.radians(0.2)
 #: The curvature tabulated on a pivot, 1/mm: the contact stays at the corner as the jaw turns
 #: (a radius of 1 µm, finite so that the error terms' ρ stay numbers).
 PIVOT_KAPPA = 1e3
+#: A net rotation this small, rad, is none (the rounding of a pose's angle after turning back): the
+#: contact is where the rolling started, even on a flat face, where the angle does not place it.
+NO_TURN = 1e-9
+#: A jaw within this of a face's angle, rad, lies flush on it (a millimetre of the jaw then deviates
+#: from the face by a nanometre; :data:`sim2d` shares the contact's flush depth of 1 µm).
+FLUSH_TURN = 1e-6
 
 
 def tracks_for(part: Boundary, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> ModeTracks:
@@ -109,15 +115,28 @@ class ModeTracks:
         span = float(th.max() - th.min()) + 1.0
         # each run's nodes, its θ shifted into a band of its own (flat on falling runs), concatenated:
         # one searchsorted then serves every run
-        pieces_s, pieces_b, offsets = [], [], []
+        pieces_s, pieces_b, pieces_n, offsets = [], [], [], []
+        nodes = np.concatenate([np.arange(n)] * 3 + [[0]])
         at = 0
         for r, (lo, hi) in enumerate(zip(a, b)):
             offsets.append(at)
             pieces_s.append(arcs[lo : hi + 1])
+            pieces_n.append(nodes[lo : hi + 1])
             vals = th[lo : hi + 1] if rising[lo] else np.full(hi + 1 - lo, th[lo])
             pieces_b.append(vals + r * span)
             at += hi + 1 - lo
         self._s = np.concatenate(pieces_s)
+        self._node = np.concatenate(pieces_n)
+        # flat faces on the convex stretches: runs of equal angle along rising arc, (first, last) arc
+        band = np.concatenate(pieces_b)
+        convex_entry = np.concatenate([np.full(hi + 1 - lo, bool(rising[lo])) for lo, hi in zip(a, b)])
+        same = (np.diff(band) == 0) & (np.diff(self._s) > 0) & convex_entry[1:] & convex_entry[:-1]
+        self._face_a = np.full(band.size, np.nan)
+        self._face_b = np.full(band.size, np.nan)
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], same.astype(np.int8), [0]])))
+        for f0, f1 in zip(edges[::2], edges[1::2]):  # cells f0..f1-1: entries f0..f1
+            self._face_a[f0 : f1 + 1] = self._s[f0]
+            self._face_b[f0 : f1 + 1] = self._s[f1]
         self._banded = np.concatenate(pieces_b)
         self._first = np.array(offsets)
         self._last = np.array(offsets) + (b - a)
@@ -128,6 +147,10 @@ class ModeTracks:
         self.reach = reach_for(part, jaw)
         self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
         self.lo_sure, self.hi_sure = (np.array(v) for v in self.reach.interval(sigma, sure=True))
+        if pivots:
+            # on a pivot the jaw lies at the start's own angle, not along the tangent after the corner
+            on = np.flatnonzero(within)
+            self.lo[on], self.hi[on], self.lo_sure[on], self.hi_sure[on] = self.reach.at_angle(sigma[on], theta[on])
         self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
         # a start on a flat face (κ = 0 within a convex stretch) is where the jaw lay flush: the wrist
         # read the centre of pressure there, and the first turn takes the contact to the face's end
@@ -143,12 +166,21 @@ class ModeTracks:
             self.touchable,
             self.convex,
             self._s,
+            self._node,
+            self._face_a,
+            self._face_b,
             self._banded,
             self._first,
             self._last,
             self._run,
         ):
             arr.setflags(write=False)
+
+    @property
+    def has_faces(self) -> bool:
+        """Whether some start lies on a flat face (κ = 0 on a convex stretch), which the jaw crosses in
+        one step (a spline has none)."""
+        return bool(np.any(self.convex & (self.kappa == 0)))
 
     def node_at(self, arc: ArrayLike) -> IntArray:
         """The grid point nearest arc position(s) ``arc`` (mm, unwrapped; at a pivot, its first)."""
@@ -169,6 +201,19 @@ class ModeTracks:
     def advance(
         self, index: IntArray, turn: FloatArray | float, *, turn_margin: float = 0.0
     ) -> tuple[FloatArray, BoolArray]:
+        """(arc, ok) of :meth:`step`."""
+        arc, _, ok = self.step(index, turn, turn_margin=turn_margin)
+        return arc, ok
+
+    def step(
+        self,
+        index: IntArray,
+        turn: FloatArray | float,
+        *,
+        turn_margin: float = 0.0,
+        jaw: float | None = None,
+        at: ArrayLike | None = None,
+    ) -> tuple[FloatArray, IntArray, BoolArray]:
         """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``, along their
         convex stretches (no check of where the jaw reaches: :meth:`touches`, :meth:`roll`).
 
@@ -182,11 +227,19 @@ class ModeTracks:
             A rotation up to this far past the end of the point's convex stretch keeps the
             contact at the end (the real part's slope differs from the model's near an
             inflection) instead of ruling the point out.
+        jaw, at : float and array, mm
+            Where the contact was on the jaw, at arc positions ``at`` (unwrapped): a turn that
+            lays the jaw flush on a face (within :data:`FLUSH_TURN` of its angle) puts the contact
+            at the middle of the face's stretch under the jaw, the centre of pressure of a line
+            contact (without them, at the face's start).
 
         Returns
         -------
         arc : ndarray, mm
             Unwrapped; ``nan`` where the rotation leaves the point's convex stretch.
+        node : ndarray of int
+            The grid point nearest the landing in the rolling coordinate: on a pivot, the one of
+            the jaw's angle (where the arc alone names the corner's first).
         ok : ndarray of bool
         """
         idx = np.asarray(index)
@@ -200,17 +253,41 @@ class ModeTracks:
         b0, b1 = self._banded[j - 1], self._banded[j]
         w = (target - b0) / np.where(b1 > b0, b1 - b0, 1.0)
         arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
-        return np.where(ok, arc, np.nan), ok
+        # no turn, no move: on a flat face the angle alone does not say where along it the contact is
+        still = np.abs(np.asarray(turn)) <= NO_TURN
+        node = np.where(w < 0.5, self._node[j - 1], self._node[j])
+        if jaw is not None and at is not None:
+            # flush on a face: the entry at or before the landing on a face of (nearly) that angle
+            for e in (j, j - 1):
+                on = np.isfinite(self._face_a[e]) & (np.abs(self._banded[e] - target) <= FLUSH_TURN) & ~still
+                if on.any():
+                    fa, fb = self._face_a[e[on]], self._face_b[e[on]]
+                    base = np.asarray(at, dtype=float)[on]
+                    # the face's point σ lies at jaw + (σ − base) along the jaw (the contact moves as
+                    # far along the jaw as along the part)
+                    lo = np.maximum(fa, base - self.jaw.half - jaw)
+                    hi = np.minimum(fb, base + self.jaw.half - jaw)
+                    arc[on] = np.where(hi >= lo, 0.5 * (lo + hi), fa)
+                    node[on] = self.node_at(arc[on])
+        arc = np.where(still, self.sigma[idx], arc)
+        node = np.where(still, idx, node)
+        return np.where(ok, arc, np.nan), node, ok
 
     def touches(
-        self, arc: ArrayLike, jaw: ArrayLike | None = None, margin: float = 0.0, sure: bool = False
+        self,
+        arc: ArrayLike,
+        jaw: ArrayLike | None = None,
+        margin: float = 0.0,
+        sure: bool = False,
+        node: IntArray | None = None,
     ) -> BoolArray:
         """Whether the jaw can touch at arc positions ``arc`` (mm, unwrapped; nan: no) with the contact
         at jaw position(s) ``jaw`` (mm; None: at some place on the jaw), within ``margin`` mm (negative:
-        with that much to spare). ``sure`` takes the reach's sure interval (:meth:`Reach.interval`)."""
+        with that much to spare). ``sure`` takes the reach's sure interval (:meth:`Reach.interval`). ``node``:
+        the grid points of those positions (from :meth:`step`), which on a pivot also say the jaw's angle."""
         arc = np.asarray(arc, dtype=float)
         finite = np.isfinite(arc)
-        land = self.node_at(np.where(finite, arc, 0.0))
+        land = self.node_at(np.where(finite, arc, 0.0)) if node is None else np.asarray(node)
         if jaw is None:
             somewhere: BoolArray = finite & self.touchable[land]
             return somewhere
@@ -240,20 +317,20 @@ class ModeTracks:
         ``margin`` mm. Without ``jaw`` the landing must be touchable at some place on the jaw.
         Returns (arc mm, nan where not; ok).
         """
-        arc, ok = self.advance(index, turn, turn_margin=turn_margin)
+        arc, node, ok = self.step(index, turn, turn_margin=turn_margin)
         if jaw is not None:
             base = self.sigma[np.asarray(index)] if at is None else np.asarray(at, dtype=float)
             jaw = np.asarray(jaw, dtype=float) + (arc - base)
-        ok = ok & self.touches(arc, jaw, margin)
+        ok = ok & self.touches(arc, jaw, margin, node=node)
         return np.where(ok, arc, np.nan), ok
 
     def rollable(self, turns: ArrayLike, jaw: float, margin: float = 0.0) -> BoolArray:
         """Grid points from which the jaw, laid with the contact at ``jaw`` (mm on it), can roll through
         every net rotation of ``turns`` (rad, in order, one sign) without bridging, with ``margin``
         mm to spare on the jaw all along (boolean mask over the grid)."""
-        ok: BoolArray = self.convex & self.touches(self.sigma, jaw, -margin, sure=True)
+        ok: BoolArray = self.convex & self.touches(self.sigma, jaw, -margin, sure=True, node=np.arange(self.sigma.size))
         for t in np.atleast_1d(np.asarray(turns, dtype=float)):
             idx = np.flatnonzero(ok)
-            arc, moved = self.advance(idx, float(t))
-            ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin, sure=True)
+            arc, node, moved = self.step(idx, float(t))
+            ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin, sure=True, node=node)
         return ok

@@ -7,6 +7,13 @@ wrist gives along m by the depth of the deepest point and the contact force is
 ``stiffness`` times that depth. The deepest point is the part's support point
 in the direction -m: a straight edge touches the part's convex hull, so across
 a concavity the contact jumps from one side to the other and the jaw bridges.
+
+On an outline from CAD (:class:`sim2d.machining.MachinedOutline`) the same holds point by point
+over its dense sample: at a convex corner the corner stays the deepest point while the jaw turns
+through the jump (a pivot). Lying flush on a face the rigid jaw touches a line: the load is
+taken as shared evenly by the points within :data:`FLUSH` of the deepest, so the wrist reads their
+middle (the centre of pressure) and the contact's arc is theirs. A machined face is wavy by
+microns, so flush contact is the exception there, and the jaw rests on the highest bump.
 """
 
 from __future__ import annotations
@@ -16,9 +23,17 @@ import numpy as np
 from localizer import Part
 
 from ._errors import SimError
+from .machining import MachinedOutline
 from .world import Contact
 
-__all__ = ["QuasiStaticWorld", "tangent_point"]
+__all__ = ["QuasiStaticWorld", "tangent_point", "FLUSH"]
+
+#: Points of an outline within this depth of the deepest share the load (mm): the jaw lies flush. A
+#: nanometre: an exactly flat face at its own angle (up to rounding), as the filter takes it
+#: (``localizer`` FLUSH_TURN); a compliant contact would spread the load before that, which neither models.
+FLUSH = 1e-6
+#: A contact this close to the jaw's end (mm), four of the outline's sample steps, is at its edge.
+EDGE = 0.02
 
 
 class QuasiStaticWorld:
@@ -26,22 +41,29 @@ class QuasiStaticWorld:
 
     Parameters
     ----------
-    part : Part
-        The real part (machined, if so).
+    part : Part or MachinedOutline
+        The real part (machined, if so). On a spline the contact's ``param`` is the spline
+        parameter; on an outline it is the model's arc position (mm).
     stiffness : float, N/mm
         The wrist's compliance along the jaw normal.
     half_span : float, mm
         Half the jaw's length (paper: 50).
     """
 
-    def __init__(self, part: Part, *, stiffness: float = 1.0, half_span: float = 50.0):
+    def __init__(self, part: Part | MachinedOutline, *, stiffness: float = 1.0, half_span: float = 50.0):
         if not (stiffness > 0 and half_span > 0):
             raise SimError(f"stiffness={stiffness!r} N/mm and half_span={half_span!r} mm must be positive")
         self.part = part
         self.stiffness = float(stiffness)
         self.half_span = float(half_span)
-        self._t = np.arange(part.n_knots * 32) / 32.0
-        self._xy = part.point(self._t)
+        self._spline = None if isinstance(part, MachinedOutline) else part
+        if isinstance(part, MachinedOutline):
+            self._t, self._xy = part.arcs, part.xy
+            self._period = part.perimeter
+        else:
+            self._t = np.arange(part.n_knots * 32) / 32.0
+            self._xy = part.point(self._t)
+            self._period = float(part.n_knots)
         self.hand: tuple[float, float, float] | None = (0.0, 0.0, 0.0)
 
     def set_hand(self, x: float, y: float, phi: float) -> None:
@@ -60,19 +82,34 @@ class QuasiStaticWorld:
         if not inside.any():
             return Contact(0.0, 0.0, float("nan"), 0.0, False)
         k = int(np.argmax(np.where(inside, depth, -np.inf)))
-        t = self._refine(self._t[k], phi)
-        p = self.part.point(t)
+        spline = self._spline
+        if spline is None:
+            return self._outline_contact(k, u, depth, inside)
+        t = tangent_point(spline, self._t[k], phi)
+        p = spline.point(t)
         du = float((p - (x, y)) @ e)
         dd = float(-((p - (x, y)) @ m))
         at_edge = abs(du) > self.half_span + 1e-6
         if at_edge:  # the deepest point lies beyond the jaw: the jaw's end is what touches
             t, du, dd = float(self._t[k]), float(u[k]), float(depth[k])
         if dd <= 0:
-            return Contact(0.0, du, float(t) % self.part.n_knots, dd, at_edge)
-        return Contact(self.stiffness * dd, du, float(t) % self.part.n_knots, dd, at_edge)
+            return Contact(0.0, du, float(t) % spline.n_knots, dd, at_edge)
+        return Contact(self.stiffness * dd, du, float(t) % spline.n_knots, dd, at_edge)
 
-    def _refine(self, t0: float, phi: float) -> float:
-        return tangent_point(self.part, t0, phi)
+    def _outline_contact(self, k: int, u: np.ndarray, depth: np.ndarray, inside: np.ndarray) -> Contact:
+        """The contact on a sampled outline: the deepest point, or the middle of a flush line contact."""
+        flush = inside & (depth >= depth[k] - FLUSH)
+        P = self._period
+        # arcs relative to the deepest point's, so that a face across the first point stays whole
+        rel = (self._t[flush] - self._t[k] + P / 2) % P - P / 2
+        arc = float((self._t[k] + rel.mean()) % P)
+        du = float(u[flush].mean())
+        dd = float(depth[k])
+        # the deepest point the last one under the jaw, not a line: the jaw's end is what touches
+        line = float(np.ptp(u[flush])) > EDGE
+        at_edge = not line and abs(float(u[k])) >= self.half_span - EDGE
+        force = self.stiffness * dd if dd > 0 else 0.0
+        return Contact(force, du, arc, dd, at_edge)
 
 
 def tangent_point(part: Part, t0: float, phi: float) -> float:

@@ -11,10 +11,10 @@ import math
 
 import numpy as np
 
-from localizer import Part
+from localizer import Outline, Part
 
 from ._errors import SimError
-from .machining import machined_part
+from .machining import MachinedOutline, machined_outline, machined_part
 from .noise import NoiseModel, load_noise
 from .quasistatic import QuasiStaticWorld
 from .world import World
@@ -30,9 +30,10 @@ class SimRig:
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
         The part's model (what the localizer is given); the simulated part is
-        this one machined with ``noise.machining_error``.
+        this one machined with ``noise.machining_error``. An outline from CAD runs on the
+        kinematic engine only.
     noise : str, Path or NoiseModel
         ``"none"``, ``"paper"`` or a TOML file (see :func:`sim2d.noise.load_noise`).
     seed : int
@@ -55,7 +56,7 @@ class SimRig:
 
     def __init__(
         self,
-        part: Part,
+        part: Part | Outline,
         *,
         noise="none",
         seed: int = 0,
@@ -72,20 +73,32 @@ class SimRig:
         self.model = part
         self.noise: NoiseModel = load_noise(noise)
         self.rng = np.random.default_rng(seed)
-        self.part = machined_part(part, self.noise, self.rng)
+        self.part: Part | MachinedOutline
         self.world: World
-        if engine == "pymunk":
-            from .pymunk_world import PymunkWorld
-
-            self.world = PymunkWorld(
-                self.part,
-                stiffness=stiffness,
-                linear_speed=linear_speed,
-                angular_speed=angular_speed,
-                **(world_options or {}),
-            )
+        if isinstance(part, Outline):
+            if engine != "kinematic":
+                raise SimError(
+                    f"engine={engine!r}: an outline from CAD ({part.name}) runs on the kinematic engine only "
+                    "(the pymunk world is built from a spline's polygon); use engine='kinematic'"
+                )
+            machined = machined_outline(part, self.noise, self.rng)
+            self.part = machined
+            self.world = QuasiStaticWorld(machined, stiffness=stiffness, **(world_options or {}))
         else:
-            self.world = QuasiStaticWorld(self.part, stiffness=stiffness, **(world_options or {}))
+            spline = machined_part(part, self.noise, self.rng)
+            self.part = spline
+            if engine == "pymunk":
+                from .pymunk_world import PymunkWorld
+
+                self.world = PymunkWorld(
+                    spline,
+                    stiffness=stiffness,
+                    linear_speed=linear_speed,
+                    angular_speed=angular_speed,
+                    **(world_options or {}),
+                )
+            else:
+                self.world = QuasiStaticWorld(spline, stiffness=stiffness, **(world_options or {}))
         self.wrist = wrist
         self.linear_speed = float(linear_speed)
         self.angular_speed = float(angular_speed)
@@ -228,12 +241,13 @@ class SimRig:
 
         return self.approach_pose(calibration_arc(self.model), jaw_position=0.0, standoff=standoff)
 
-    def approach_pose(self, arc: float, jaw_position: float = -30.0, standoff: float = 2.0) -> tuple:
-        """A hand pose with the jaw parallel to the model's tangent at ``arc`` (mm),
-        that point facing jaw position ``jaw_position`` (mm), ``standoff`` mm off the part."""
+    def approach_pose(self, arc: float, jaw_position: float = -30.0, standoff: float = 2.0, tilt: float = 0.0) -> tuple:
+        """A hand pose with the jaw parallel to the model's tangent at ``arc`` (mm), turned by ``tilt`` rad
+        more (a start on a corner of an outline: ``tilt`` within minus its jump and 0, the tangent being
+        the one after it), that point facing jaw position ``jaw_position`` (mm), ``standoff`` mm off the part."""
         t = self.model.param_at_arc(arc)
         c = self.model.point(t)
-        phi = float(self.model.tangent_angle(t))
+        phi = float(self.model.tangent_angle(t)) + float(tilt)
         e = np.array([math.cos(phi), math.sin(phi)])
         m = np.array([-math.sin(phi), math.cos(phi)])
         d = c - jaw_position * e - standoff * m

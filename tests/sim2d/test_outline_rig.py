@@ -1,0 +1,98 @@
+"""The kinematic world and the reactive rolling on an outline from CAD (issue 16): pivots on convex
+corners, flush contact on faces, and localization from starts on fillets, faces and corners."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from driver.procedures import calibrate_simulated
+from driver.reactive import localize_reactively
+from localizer import load_outline
+from sim2d import SimRig
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+
+
+@pytest.fixture(scope="module")
+def bracket():
+    return load_outline(PARTS / "bracket.dxf")
+
+
+@pytest.fixture(scope="module")
+def calibration(bracket):
+    return calibrate_simulated(bracket, noise="none", seed=99)
+
+
+def contact_after(rig, pose):
+    rig.world.set_hand(*pose)
+    return rig.world.contact()
+
+
+def test_a_convex_corner_is_a_pivot(bracket):
+    # the jaw pressed on a corner at angles within its jump: the contact stays at the corner
+    rig = SimRig(bracket, noise="none")
+    corner = bracket.corners[0]
+    arcs = []
+    for fraction in (0.1, 0.3, 0.5, 0.7, 0.9):
+        x, y, phi = rig.approach_pose(corner.arc, jaw_position=-10.0, standoff=-0.5, tilt=-fraction * corner.angle)
+        c = contact_after(rig, (x, y, phi))
+        assert c.force > 0
+        arcs.append(float(bracket.arc_offset(c.param, corner.arc)))
+        assert abs(c.jaw_position + 10.0) < 0.01
+    assert np.max(np.abs(arcs)) < 0.01
+
+
+def test_flush_on_a_face_the_wrist_reads_the_middle_of_the_face_under_the_jaw(bracket):
+    # the first face runs from arc 0 to 72 mm; laid flush with arc 40 at jaw position -40, the jaw
+    # covers arcs 30 to 130 of its line, so the face from 30 to 72 bears: centre of pressure at 51
+    rig = SimRig(bracket, noise="none")
+    c = contact_after(rig, rig.approach_pose(40.0, jaw_position=-40.0, standoff=-0.2))
+    assert c.force > 0 and not c.at_edge
+    assert c.param == pytest.approx(51.0, abs=0.01)
+    assert c.jaw_position == pytest.approx(-29.0, abs=0.01)
+    # turned a little either way, it rests on one end of that stretch
+    x, y, phi = rig.approach_pose(40.0, jaw_position=-40.0, standoff=-0.2)
+    for turn, end in ((1e-3, 72.0), (-1e-3, 30.0)):
+        c = contact_after(rig, (x, y, phi + turn))
+        assert abs(float(bracket.arc_offset(c.param, end))) < 0.5, (turn, c.param)
+
+
+def test_the_pymunk_engine_refuses_an_outline_by_name(bracket):
+    with pytest.raises(ValueError, match="kinematic"):
+        SimRig(bracket, engine="pymunk")
+
+
+# (start arc mm, tilt as a fraction of the corner's jump, jaw position mm): fillets, faces, and
+# convex corners at angles where the jaw, laid there, touches the corner (localizer.Reach)
+STARTS = [
+    (75.0, 0.0, -40.0),
+    (210.0, 0.0, -40.0),
+    (100.0, 0.0, -40.0),
+    (230.0, 0.0, -40.0),
+    (40.0, 0.0, -40.0),
+    (0.0, 0.5, -40.0),
+    (0.0, 0.2, -40.0),
+    (183.13274122871834, 0.5, -40.0),
+]
+
+
+def test_noise_free_reactive_localization_from_fillets_faces_and_corners(bracket, calibration):
+    sure = 0
+    for arc, fraction, jaw in STARTS:
+        corner = [c for c in bracket.corners if abs(c.arc - arc) < 1e-9]
+        tilt = -fraction * corner[0].angle if corner else 0.0
+        rig = SimRig(bracket, noise="none", seed=1)
+        res = localize_reactively(
+            rig,
+            bracket,
+            calibration=calibration,
+            approach_pose=rig.approach_pose(arc, jaw_position=jaw, standoff=1.0, tilt=tilt),
+        )
+        error = abs(float(bracket.arc_offset(res.estimate_arc, rig.truth()["contact_arc"])))
+        if res.stopped == "confident":
+            sure += 1
+            assert error < 0.3, (arc, fraction, res.belief.mass, error)
+        else:  # not sure: then it must not state that it is
+            assert res.belief.mass < 0.95, (arc, fraction, res.stopped, res.belief.mass)
+    assert sure >= 6, sure
