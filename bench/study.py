@@ -73,7 +73,7 @@ from pathlib import Path
 import numpy as np
 
 from driver.reactive import CONFIDENCE, MAX_ROTATION
-from localizer import ROLL_STEP, SUCCESS_RADIUS, Part, RolltouchError, load_part
+from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -438,7 +438,7 @@ class TrialSpec:
 
 
 @functools.cache
-def _part(path: str) -> Part:
+def _part(path: str) -> Part | Outline:
     """The part file at ``path``, read once per worker process (its tables are kept with it)."""
     return load_part(path)
 

@@ -4,9 +4,27 @@ from __future__ import annotations
 
 import numpy as np
 
-from localizer import SUCCESS_RADIUS
+from localizer import SUCCESS_RADIUS, Outline
 
-__all__ = ["plot_localization", "plot_run"]
+__all__ = ["plot_localization", "plot_run", "plot_reactive", "draw_part"]
+
+
+def draw_part(ax, part) -> None:
+    """The part's boundary as it is: a spline densely, an outline from CAD piece by piece with its corners
+    marked (convex ones, where the jaw pivots, and concave ones, which a straight jaw cannot touch),
+    and its first point (arc 0)."""
+    if isinstance(part, Outline):
+        xy = part.sample(0.2)  # every piece's ends included: corners stay sharp
+        ax.plot(xy[:, 0], xy[:, 1], color="0.55", lw=1.2, label=f"part {part.name} ({len(part.pieces)} pieces)")
+        for convex, marker, label in ((True, "o", "convex corner"), (False, "x", "concave corner")):
+            arcs = [c.arc for c in part.corners if (c.angle > 0) == convex]
+            if arcs:
+                pts = part.point_at_arc(np.array(arcs))
+                ax.plot(pts[:, 0], pts[:, 1], marker, color="0.3", ms=5, ls="none", mfc="none", label=label)
+    else:
+        xy = part.sample(24)
+        ax.plot(xy[:, 0], xy[:, 1], color="0.55", lw=1.2, label=f"part {part.name}")
+    ax.plot(*part.point_at_arc(0.0), "k^", ms=6, label="arc 0 (first point)")
 
 
 def _finish(fig, ax, path) -> None:
@@ -45,9 +63,7 @@ def plot_localization(part, result, path, *, title: str | None = None):
 
     sign = 1.0 if result.direction == "ccw" else -1.0
     fig, ax = plt.subplots(figsize=(7, 7))
-    outline = part.sample(24)
-    ax.plot(outline[:, 0], outline[:, 1], color="0.55", lw=1.2, label=f"part {part.name}")
-    ax.plot(*part.point(0.0), "k^", ms=6, label="arc 0 (first point)")
+    draw_part(ax, part)
     for k, seg in enumerate(result.segments):
         xy = _arc_points(part, seg.start_arc, seg.length, sign)
         ax.plot(
@@ -101,8 +117,7 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7.5, 7.5))
-    outline = part.sample(24)
-    ax.plot(outline[:, 0], outline[:, 1], color="0.55", lw=1.2, label=f"part {part.name}")
+    draw_part(ax, part)
     cols = trace.columns
     jaw = trace.jaw_positions()
     has_truth = np.isfinite(cols["true_arc"]).all()
@@ -151,4 +166,38 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
         err = abs(float(part.arc_offset(result.best.end_arc, cols["true_arc"][-1])))
         title += f"\nerror {err:.3f} mm ({'success' if err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
     ax.set_title(title, fontsize=9)
+    _finish(fig, ax, path)
+
+
+def plot_reactive(part, run, path, *, true_arcs=None) -> None:
+    """Draw a reactive localization (:class:`driver.reactive.ReactiveRun`): the part as it is, the stretch
+    the contact rolled over (from the readings' truth where known), the estimate with its stated
+    probability, and the truth.
+
+    Parameters
+    ----------
+    part : Part or Outline
+    run : ReactiveRun
+    path : str or Path
+        PNG file to write.
+    true_arcs : sequence of float, mm, optional
+        The contact's true arc positions at the readings (a simulated rig's); default ``run.true_arcs``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 7))
+    draw_part(ax, part)
+    truth = np.asarray(run.true_arcs if true_arcs is None else true_arcs, dtype=float)
+    truth = truth[np.isfinite(truth)]
+    if truth.size:
+        xy = part.point_at_arc(truth)
+        ax.plot(xy[:, 0], xy[:, 1], ".", color="tab:blue", ms=2, label="the contact while rolling (truth)")
+        ax.plot(*part.point_at_arc(truth[-1]), "o", color="tab:blue", ms=7, mfc="none", label="true contact now")
+    b = run.belief
+    est = part.point_at_arc(b.map_arc)
+    ax.plot(*est, "*", color="tab:red", ms=12, label=f"estimate: {b.mass:.1%} within {b.radius:g} mm ({run.stopped})")
+    ax.set_title(f"reactive localization on {part.name}: {np.degrees(run.rotation):.1f} deg rolled", fontsize=9)
     _finish(fig, ax, path)

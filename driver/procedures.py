@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from localizer import ROLL_STEP, Localization, Part, arc_from_jaw_positions, localize
+from localizer import ROLL_STEP, Boundary, Localization, Outline, Part, arc_from_jaw_positions, localize
 
 from .rig import Clocked, ForceServo, GroundTruth, Reading, Rig, RigError, SampleLog, Truth
 
@@ -411,7 +411,7 @@ def calibrate(
     return Calibration(tuple(float(v) for v in positions), tuple(float(v) for v in ratios), target)
 
 
-def calibrate_simulated(part: Part, noise="none", *, seed: int = 0, engine: str = "kinematic") -> Calibration:
+def calibrate_simulated(part: Part | Outline, noise="none", *, seed: int = 0, engine: str = "kinematic") -> Calibration:
     """Calibrate a simulated wrist as the real one is calibrated (paper §III-B): a simulated rig of its own,
     seeded ``seed``, with the ``noise`` model and ``engine`` of :class:`sim2d.SimRig`, taps ``part`` at its
     most curved point that the whole jaw reaches (:func:`localizer.calibration_arc`)."""
@@ -421,7 +421,7 @@ def calibrate_simulated(part: Part, noise="none", *, seed: int = 0, engine: str 
     return calibrate(rig, rig.calibration_pose())
 
 
-def laid_off(part: Part, first_contact: float, start: float, tolerance: float = 1.0) -> bool:
+def laid_off(part: Boundary, first_contact: float, start: float, tolerance: float = 1.0) -> bool:
     """Whether a jaw laid at arc ``start`` (mm) on ``part`` first touched it elsewhere: at ``first_contact``
     (mm, a simulated rig's truth; NaN: not known) more than ``tolerance`` mm away. A straight jaw laid on a
     start off the convex hull touches the hull instead."""

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from localizer import ROLL_STEP, Belief, ContactFilter, Part, arc_from_jaw_positions
+from localizer import ROLL_STEP, Belief, Boundary, ContactFilter, arc_from_jaw_positions
 
 from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
 from .rig import Reading, Rig, RigError, Truth
@@ -226,7 +226,7 @@ class ReactivePolicy:
 
 def localize_reactively(
     rig: Rig,
-    part: Part,
+    part: Boundary,
     *,
     calibration: Calibration,
     approach_pose,
@@ -240,7 +240,7 @@ def localize_reactively(
     Parameters
     ----------
     rig : Rig
-    part : Part
+    part : Part or Outline
         The part's model.
     calibration : Calibration
         The wrist's calibration (contact place on the jaw from Δv2/Δv1).

@@ -1,15 +1,17 @@
 """Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
 
 from ._belief import Belief, Mode
+from ._boundary import Boundary
 from ._cad import CAD_SUFFIXES, load_outline
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, SLOPE_ENVELOPE, TEMPER, ContactFilter
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
+from ._files import load_part
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
 from ._outline_solver import outline_segments
-from ._part import UNITS_TO_MM, Part, load_part, part_from_points
+from ._part import UNITS_TO_MM, Part, part_from_points
 from ._particle_filter import ParticleFilter
 from ._pieces import CircularArc, CubicBezier, Line
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
@@ -19,6 +21,7 @@ from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
 from ._tracks import ModeTracks, tracks_for
 
 __all__ = [
+    "Boundary",
     "Line",
     "CircularArc",
     "CubicBezier",

@@ -13,12 +13,8 @@ counter-clockwise from the first point.
 
 from __future__ import annotations
 
-import csv
-import json
-import os
 from collections.abc import Hashable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -29,7 +25,7 @@ from ._errors import PartError
 from ._poly import bernstein_bounds, horner, poly_der, poly_mul
 from ._types import ArrayLike, FloatArray, IntArray
 
-__all__ = ["Part", "load_part", "part_from_points", "UNITS_TO_MM"]
+__all__ = ["Part", "part_from_points", "UNITS_TO_MM"]
 
 #: Length units a part file may declare, and their size in millimetres.
 UNITS_TO_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "um": 1e-3}
@@ -486,55 +482,3 @@ def part_from_points(points: ArrayLike, *, name: str = "part", units: str = "mm"
             f"{i / 16:.2f} and {j / 16:.2f} (near points {i // 16} and {j // 16}); check the point order"
         )
     return part
-
-
-def load_part(path: str | os.PathLike[str]) -> Part:
-    """Read and validate a part file.
-
-    Parameters
-    ----------
-    path : str or Path
-        A JSON file ``{"name": str, "units": "mm", "points": [[x, y], ...]}``
-        or a CSV file of ``x,y`` rows in mm (a header row and ``#`` comments
-        are allowed).
-
-    Returns
-    -------
-    Part
-
-    Raises
-    ------
-    PartError
-        The file is missing or unreadable, or the part is invalid (see
-        :func:`part_from_points`).
-    """
-    path = Path(path)
-    src = str(path)
-    if path.suffix.lower() in (".dxf", ".svg"):
-        raise PartError(
-            f"{src}: a CAD outline; read it with localizer.load_outline (localizing on outlines with corners "
-            "is not built yet: issue 16)"
-        )
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise PartError(f"{src}: cannot read part file ({exc.strerror or exc})") from None
-    if path.suffix.lower() == ".csv":
-        rows = []
-        for k, row in enumerate(csv.reader(line for line in text.splitlines() if not line.lstrip().startswith("#"))):
-            if not row or all(not c.strip() for c in row):
-                continue
-            try:
-                rows.append([float(row[0]), float(row[1])])
-            except (ValueError, IndexError):
-                if rows or k > 0:
-                    raise PartError(f"{src}: row {k + 1} {row!r} is not two numbers x,y") from None
-        return part_from_points(rows, name=path.stem, source=src)
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise PartError(f"{src}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(data, dict) or "points" not in data:
-        raise PartError(f'{src}: a part file is a JSON object with "name", "units" and "points"')
-    units = data.get("units", "mm")
-    return part_from_points(data["points"], name=str(data.get("name", path.stem)), units=units, source=src)

@@ -26,7 +26,7 @@ from driver.procedures import (
     roll,
 )
 from driver.rig import RigError
-from localizer import SUCCESS_RADIUS, load_part
+from localizer import SUCCESS_RADIUS, Part, load_part
 from sim2d import SimRig
 
 SHIPPED = ("cam.json", "ellipse.json", "trefoil.json", "kidney.csv")
@@ -136,6 +136,8 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
     out = {}
     for name in SHIPPED:
         part = load_part(PARTS_DIR / name)
+        if not isinstance(part, Part):
+            raise TypeError(f"{name}: the paper's study rolls on the shipped point-file parts")
         cal = calibrate_simulated(part, noise, seed=seed, engine=engine)
         rows: list[dict] = []
         for _k in range(trials):

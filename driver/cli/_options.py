@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from localizer import ROLL_STEP, SUCCESS_RADIUS, RolltouchError
+from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part
 
 from ..procedures import PRESS, PressSettings, ServoSettings
 from ..reactive import CONFIDENCE, MAX_ROTATION
@@ -16,6 +16,9 @@ __all__ = [
     "MAX_ROTATION_DEG",
     "UsageError",
     "add_command",
+    "part_arguments",
+    "read_part",
+    "spline_part",
     "positive",
     "probability",
     "rig_arguments",
@@ -40,6 +43,30 @@ def add_command(sub, name: str, run, **kwargs) -> argparse.ArgumentParser:
     p = sub.add_parser(name, **kwargs)
     p.set_defaults(run=run, parser=p)
     return p
+
+
+def part_arguments(p, help: str = "part file") -> None:
+    """The part: a point file (JSON or CSV) or a CAD drawing (DXF or SVG), and which of the drawing's
+    layers or elements holds the outline."""
+    p.add_argument("part", help=f"{help}: JSON or CSV points, or a DXF or SVG drawing (its outer outline)")
+    p.add_argument("--layer", metavar="NAME", help="DXF: read the outline from this layer")
+    p.add_argument("--element", metavar="ID", help="SVG: read the outline from the element with this id")
+
+
+def read_part(args) -> Part | Outline:
+    """The part that :func:`part_arguments` named."""
+    return load_part(args.part, layer=getattr(args, "layer", None), element=getattr(args, "element", None))
+
+
+def spline_part(part: Part | Outline, args, what: str, instead: str = "localize with --reactive") -> Part:
+    """``part`` if it is a point-file spline; an outline from CAD raises :class:`UsageError` saying that
+    ``what`` needs one (the two-roll rule is not built on outlines yet) and what to do ``instead``."""
+    if isinstance(part, Outline):
+        raise UsageError(
+            f"{args.part} is an outline from CAD: {what} runs on point-file parts only so far (issue 16); "
+            f"on an outline {instead}"
+        )
+    return part
 
 
 def _number(text: str, ok, what: str) -> float:

@@ -11,7 +11,7 @@ import numpy as np
 
 from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, load_part, localize
 
-from ._options import add_command, positive
+from ._options import add_command, part_arguments, positive, read_part, spline_part
 from ._output import emit_run, run_summary
 
 __all__ = ["register", "localize_command", "locate_command"]
@@ -26,7 +26,7 @@ def register(sub) -> None:
         help="find where the jaw rolled from measured (length, turn) rolls",
         description="Find every place on the part where the measured rolls could have happened and rank them.",
     )
-    loc.add_argument("part", help="part file (JSON of DESIGN.md, or CSV of x,y in mm)")
+    part_arguments(loc)
     loc.add_argument("--length", type=float, required=True, metavar="MM", help="contact travel of the first roll, mm")
     loc.add_argument(
         "--turn",
@@ -87,14 +87,16 @@ def register(sub) -> None:
         description="Recompute the rolls' (L, Ω) from a trace's readings and localize.",
     )
     lct.add_argument("trace", help="trace file (.npz) from 'rolltouch simulate'")
-    lct.add_argument("--part", required=True, help="part file (the model the localizer is given)")
+    lct.add_argument("--part", required=True, help="part file (the model the localizer is given; a point file)")
     lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
     lct.add_argument("--json", action="store_true", help="print the result as JSON")
     lct.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
 
 
 def localize_command(args) -> int:
-    part = load_part(args.part)
+    part = spline_part(
+        read_part(args), args, "the two-roll localization", "roll reactively: rolltouch simulate|run PART --reactive"
+    )
     rolls = [(args.length, np.radians(args.turn))] + [(L, np.radians(d)) for L, d in args.then]
     result = localize(
         part,
@@ -151,7 +153,12 @@ def localize_command(args) -> int:
 def locate_command(args) -> int:
     from driver.trace import Trace
 
-    part = load_part(args.part)
+    part = spline_part(
+        load_part(args.part),
+        args,
+        "the two-roll localization",
+        "roll reactively: rolltouch simulate|run PART --reactive",
+    )
     trace = Trace.load(args.trace)
     estimates = trace.estimates()
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"

@@ -9,9 +9,20 @@ import json
 import math
 import sys
 
-from localizer import SUCCESS_RADIUS, load_part
+from localizer import SUCCESS_RADIUS
 
-from ._options import STEP_DEG, add_command, positive, pressing, reactive_arguments, rig_arguments, servo_arguments
+from ._options import (
+    STEP_DEG,
+    add_command,
+    part_arguments,
+    positive,
+    pressing,
+    reactive_arguments,
+    read_part,
+    rig_arguments,
+    servo_arguments,
+    spline_part,
+)
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
 __all__ = ["register", "calibrate_command", "run_command"]
@@ -39,7 +50,7 @@ def register(sub) -> None:
         "of the part): calibrate if no calibration is given, slide 40 mm, "
         "establish contact, roll, localize.",
     )
-    run.add_argument("part", help="part file")
+    part_arguments(run)
     rig_arguments(run)
     run.add_argument("--calibration", metavar="CAL.json", help="calibration from 'rolltouch calibrate'")
     run.add_argument(
@@ -88,7 +99,9 @@ def run_command(args) -> int:
     from driver.serial_rig import SerialRig
     from driver.trace import Trace
 
-    part = load_part(args.part)
+    part = read_part(args)
+    if not args.reactive:
+        spline_part(part, args, "the fixed rolls' two-roll rule")
     rolls = args.roll or [20.0, 15.0]
     calibration = Calibration.load(args.calibration) if args.calibration else None
     header = {
@@ -116,7 +129,7 @@ def run_command(args) -> int:
     with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         run, calibration = run_from_here(
             rig,
-            part,
+            spline_part(part, args, "the fixed rolls' two-roll rule"),
             [math.radians(r) for r in rolls],
             calibration=calibration,
             step=math.radians(args.step),

@@ -9,10 +9,21 @@ from dataclasses import asdict
 
 import numpy as np
 
-from localizer import QueryError, load_part
+from localizer import Outline, QueryError
 
 from ..rig import RigError
-from ._options import STEP_DEG, UsageError, add_command, positive, pressing, reactive_arguments, servo_arguments
+from ._options import (
+    STEP_DEG,
+    UsageError,
+    add_command,
+    part_arguments,
+    positive,
+    pressing,
+    reactive_arguments,
+    read_part,
+    servo_arguments,
+    spline_part,
+)
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
 __all__ = ["register", "simulate_command", "emulate_command"]
@@ -28,7 +39,7 @@ def register(sub) -> None:
         description="Calibrate a simulated rig, establish contact at --start, roll, "
         "localize, and save the readings with their ground truth.",
     )
-    sim.add_argument("part", help="part file")
+    part_arguments(sim)
     sim.add_argument(
         "--start",
         type=float,
@@ -53,8 +64,8 @@ def register(sub) -> None:
     sim.add_argument(
         "--engine",
         choices=("pymunk", "kinematic"),
-        default="pymunk",
-        help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk)",
+        help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk; "
+        "kinematic for a DXF or SVG outline, which the pymunk world does not take)",
     )
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     sim.add_argument(
@@ -75,7 +86,7 @@ def register(sub) -> None:
         "loopback TCP (arm on PORT, DAQ on PORT+1) or on two pseudo-terminals, "
         "until killed.",
     )
-    emu.add_argument("part", help="part file")
+    part_arguments(emu)
     emu.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
     emu.add_argument(
         "--start",
@@ -103,10 +114,14 @@ def simulate_command(args) -> int:
     from driver.trace import Trace
     from sim2d import SimRig, load_noise
 
-    part = load_part(args.part)
+    part = read_part(args)
+    if args.engine is None:
+        args.engine = "kinematic" if isinstance(part, Outline) else "pymunk"
     noise = load_noise(args.noise)
     if not args.roll and not args.reactive:
         raise UsageError("give the rolls (--roll DEG, repeated) or --reactive")
+    if not args.reactive:
+        spline_part(part, args, "the fixed rolls' two-roll rule")
     rolls = [math.radians(r) for r in (args.roll or [20.0])]
     if not 0 <= args.start < part.perimeter:
         raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
@@ -132,6 +147,11 @@ def simulate_command(args) -> int:
             ),
         )
         doc["trace"] = str(args.out)
+        if args.plot:
+            from driver.plotting import plot_reactive
+
+            plot_reactive(part, res, args.plot)
+            doc["plot"] = str(args.plot)
         print(json.dumps(doc, indent=2) if args.json else "", end="\n" if args.json else "")
         if not args.json:
             print_reactive(doc)
@@ -139,7 +159,7 @@ def simulate_command(args) -> int:
         return 0
     run = localize_by_rolling(
         rig,
-        part,
+        spline_part(part, args, "the fixed rolls' two-roll rule"),
         rolls,
         calibration=calibration,
         step=math.radians(args.step),
@@ -198,7 +218,7 @@ def emulate_command(args) -> int:
     from driver.emulator import Emulator, Faults
     from sim2d import SimRig
 
-    part = load_part(args.part)
+    part = read_part(args)
     faults = Faults.parse(args.fault)
     rig = SimRig(part, noise=args.noise, seed=args.seed, engine=args.engine)
     if args.start is None:

@@ -187,3 +187,38 @@ def test_a_start_the_jaw_cannot_be_laid_on_is_refused_before_anything_moves(tmp_
     err = capsys.readouterr().err
     assert f"--start {deepest} mm" in err and "no place on the jaw touches there" in err
     assert not (tmp_path / "x.npz").exists()
+
+
+def test_simulate_reactively_on_a_dxf_outline_with_its_plot(tmp_path, capsys):
+    # a CAD drawing runs on the kinematic world by default (the pymunk world takes splines only)
+    out, png = tmp_path / "b.npz", tmp_path / "b.png"
+    rc = main(
+        [
+            "simulate",
+            str(PARTS / "bracket.dxf"),
+            "--start",
+            "75",
+            "--reactive",
+            "--noise",
+            "none",
+            "--out",
+            str(out),
+            "--plot",
+            str(png),
+            "--json",
+        ]
+    )
+    doc = json.loads(capsys.readouterr().out)
+    assert rc == 0 and doc["stopped"] == "confident" and doc["error_mm"] < 0.3
+    assert png.stat().st_size > 10_000 and out.exists()
+
+
+def test_the_two_roll_rule_refuses_an_outline_and_says_what_works(capsys):
+    for argv in (
+        ["localize", str(PARTS / "bracket.dxf"), "--length", "5", "--turn", "10"],
+        ["simulate", str(PARTS / "profile.svg"), "--start", "10", "--roll", "20", "--out", "x.npz"],
+    ):
+        with pytest.raises(SystemExit) as info:
+            main(argv)
+        err = capsys.readouterr().err
+        assert info.value.code == 2 and "outline from CAD" in err and "--reactive" in err, err
