@@ -57,7 +57,7 @@ class Boundary(Protocol):
         ...
 
     def wrap_arc(self, sigma: ArrayLike) -> FloatArray:
-        """Arc positions reduced to [0, perimeter), mm."""
+        """Arc positions ``sigma`` (mm) reduced to [0, perimeter)."""
         ...
 
     def arc_offset(self, a: ArrayLike, b: ArrayLike) -> FloatArray:

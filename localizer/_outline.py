@@ -158,11 +158,11 @@ class Outline(ArcPositions):
         return np.asarray(t, dtype=float)
 
     def point(self, t: ArrayLike) -> FloatArray:
-        """:meth:`point_at_arc` (the parameter is the arc position, mm)."""
+        """:meth:`point_at_arc` at ``t`` (the parameter is the arc position, mm)."""
         return self.point_at_arc(t)
 
     def tangent_angle(self, t: ArrayLike) -> FloatArray:
-        """:meth:`tangent_angle_at_arc` (the parameter is the arc position, mm)."""
+        """:meth:`tangent_angle_at_arc` at ``t`` (the parameter is the arc position, mm)."""
         return self.tangent_angle_at_arc(t)
 
     def sample(self, spacing: float = 0.5) -> FloatArray:

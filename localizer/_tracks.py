@@ -201,7 +201,8 @@ class ModeTracks:
     def advance(
         self, index: IntArray, turn: FloatArray | float, *, turn_margin: float = 0.0
     ) -> tuple[FloatArray, BoolArray]:
-        """(arc, ok) of :meth:`step`."""
+        """(arc, ok) of :meth:`step` for the grid points ``index``, net rotation ``turn`` (rad) and
+        ``turn_margin`` (rad)."""
         arc, _, ok = self.step(index, turn, turn_margin=turn_margin)
         return arc, ok
 
