@@ -1,4 +1,5 @@
-# make demo : set up .venv, simulate two rolls on a shipped part with the paper's noise, localize (plot in out/)
+# make demo : set up .venv, simulate two rolls on a shipped part with the paper's noise, localize; then roll
+#             reactively on the bracket drawn in CAD (plots in out/)
 # make test : set up .venv; lint (ruff), type-check (mypy), run the tests, the doctests and the benchmark smoke run
 PYTHON ?= python3.11
 VENV   := .venv
@@ -17,6 +18,7 @@ demo: $(STAMP)
 	@mkdir -p out
 	$(VENV)/bin/rolltouch simulate parts/trefoil.json --start 120 --roll 20 --roll 15 --noise paper --engine pymunk --out out/demo.npz --plot out/demo.png
 	$(VENV)/bin/rolltouch locate out/demo.npz --part parts/trefoil.json
+	$(VENV)/bin/rolltouch simulate parts/bracket.dxf --start 75 --reactive --noise paper --seed 2 --out out/demo-cad.npz --plot out/demo-cad.png
 
 CODE   := localizer passivity sim2d driver bench tests
 
