@@ -302,7 +302,7 @@ def plot_study(study: Study, rows, out: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from localizer import load_part
+    from localizer import Outline, load_part
 
     full = summarize(study, rows)
     summ = full["levels"]
@@ -349,7 +349,8 @@ def plot_study(study: Study, rows, out: Path) -> None:
         by_name = {Path(p).name: p for p in study.parts}
         for ax, name in zip(axes[0], names):
             part = load_part(by_name[name])
-            xy = part.sample(16)
+            # an outline from CAD every 0.5 mm with its corners, a spline 16 points per piece
+            xy = part.sample(0.5) if isinstance(part, Outline) else part.sample(16)
             ax.plot(xy[:, 0], xy[:, 1], color="0.6", lw=1)
             sel = [r for r in rows if r["part"] == name and r["true_arc"] not in ("", "nan")]
             for ok, colour, label in ((1, "tab:green", "success"), (0, "tab:red", "failure")):

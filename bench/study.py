@@ -446,13 +446,14 @@ def _part(path: str) -> Part | Outline:
 def start_sampler(part, rolls, jaw_start: float):
     """Boundary points (grid indices) and grid step of the filter's tracks from which the jaw, laid with
     the contact at ``jaw_start`` mm on it, rolls through ``rolls`` (rad, one sign) without bridging,
-    with a millimetre to spare (:meth:`localizer.ModeTracks.rollable`)."""
+    with a millimetre to spare (:meth:`localizer.ModeTracks.rollable`), and not on a flat face."""
     from localizer import tracks_for
 
     tracks = tracks_for(part, 0.02)
     total = float(sum(rolls))
     turns = np.append(np.arange(0.0, abs(total), math.radians(1.0)), abs(total)) * math.copysign(1.0, total)
-    ok = np.flatnonzero(tracks.rollable(turns, jaw_start, margin=1.0))
+    # not on a flat face of an outline: a jaw laid there lies flush, its contact a line, not the start
+    ok = np.flatnonzero(tracks.rollable(turns, jaw_start, margin=1.0) & (tracks.kappa != 0))
     return ok, tracks
 
 
