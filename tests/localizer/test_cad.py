@@ -192,7 +192,10 @@ def test_the_shipped_bracket_and_profile():
     profile = load_outline(parts / "profile.svg")
     assert profile.point_at_arc(0.0) == pytest.approx([0.0, 0.0], abs=1e-12)  # the path's first M, y up
     assert len(profile.corners) == 3 and all(c.angle > 0 for c in profile.corners)
-    with pytest.raises(PartError, match="load_outline"):
-        from localizer import load_part
+    from localizer import Outline, load_part
 
-        load_part(parts / "bracket.dxf")
+    # load_part reads a drawing as its outline; a point file takes no layer or element
+    via_load_part = load_part(parts / "bracket.dxf")
+    assert isinstance(via_load_part, Outline) and via_load_part.perimeter == bracket.perimeter
+    with pytest.raises(PartError, match="layer='outline'.*point file"):
+        load_part(parts / "cam.json", layer="outline")
