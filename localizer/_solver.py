@@ -38,6 +38,8 @@ import numpy as np
 
 from ._errors import QueryError
 from ._march import PAPER_MARCH, MarchOptions, march
+from ._outline import Outline
+from ._outline_solver import outline_segments
 from ._part import _TWO_PI, Part
 from ._segment import DIRECTIONS, KINDS, Segment
 from ._table import ArcTable, arc_table
@@ -386,7 +388,7 @@ def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:
 
 
 def feasible_segments(
-    part: Part,
+    part: Part | Outline,
     length: float,
     turn: float,
     *,
@@ -399,8 +401,10 @@ def feasible_segments(
 
     Parameters
     ----------
-    part : Part
-        The part, from :func:`load_part`.
+    part : Part or Outline
+        The part, from :func:`load_part`. An outline from CAD is solved by
+        :func:`localizer.outline_segments` (exact on lines and arcs, corners and continua
+        included); the marching reference runs on splines only.
     length : float, mm
         Contact travel L on the jaw (= arc length on the part, eq. 3), ``0 < L < perimeter``.
     turn : float, rad
@@ -446,6 +450,13 @@ def feasible_segments(
     >>> abs(segs[2].start_arc - segs[0].start_arc - ellipse.perimeter / 2) < 1e-9
     True
     """
+    if isinstance(part, Outline):
+        if method != "exact":
+            raise QueryError(
+                f"method={method!r}: on an outline from CAD ({part.name}) only the exact solver runs "
+                "(localizer.outline_segments); the marching reference is for splines"
+            )
+        return outline_segments(part, length, turn, direction=direction)
     length, turn = _check_query(part, length, turn, direction, method)
     P = part.perimeter
     omega = turn if direction == "ccw" else -turn

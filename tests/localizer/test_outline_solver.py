@@ -104,3 +104,17 @@ def test_bad_queries():
     with pytest.raises(QueryError, match="direction"):
         outline_segments(o, 5.0, 0.1, direction="up")
     assert math.isfinite(o.perimeter)
+
+
+def test_feasible_segments_solves_an_outline_with_the_outline_solver():
+    from localizer import feasible_segments
+
+    bracket = load_outline(PARTS / "bracket.dxf")
+    found = 0
+    for length, turn, direction in ((12.0, 0.3, "ccw"), (30.0, math.pi / 2, "ccw"), (8.0, -0.4, "cw")):
+        got = feasible_segments(bracket, length, turn, direction=direction)
+        assert got == outline_segments(bracket, length, turn, direction=direction)
+        found += len(got)
+    assert found > 0
+    with pytest.raises(QueryError, match="marching reference is for splines"):
+        feasible_segments(bracket, 12.0, 0.3, method="march")
