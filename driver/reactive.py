@@ -406,9 +406,10 @@ class _Roller:
         if not tracks.has_faces:
             return False
         arc = self.direction * arc_from_jaw_positions([self.d_prev, d], s, self.offset)
-        idx = np.flatnonzero(self.flt.posterior() > 0)
+        posterior = self.flt.posterior()
+        idx = np.flatnonzero(posterior > 0)
         moved, _, ok = tracks.step(idx, self.turn_now(), jaw=self.d_prev, at=self.flt.current[idx])
-        w = self.flt.posterior()[idx]
+        w = posterior[idx]
         step = np.where(ok, moved - self.flt.current[idx], np.nan)
         fits = ok & (np.abs(step - arc) <= max(1.0, 0.1 * abs(arc)))
         return bool(w[fits].sum() > w[~ok].sum())

@@ -405,9 +405,14 @@ class ContactFilter:
         # never evaluated again)
         idx = self._live_idx
         # the contact's last place on the jaw says where a jaw laid flush on a face presses it
-        known = math.isfinite(self.jaw_position)
+        # (on a part with faces only: elsewhere the look-up would find none, once per reading)
+        flush = self.tracks.has_faces and math.isfinite(self.jaw_position)
         current, node, ok = self.tracks.step(
-            idx, turn, turn_margin=TURN_MARGIN, jaw=self.jaw_position if known else None, at=self.current[idx]
+            idx,
+            turn,
+            turn_margin=TURN_MARGIN,
+            jaw=self.jaw_position if flush else None,
+            at=self.current[idx] if flush else None,
         )
         if not ok.all():
             out = idx[~ok]

@@ -53,7 +53,10 @@ class ModeTracks:
     touchable : ndarray of bool
         The jaw touches the point at some place along it.
     convex : ndarray of bool
-        Where a rolling can be: a convex stretch (θ rising, κ > 0) the jaw touches.
+        Where a rolling can be: a convex stretch (θ not falling, κ ≥ 0: a flat face of an outline
+        belongs to the stretch around it) the jaw touches.
+    has_faces : bool
+        Some start lies on a flat face, which the jaw crosses in one step (a spline has none).
 
     Parameters
     ----------
@@ -155,6 +158,7 @@ class ModeTracks:
         # a start on a flat face (κ = 0 within a convex stretch) is where the jaw lay flush: the wrist
         # read the centre of pressure there, and the first turn takes the contact to the face's end
         self.convex: BoolArray = rising[a][self._run] & (kappa >= 0) & self.touchable
+        self.has_faces = bool(np.any(self.convex & (kappa == 0)))
         for arr in (
             self.sigma,
             self.theta,
@@ -175,12 +179,6 @@ class ModeTracks:
             self._run,
         ):
             arr.setflags(write=False)
-
-    @property
-    def has_faces(self) -> bool:
-        """Whether some start lies on a flat face (κ = 0 on a convex stretch), which the jaw crosses in
-        one step (a spline has none)."""
-        return bool(np.any(self.convex & (self.kappa == 0)))
 
     def node_at(self, arc: ArrayLike) -> IntArray:
         """The grid point nearest arc position(s) ``arc`` (mm, unwrapped; at a pivot, its first)."""
@@ -257,7 +255,7 @@ class ModeTracks:
         # no turn, no move: on a flat face the angle alone does not say where along it the contact is
         still = np.abs(np.asarray(turn)) <= NO_TURN
         node = np.where(w < 0.5, self._node[j - 1], self._node[j])
-        if jaw is not None and at is not None:
+        if jaw is not None and at is not None and self.has_faces:
             # flush on a face: the entry at or before the landing on a face of (nearly) that angle
             for e in (j, j - 1):
                 on = np.isfinite(self._face_a[e]) & (np.abs(self._banded[e] - target) <= FLUSH_TURN) & ~still
