@@ -13,7 +13,7 @@ from ._outline import Corner, Outline, outline_from_pieces
 from ._outline_solver import outline_segments
 from ._part import UNITS_TO_MM, Part, part_from_points
 from ._particle_filter import ParticleFilter
-from ._pieces import CircularArc, CubicBezier, Line
+from ._pieces import CircularArc, CubicBezier, Line, elliptical_arc
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._segment import DIRECTIONS, Segment
@@ -25,6 +25,7 @@ __all__ = [
     "Line",
     "CircularArc",
     "CubicBezier",
+    "elliptical_arc",
     "Outline",
     "Corner",
     "outline_from_pieces",

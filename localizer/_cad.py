@@ -14,13 +14,13 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from ._errors import PartError
 from ._outline import JOIN_TOL, Outline, outline_from_pieces
-from ._pieces import CircularArc, CubicBezier, Line, Piece
+from ._pieces import CircularArc, CubicBezier, Line, Piece, elliptical_arc
 
 __all__ = ["load_outline", "CAD_SUFFIXES"]
 
@@ -133,7 +133,17 @@ def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[st
                 pieces.extend(chain)
         elif kind == "SPLINE":
             pieces.extend(_spline(e, k, where))
-        elif kind == "ELLIPSE" and abs(float(e.dxf.ratio) - 1.0) <= 1e-12:
+        elif kind == "ELLIPSE" and abs(float(e.dxf.ratio) - 1.0) > 1e-12:
+            # the minor axis follows the extrusion, and t runs counter-clockwise about it
+            ce = cast(Any, e).construction_tool()
+            t0, t1 = float(ce.start_param), float(ce.end_param)
+            t1 = t0 + ((t1 - t0) % (2 * math.pi) or 2 * math.pi)
+            arcs = elliptical_arc(_pt(ce.center, k), _pt(ce.major_axis, k), _pt(ce.minor_axis, k), t0, t1)
+            if t1 - t0 >= 2 * math.pi - 1e-12:
+                loops.append(list(arcs))
+            else:
+                pieces.extend(arcs)
+        elif kind == "ELLIPSE":
             c, major = e.dxf.center, e.dxf.major_axis
             r = math.hypot(major.x, major.y) * k
             a0 = math.atan2(major.y, major.x) + float(e.dxf.start_param)
@@ -145,9 +155,8 @@ def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[st
                 pieces.append(arc)
         else:
             raise PartError(
-                f"{where}: cannot be read exactly"
-                + (" (an ellipse that is not a circle)" if kind == "ELLIPSE" else "")
-                + "; rolltouch reads LINE, ARC, CIRCLE, LWPOLYLINE, POLYLINE and SPLINE outlines"
+                f"{where}: cannot be read exactly; rolltouch reads LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE,"
+                " POLYLINE and SPLINE outlines"
             )
     loops.extend(_chain(pieces, str(path), ignored))
     return loops, ignored
@@ -194,25 +203,40 @@ def _polyline(e: Any, kind: str, k: float, where: str) -> list[Piece]:
 
 
 def _spline(e: Any, k: float, where: str) -> list[Piece]:
+    """A SPLINE's Bézier pieces. A rational one (NURBS weights) is split as the polynomial B-spline of
+    its homogeneous points (w·x, w·y, w), whose Béziers are the rational pieces' homogeneous points."""
+    from ezdxf.math import BSpline, Vec3
+
     bs = e.construction_tool()
-    if bs.is_rational:
-        raise PartError(f"{where}: a rational SPLINE (NURBS weights) cannot be read exactly yet")
+    rational = bool(bs.is_rational)
     degree = int(bs.degree)
-    out: list[Piece] = []
+    if degree not in (1, 2, 3):
+        raise PartError(f"{where}: a SPLINE of degree {degree}; rolltouch reads degrees 1 to 3")
+    if rational:
+        w = [float(v) for v in bs.weights()]
+        if not all(math.isfinite(v) and v > 0 for v in w):
+            raise PartError(f"{where}: NURBS weights {w} must be positive")
+        cps = [Vec3(float(p.x) * v, float(p.y) * v, v) for p, v in zip(bs.control_points, w, strict=True)]
+        bs = BSpline(cps, order=degree + 1, knots=bs.knots())
     try:
         parts = list(bs.bezier_decomposition())
     except Exception as exc:  # ezdxf refuses splines it cannot split (e.g. unclamped)
         raise PartError(f"{where}: cannot split the SPLINE into Bézier pieces ({exc})") from None
+    out: list[Piece] = []
     for cps in parts:
-        p = [_pt(c, k) for c in cps]
+        h = np.array([[float(c.x), float(c.y), float(c.z) if rational else 1.0] for c in cps])
+        p = [_pt(q[:2] / q[2], k) for q in h]
         if degree == 1:
             out.append(_line(p[0], p[1], where))
-        elif degree == 2:
+        elif not rational and degree == 2:
             out.append(CubicBezier.from_quadratic(p[0], p[1], p[2]))
-        elif degree == 3:
+        elif not rational:
             out.append(CubicBezier(p[0], p[1], p[2], p[3]))
         else:
-            raise PartError(f"{where}: a SPLINE of degree {degree}; rolltouch reads degrees 1 to 3")
+            if degree == 2:  # degree elevation of the homogeneous points
+                h = np.array([h[0], (h[0] + 2 * h[1]) / 3, (2 * h[1] + h[2]) / 3, h[2]])
+                p = [_pt(q[:2] / q[2], k) for q in h]
+            out.append(CubicBezier(p[0], p[1], p[2], p[3], (h[0, 2], h[1, 2], h[2, 2], h[3, 2])))
     return out
 
 
@@ -306,13 +330,14 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
                     loops.append(current)
                     current = []
             elif isinstance(seg, se.CubicBezier):
-                current.append(CubicBezier(*(pt(q) for q in (seg.start, seg.control1, seg.control2, seg.end))))
+                current.append(CubicBezier(pt(seg.start), pt(seg.control1), pt(seg.control2), pt(seg.end)))
             elif isinstance(seg, se.QuadraticBezier):
                 p0, p1, p2 = (pt(q) for q in (seg.start, seg.control, seg.end))
                 current.append(CubicBezier.from_quadratic(p0, p1, p2))
             elif isinstance(seg, se.Arc):
                 if abs(float(seg.rx) - float(seg.ry)) > 1e-9 * max(float(seg.rx), float(seg.ry)):
-                    raise PartError(f"{where}: an elliptical arc (rx={seg.rx:g}, ry={seg.ry:g}) cannot be read exactly")
+                    current.extend(_svg_ellipse(seg, pt, where))
+                    continue
                 cx, cy = pt(seg.center)
                 sx, sy = pt(seg.start)
                 # y flipped: angles and the sense of the sweep change sign
@@ -331,6 +356,28 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
 
 
 # ------------------------------------------------------------------ loops
+def _svg_ellipse(seg: Any, pt: Any, where: str) -> list[CubicBezier]:
+    """An SVG elliptical arc (after its transforms) as rational Béziers in the part's frame: the
+    conic's control points mapped by the same affine map as every other point (``pt``: units, y up),
+    which keeps a rational Bézier exact."""
+    rot = float(seg.get_rotation())
+    a, b = float(seg.rx), float(seg.ry)
+    cx, cy = float(seg.center.x), float(seg.center.y)
+    u = (a * math.cos(rot), a * math.sin(rot))
+    v = (-b * math.sin(rot), b * math.cos(rot))
+    t0 = float(seg.get_start_t())
+    t1 = float(seg.get_end_t())
+    sweep = float(seg.sweep)
+    dt = (t1 - t0) % (2 * math.pi) if sweep > 0 else -((t0 - t1) % (2 * math.pi))
+    arcs = elliptical_arc((cx, cy), u, v, t0, t0 + dt)
+    size = max(a, b)
+    for q, want in ((arcs[0].p0, seg.start), (arcs[-1].p3, seg.end)):
+        if math.dist(q, (float(want.x), float(want.y))) > 1e-7 * max(1.0, size):
+            raise PartError(f"{where}: an elliptical arc whose axes are not perpendicular (a skewed transform)")
+    # the control points through the same map as every other point (units, y flipped)
+    return [CubicBezier(pt(q.p0), pt(q.p1), pt(q.p2), pt(q.p3), q.weights) for q in arcs]
+
+
 def _chain(pieces: list[Piece], source: str, ignored: list[str]) -> list[list[Piece]]:
     """Loose pieces chained end to start (reversing pieces where needed) into closed loops; what
     does not close is reported in ``ignored``."""

@@ -165,6 +165,10 @@ class Outline(ArcPositions):
         """:meth:`tangent_angle_at_arc` at ``t`` (the parameter is the arc position, mm)."""
         return self.tangent_angle_at_arc(t)
 
+    def curvature(self, t: ArrayLike) -> FloatArray:
+        """:meth:`curvature_at_arc` at ``t`` (the parameter is the arc position, mm), 1/mm."""
+        return self.curvature_at_arc(t)
+
     def sample(self, spacing: float = 0.5) -> FloatArray:
         """A closed polyline through the outline every ``spacing`` mm or less (every piece's ends
         included), shape (M + 1, 2), mm, its last point the first."""

@@ -7,6 +7,11 @@ Bézier's arc length is the composite Gauss–Legendre integral of its speed on 
 until two rules agree to 1e-13 of the length, and its inverse (the Bézier parameter u at arc s) a
 safeguarded Newton iteration to 1e-12 mm.
 
+A Bézier may be *rational* (a weight per control point, the point Σ Bᵢwᵢpᵢ / Σ Bᵢwᵢ): it then draws
+conics exactly, so an ellipse's arc (:func:`elliptical_arc`, a quadratic rational Bézier per quarter
+or less) and a NURBS curve (split at its knots into rational Béziers) are pieces as exact as the
+others.
+
 A piece reversed (:meth:`reversed`) is the same curve travelled the other way: its tangent angle
 turns by π and its curvature changes sign.
 """
@@ -22,7 +27,7 @@ from ._errors import PartError
 from ._part import _wrap
 from ._types import ArrayLike, FloatArray
 
-__all__ = ["Line", "CircularArc", "CubicBezier", "Piece"]
+__all__ = ["Line", "CircularArc", "CubicBezier", "Piece", "elliptical_arc"]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
 _GL_X, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W
@@ -138,19 +143,30 @@ class CircularArc:
 
 @dataclass(frozen=True)
 class CubicBezier:
-    """A cubic Bézier from ``p0`` to ``p3`` with control points ``p1``, ``p2`` (mm)."""
+    """A cubic Bézier from ``p0`` to ``p3`` with control points ``p1``, ``p2`` (mm).
+
+    ``weights`` (positive, one per control point) make it rational: the point at u is
+    Σ Bᵢ(u)wᵢpᵢ / Σ Bᵢ(u)wᵢ. Equal weights give the ordinary polynomial Bézier.
+    """
 
     p0: tuple[float, float]
     p1: tuple[float, float]
     p2: tuple[float, float]
     p3: tuple[float, float]
+    weights: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)
     _breaks: FloatArray = field(init=False, repr=False, compare=False)  # u of the subintervals
     _cum: FloatArray = field(init=False, repr=False, compare=False)  # arc length at the breaks, mm
     _theta: FloatArray = field(init=False, repr=False, compare=False)  # unwrapped θ at 65 u, rad
+    _rational: bool = field(init=False, repr=False, compare=False)  # weights not all equal
 
     def __post_init__(self) -> None:
         for name in ("p0", "p1", "p2", "p3"):
             object.__setattr__(self, name, _xy(getattr(self, name), f"Bézier {name}"))
+        w = np.asarray(self.weights, dtype=float)
+        if w.shape != (4,) or not np.all(np.isfinite(w) & (w > 0)):
+            raise PartError(f"Bézier weights={self.weights!r} must be four positive numbers")
+        object.__setattr__(self, "weights", tuple(float(v) for v in w))
+        object.__setattr__(self, "_rational", bool(np.ptp(w) > 0))
         u = np.linspace(0.0, 1.0, 257)
         if np.hypot(*self._d1(u).T).min() <= 1e-9 * max(1.0, self._size()):
             raise PartError(f"Bézier {self.p0}…{self.p3} stops (zero speed, a cusp): split it there")
@@ -175,7 +191,33 @@ class CubicBezier:
         pts = np.array([self.p0, self.p1, self.p2, self.p3])
         return float(np.ptp(pts, axis=0).max())
 
+    def _homogeneous(self, u: FloatArray, order: int) -> list[FloatArray]:
+        """The polynomial Bézier of the homogeneous points (wᵢxᵢ, wᵢyᵢ, wᵢ) and its derivatives up to
+        ``order`` at ``u``, each shape (..., 3) (Horner in the power basis)."""
+        w = np.asarray(self.weights)
+        h = np.c_[np.array([self.p0, self.p1, self.p2, self.p3]) * w[:, None], w]
+        c0, c1, c2, c3 = h[0], 3 * (h[1] - h[0]), 3 * (h[2] - 2 * h[1] + h[0]), h[3] - 3 * h[2] + 3 * h[1] - h[0]
+        u = np.asarray(u, dtype=float)[..., None]
+        out = [((c3 * u + c2) * u + c1) * u + c0, (3 * c3 * u + 2 * c2) * u + c1]
+        if order >= 2:
+            out.append(6 * c3 * u + 2 * c2)
+        return out
+
+    def _rational_derivatives(self, u: FloatArray, order: int = 2) -> list[FloatArray]:
+        """Point and derivatives (up to ``order``) of the rational curve C = A/W at ``u``:
+        C' = (A' − W'C)/W, C'' = (A'' − 2W'C' − W''C)/W."""
+        h = self._homogeneous(u, order)
+        wt, w1 = h[0][..., 2:], h[1][..., 2:]
+        c = h[0][..., :2] / wt
+        c1 = (h[1][..., :2] - w1 * c) / wt
+        if order < 2:
+            return [c, c1]
+        c2 = (h[2][..., :2] - 2 * w1 * c1 - h[2][..., 2:] * c) / wt
+        return [c, c1, c2]
+
     def _bezier(self, u: FloatArray) -> FloatArray:
+        if self._rational:
+            return self._rational_derivatives(u, 1)[0]
         u = u[..., None]
         v = 1.0 - u
         p = [np.asarray(q) for q in (self.p0, self.p1, self.p2, self.p3)]
@@ -183,6 +225,8 @@ class CubicBezier:
         return out
 
     def _d1(self, u: FloatArray) -> FloatArray:
+        if self._rational:
+            return self._rational_derivatives(u, 1)[1]
         u = u[..., None]
         v = 1.0 - u
         p = [np.asarray(q) for q in (self.p0, self.p1, self.p2, self.p3)]
@@ -190,6 +234,8 @@ class CubicBezier:
         return out
 
     def _d2(self, u: FloatArray) -> FloatArray:
+        if self._rational:
+            return self._rational_derivatives(u)[2]
         u = u[..., None]
         p = [np.asarray(q) for q in (self.p0, self.p1, self.p2, self.p3)]
         out: FloatArray = 6 * (1.0 - u) * (p[2] - 2 * p[1] + p[0]) + 6 * u * (p[3] - 2 * p[2] + p[1])
@@ -265,15 +311,59 @@ class CubicBezier:
         return out
 
     @classmethod
-    def from_quadratic(cls, p0: tuple[float, float], p1: tuple[float, float], p2: tuple[float, float]) -> CubicBezier:
-        """The quadratic Bézier ``p0``, ``p1``, ``p2`` (mm) as the cubic it is exactly (degree elevation)."""
-        c1 = (p0[0] + 2 / 3 * (p1[0] - p0[0]), p0[1] + 2 / 3 * (p1[1] - p0[1]))
-        c2 = (p2[0] + 2 / 3 * (p1[0] - p2[0]), p2[1] + 2 / 3 * (p1[1] - p2[1]))
-        return cls(p0, c1, c2, p2)
+    def from_quadratic(
+        cls, p0: tuple[float, float], p1: tuple[float, float], p2: tuple[float, float], weight: float = 1.0
+    ) -> CubicBezier:
+        """The quadratic Bézier ``p0``, ``p1``, ``p2`` (mm), rational with weights (1, ``weight``, 1), as
+        the cubic it is exactly (degree elevation of the homogeneous points)."""
+        if not (math.isfinite(weight) and weight > 0):
+            raise PartError(f"quadratic Bézier weight={weight!r} must be a positive number")
+        if weight == 1.0:
+            c1 = (p0[0] + 2 / 3 * (p1[0] - p0[0]), p0[1] + 2 / 3 * (p1[1] - p0[1]))
+            c2 = (p2[0] + 2 / 3 * (p1[0] - p2[0]), p2[1] + 2 / 3 * (p1[1] - p2[1]))
+            return cls(p0, c1, c2, p2)
+        a, b, c = (np.asarray(q, dtype=float) for q in (p0, p1, p2))
+        w1 = (1.0 + 2.0 * weight) / 3.0
+        q1 = (a + 2.0 * weight * b) / (3.0 * w1)
+        q2 = (2.0 * weight * b + c) / (3.0 * w1)
+        return cls(p0, (float(q1[0]), float(q1[1])), (float(q2[0]), float(q2[1])), p2, (1.0, w1, w1, 1.0))
 
     def reversed(self) -> CubicBezier:
         """The same curve travelled from ``p3`` to ``p0``."""
-        return CubicBezier(self.p3, self.p2, self.p1, self.p0)
+        w = self.weights
+        return CubicBezier(self.p3, self.p2, self.p1, self.p0, (w[3], w[2], w[1], w[0]))
+
+
+def elliptical_arc(
+    center: tuple[float, float], u: tuple[float, float], v: tuple[float, float], t0: float, t1: float
+) -> list[CubicBezier]:
+    """The arc c + u·cos t + v·sin t for t from ``t0`` to ``t1`` (rad; decreasing travels the other
+    way) as exact rational Béziers, one per quarter of t or less.
+
+    ``u`` and ``v`` (mm) are conjugate semi-diameters (the semi-axes when perpendicular; any affine
+    image of a circle, e.g. an SVG arc after a skew, is such an arc). A piece over [a, b] is the
+    quadratic with end points C(a), C(b), middle point c + (u·cos m + v·sin m)/cos h and middle
+    weight cos h, m = (a + b)/2, h = (b − a)/2: the rational form of a conic, exact.
+    """
+    c, uu, vv = (np.asarray(q, dtype=float) for q in (center, u, v))
+    if not (np.all(np.isfinite(np.r_[c, uu, vv, t0, t1])) and t0 != t1):
+        raise PartError(f"elliptical arc centre={center!r} u={u!r} v={v!r} t={t0!r}..{t1!r} must be finite and sweep")
+    if abs(float(uu[0] * vv[1] - uu[1] * vv[0])) <= 1e-12 * float(np.dot(uu, uu) + np.dot(vv, vv)):
+        raise PartError(f"elliptical arc with semi-diameters u={u!r}, v={v!r} mm is flat (they are parallel)")
+    if abs(t1 - t0) > 2 * math.pi + 1e-12:
+        raise PartError(f"elliptical arc t={t0!r}..{t1!r} rad turns more than once")
+    n = max(1, math.ceil(abs(t1 - t0) / (0.5 * math.pi) - 1e-9))
+    ts = np.linspace(t0, t1, n + 1)
+
+    def at(t: float, scale: float = 1.0) -> tuple[float, float]:
+        q = c + (uu * math.cos(t) + vv * math.sin(t)) * scale
+        return float(q[0]), float(q[1])
+
+    out = []
+    for a, b in zip(ts[:-1], ts[1:], strict=True):
+        h = 0.5 * (b - a)
+        out.append(CubicBezier.from_quadratic(at(a), at(0.5 * (a + b), 1.0 / math.cos(h)), at(b), math.cos(h)))
+    return out
 
 
 #: Any of the pieces.

@@ -6,6 +6,7 @@ import math
 import ezdxf
 import numpy as np
 import pytest
+from scipy.special import ellipe
 
 from localizer import PartError, load_outline
 
@@ -102,13 +103,81 @@ def test_a_cubic_spline_is_read_as_bezier_pieces(tmp_path):
     assert o.perimeter == pytest.approx(dense + 30 + 60 + 30, abs=1e-6)
 
 
-def test_unreadable_entities_and_units_are_named(tmp_path):
+def ellipse_perimeter(a, b):
+    """4a·E(m), m = 1 − b²/a²: the complete elliptic integral of the second kind (scipy)."""
+    return 4 * a * ellipe(1 - (b / a) ** 2)
+
+
+def test_a_dxf_ellipse_is_exact_whatever_its_extrusion(tmp_path):
+    a, b, tilt = 30.0, 12.0, 0.3
+    for extrusion in ((0, 0, 1), (0, 0, -1)):
+        doc = ezdxf.new()
+        doc.header["$INSUNITS"] = 4
+        major = (a * math.cos(tilt), a * math.sin(tilt))
+        e = doc.modelspace().add_ellipse((5, 6), major_axis=major, ratio=b / a, dxfattribs={"extrusion": extrusion})
+        doc.saveas(tmp_path / "e.dxf")
+        o = load_outline(tmp_path / "e.dxf")
+        assert o.perimeter == pytest.approx(ellipse_perimeter(a, b), abs=1e-9)
+        assert o.corners == ()
+        # curvature against the closed form a·b / (a² sin² t + b² cos² t)^{3/2} at the points' own t
+        sigma = np.linspace(0, o.perimeter, 97, endpoint=False)
+        q = o.point_at_arc(sigma) - [5, 6]
+        x = q[:, 0] * math.cos(tilt) + q[:, 1] * math.sin(tilt)
+        y = -q[:, 0] * math.sin(tilt) + q[:, 1] * math.cos(tilt)
+        assert (x / a) ** 2 + (y / b) ** 2 == pytest.approx(1.0, abs=1e-12)
+        t = np.arctan2(y / b, x / a)
+        kappa = a * b / (a**2 * np.sin(t) ** 2 + b**2 * np.cos(t) ** 2) ** 1.5
+        assert o.curvature(sigma) == pytest.approx(kappa, rel=1e-9)
+        assert e.dxf.extrusion.z == extrusion[2]
+
+
+def test_a_dxf_elliptical_arc_closed_by_a_line(tmp_path):
     doc = ezdxf.new()
     doc.header["$INSUNITS"] = 4
-    doc.modelspace().add_ellipse((0, 0), major_axis=(10, 0), ratio=0.5)
-    doc.saveas(tmp_path / "e.dxf")
-    with pytest.raises(PartError, match="ELLIPSE .*an ellipse that is not a circle"):
-        load_outline(tmp_path / "e.dxf")
+    msp = doc.modelspace()
+    msp.add_ellipse((0, 0), major_axis=(20, 0), ratio=0.5, start_param=0.0, end_param=math.pi)
+    msp.add_line((-20, 0), (20, 0))
+    doc.saveas(tmp_path / "half.dxf")
+    o = load_outline(tmp_path / "half.dxf")
+    assert o.perimeter == pytest.approx(ellipse_perimeter(20, 10) / 2 + 40, abs=1e-9)
+    assert [c.angle for c in o.corners] == pytest.approx([math.pi / 2] * 2, abs=1e-9)
+
+
+def test_a_nurbs_circle_is_a_circle(tmp_path):
+    """The textbook degree-2 NURBS circle (nine control points, corner weights 1/√2): the reader
+    splits it as the B-spline of its homogeneous points, so it is a circle to rounding."""
+    r, w = 20.0, math.sqrt(0.5)
+    cps = [(r, 0), (r, r), (0, r), (-r, r), (-r, 0), (-r, -r), (0, -r), (r, -r), (r, 0)]
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    knots = [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+    doc.modelspace().add_rational_spline(cps, [1, w, 1, w, 1, w, 1, w, 1], degree=2, knots=knots)
+    doc.saveas(tmp_path / "c.dxf")
+    o = load_outline(tmp_path / "c.dxf")
+    assert o.perimeter == pytest.approx(2 * math.pi * r, abs=1e-9)
+    sigma = np.linspace(0, o.perimeter, 101, endpoint=False)
+    assert np.hypot(*o.point_at_arc(sigma).T) == pytest.approx(r, abs=1e-12)
+    assert o.curvature(sigma) == pytest.approx(1 / r, rel=1e-9)
+    # arc position is arc length: the points' polar angle grows as σ / r
+    angle = np.unwrap(np.arctan2(*o.point_at_arc(sigma)[:, ::-1].T))
+    assert angle - angle[0] == pytest.approx(sigma / r, abs=1e-9)
+
+
+def test_a_weighted_cubic_spline_matches_ezdxf_dense(tmp_path):
+    cps = [(0, 0), (10, 25), (40, 30), (60, 0)]
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    spline = msp.add_rational_spline(cps, [1.0, 3.0, 0.5, 1.0], degree=3)
+    msp.add_line((60, 0), (0, 0))
+    doc.saveas(tmp_path / "w.dxf")
+    o = load_outline(tmp_path / "w.dxf")
+    pts = np.array([(v.x, v.y) for v in spline.construction_tool().approximate(400_000)])
+    dense = float(np.hypot(*np.diff(pts, axis=0).T).sum())
+    assert o.perimeter == pytest.approx(dense + 60, abs=1e-6)
+
+
+def test_unreadable_entities_and_units_are_named(tmp_path):
     bracket_dxf(tmp_path / "u.dxf", units=3)  # miles
     with pytest.raises(PartError, match=r"\$INSUNITS=3"):
         load_outline(tmp_path / "u.dxf")
@@ -160,11 +229,21 @@ def test_an_svg_element_can_be_chosen(tmp_path):
         load_outline(tmp_path / "p.svg", element="x")
 
 
-def test_an_elliptical_svg_arc_is_named(tmp_path):
-    svg = '<svg xmlns="http://www.w3.org/2000/svg"><path id="e" d="M 0 0 L 50 0 A 20 10 0 0 1 50 20 L 0 20 Z"/></svg>'
+def test_elliptical_svg_arcs_are_exact_in_a_path_and_an_ellipse(tmp_path):
+    svg = """<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
+      <path id="p" d="M 20 50 A 30 12 0 0 1 80 50 A 30 12 0 0 1 20 50 Z"/>
+      <path id="d" d="M 0 0 L 50 0 A 20 10 0 0 1 50 20 L 0 20 Z"/>
+      <ellipse id="q" cx="50" cy="50" rx="30" ry="12" transform="rotate(20 50 50)"/></svg>"""
     (tmp_path / "e.svg").write_text(svg)
-    with pytest.raises(PartError, match="Path e: an elliptical arc"):
-        load_outline(tmp_path / "e.svg")
+    for element in ("p", "q"):
+        assert load_outline(tmp_path / "e.svg", element=element).perimeter == pytest.approx(
+            ellipse_perimeter(30, 12), abs=1e-9
+        )
+    # a D: three lines and half an ellipse, its 20 mm chord the y semi-axis (10) twice, bulging by rx = 20
+    d = load_outline(tmp_path / "e.svg", element="d")
+    assert d.perimeter == pytest.approx(50 + 20 + 50 + ellipse_perimeter(20, 10) / 2, abs=1e-9)
+    far = d.point_at_arc(np.linspace(0, d.perimeter, 20001))[:, 0].max()
+    assert far == pytest.approx(70.0, abs=1e-4)
 
 
 def test_two_equal_loops_need_a_choice(tmp_path):

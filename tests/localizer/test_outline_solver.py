@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import Line, QueryError, load_outline, outline_from_pieces, outline_segments
+from localizer import Line, QueryError, elliptical_arc, load_outline, outline_from_pieces, outline_segments
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 H = 0.002  # mm between the reference's points
@@ -40,8 +40,11 @@ def near_a_piece_end(outline, sigma, margin):
     return (d < margin).any(axis=-1)
 
 
-@pytest.fixture(scope="module", params=["bracket.dxf", "profile.svg"])
+@pytest.fixture(scope="module", params=["bracket.dxf", "profile.svg", "half-ellipse"])
 def outline(request):
+    if request.param == "half-ellipse":  # rational Béziers: three quarters of an ellipse and two lines
+        arcs = elliptical_arc((0.0, 0.0), (40.0, 0.0), (0.0, 15.0), -0.5 * math.pi, math.pi)
+        return outline_from_pieces([*arcs, Line((-40.0, 0.0), (0.0, 0.0)), Line((0.0, 0.0), (0.0, -15.0))])
     return load_outline(PARTS / request.param)
 
 
