@@ -615,7 +615,9 @@ def roll(
             raise RigError(
                 f"step {j + 1} of the roll bridged a concave stretch: the contact jumped "
                 f"{abs(d[-1] - d[-2]):.1f} mm on the jaw (limit {bridge_jump} mm). A straight jaw "
-                "touches the convex hull there; start where the rolls stay on convex stretches"
+                "touches the convex hull there; start where the rolls stay on convex stretches. (On a "
+                "part drawn with flat faces a jaw tipping over a face jumps as well, which fixed rolls "
+                "cannot tell from a bridge: roll reactively, --reactive, whose belief tells them apart)"
             )
     sign = 1.0 if angle > 0 else -1.0
     du = np.diff(d)
@@ -716,7 +718,7 @@ def roll_sequence(
 
 def localize_by_rolling(
     rig: Rig,
-    part: Part,
+    part: Part | Outline,
     rolls,
     *,
     calibration: Calibration,
@@ -760,7 +762,7 @@ def localize_by_rolling(
 
 def run_from_here(
     rig: Rig,
-    part: Part,
+    part: Part | Outline,
     rolls,
     *,
     calibration: Calibration | None = None,

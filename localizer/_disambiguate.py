@@ -24,6 +24,7 @@ rolls, each starting where the previous one ended. Two rules:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -31,8 +32,11 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from ._boundary import Boundary
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
+from ._outline import Outline
+from ._outline_chain import chain_likelihood, chain_paper
 from ._part import Part
 from ._segment import DIRECTIONS, Segment
 from ._solver import feasible_segments
@@ -126,7 +130,7 @@ class Localization:
         return self.best is None or self.best.probability < self.confidence
 
 
-def _check_rolls(part: Part, rolls: Iterable[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+def _check_rolls(part: Boundary, rolls: Iterable[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
     try:
         chain = [(float(L), float(w)) for L, w in rolls]
     except (TypeError, ValueError):
@@ -275,8 +279,60 @@ def _likelihood(
     return out
 
 
+def _on_outline(
+    outline: Outline,
+    chain: tuple[tuple[float, float], ...],
+    segs: list[Segment],
+    rule: str,
+    sign: float,
+    sd_length: float,
+    sd_turn: float,
+    length_tol: float,
+    turn_tol: float,
+    min_separation: float,
+) -> list[Candidate]:
+    """The rules on an outline with corners (:mod:`localizer._outline_chain`) as candidates."""
+    P = outline.perimeter
+
+    def candidate(pos: FloatArray, res: FloatArray, prob: float, score: float) -> Candidate:
+        wrapped = np.mod(pos, P)
+        return Candidate(
+            start_arc=float(wrapped[0]),
+            end_arc=float(wrapped[-1]),
+            path=tuple(float(v) for v in wrapped),
+            lengths=tuple(float(v) for v in np.abs(np.diff(pos))),
+            turn_residuals=tuple(float(v) for v in res),
+            probability=prob,
+            score=score,
+            start_param=float(wrapped[0]),
+            end_param=float(wrapped[-1]),
+        )
+
+    if rule == "paper":
+        rows = chain_paper(outline, chain, segs, sign, length_tol)
+        if not rows:
+            return []
+        best = min(r[0] for r in rows)
+        limit = best + turn_tol * max(len(chain) - 1, 1)
+        rows.sort(key=lambda r: r[0])
+        kept: list[tuple[float, FloatArray, FloatArray]] = []
+        ends = np.empty(len(rows))
+        for r in rows:
+            if r[0] > limit:
+                break
+            end = r[1][-1] % P
+            gap = np.abs((ends[: len(kept)] - end + 0.5 * P) % P - 0.5 * P)
+            if not (gap <= min_separation).any():
+                ends[len(kept)] = end
+                kept.append(r)
+        out = [candidate(pos, res, 1.0 / len(kept), score) for score, pos, res in kept]
+        return out
+    modes = chain_likelihood(outline, chain, sign, sd_length, sd_turn, min_separation)
+    return [candidate(arcs, res, prob, -math.log(max(prob, 1e-300))) for prob, arcs, res in modes]
+
+
 def localize(
-    part: Part,
+    part: Part | Outline,
     rolls: Iterable[tuple[float, float]],
     *,
     rule: str = "likelihood",
@@ -292,7 +348,9 @@ def localize(
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
+        On an outline with corners both rules weigh every start on a grid (see
+        :mod:`localizer._outline_chain`): corners and continua make a least-squares fit unsound.
     rolls : sequence of (float, float)
         Measured (contact travel L in mm, signed jaw rotation Ω in rad) of each roll.
     rule : {"likelihood", "paper"}
@@ -353,7 +411,9 @@ def localize(
     chain = _check_rolls(part, rolls)
     sign = 1.0 if direction == "ccw" else -1.0
     segs = feasible_segments(part, chain[0][0], chain[0][1], direction=direction)
-    if rule == "paper":
+    if isinstance(part, Outline):
+        cands = _on_outline(part, chain, segs, rule, sign, sd_length, sd_turn, length_tol, turn_tol, min_separation)
+    elif rule == "paper":
         cands = _paper(part, chain, segs, sign, length_tol, turn_tol)
         cands.sort(key=lambda c: (-c.probability, c.score))
     else:

@@ -28,10 +28,14 @@ from ._types import ArrayLike, FloatArray
 
 __all__ = ["Outline", "Corner", "outline_from_pieces"]
 
-#: Two pieces meet when the end of one is this close to the start of the next, mm, and a tangent
-#: that turns by less than this, rad, across a meeting point is smooth there (no corner).
+#: Two pieces meet when the end of one is this close to the start of the next, mm.
 JOIN_TOL = 1e-6
-SMOOTH_TOL = 1e-9
+#: A tangent that turns by less than this across a meeting point, rad, is smooth there (no corner).
+#: A drawing written with coordinates rounded to 1 µm (SVG text, DXF exports) breaks a smooth join by
+#: about 1e-7 rad over a 10 mm control arm, and by 1e-4 at 1e-3 mm; such a "corner" would be a pivot
+#: (or, turned the other way, a concave corner the jaw cannot touch) in the middle of a smooth
+#: stretch. 1e-3 rad is half of two steps of the arm's 0.03° encoder: a jump the jaw cannot sense.
+SMOOTH_TOL = 1e-3
 
 
 class Corner(NamedTuple):

@@ -18,7 +18,6 @@ __all__ = [
     "add_command",
     "part_arguments",
     "read_part",
-    "spline_part",
     "positive",
     "probability",
     "rig_arguments",
@@ -56,17 +55,6 @@ def part_arguments(p, help: str = "part file") -> None:
 def read_part(args) -> Part | Outline:
     """The part that :func:`part_arguments` named."""
     return load_part(args.part, layer=getattr(args, "layer", None), element=getattr(args, "element", None))
-
-
-def spline_part(part: Part | Outline, args, what: str, instead: str = "localize with --reactive") -> Part:
-    """``part`` if it is a point-file spline; an outline from CAD raises :class:`UsageError` saying that
-    ``what`` needs one (the two-roll rule is not built on outlines yet) and what to do ``instead``."""
-    if isinstance(part, Outline):
-        raise UsageError(
-            f"{args.part} is an outline from CAD: {what} runs on point-file parts only so far (issue 16); "
-            f"on an outline {instead}"
-        )
-    return part
 
 
 def _number(text: str, ok, what: str) -> float:

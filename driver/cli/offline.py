@@ -9,9 +9,9 @@ import sys
 
 import numpy as np
 
-from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, load_part, localize
+from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
 
-from ._options import add_command, part_arguments, positive, read_part, spline_part
+from ._options import add_command, part_arguments, positive, read_part
 from ._output import emit_run, run_summary
 
 __all__ = ["register", "localize_command", "locate_command"]
@@ -94,9 +94,7 @@ def register(sub) -> None:
 
 
 def localize_command(args) -> int:
-    part = spline_part(
-        read_part(args), args, "the two-roll localization", "roll reactively: rolltouch simulate|run PART --reactive"
-    )
+    part = read_part(args)
     rolls = [(args.length, np.radians(args.turn))] + [(L, np.radians(d)) for L, d in args.then]
     result = localize(
         part,
@@ -129,7 +127,11 @@ def localize_command(args) -> int:
         json.dump(doc, sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
-        print(f"part {part.name}: perimeter {part.perimeter:.3f} mm, {part.n_knots} knots")
+        if isinstance(part, Outline):
+            made = f"{len(part.pieces)} pieces, {len(part.corners)} corners"
+        else:
+            made = f"{part.n_knots} knots"
+        print(f"part {part.name}: perimeter {part.perimeter:.3f} mm, {made}")
         print(f"roll 1 (L={rolls[0][0]:.4g} mm, turn={args.turn:.4g} deg): {len(result.segments)} feasible segment(s)")
         if not result.candidates:
             print("no place on the part fits these rolls")
@@ -153,12 +155,7 @@ def localize_command(args) -> int:
 def locate_command(args) -> int:
     from driver.trace import Trace
 
-    part = spline_part(
-        load_part(args.part),
-        args,
-        "the two-roll localization",
-        "roll reactively: rolltouch simulate|run PART --reactive",
-    )
+    part = load_part(args.part)
     trace = Trace.load(args.trace)
     estimates = trace.estimates()
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"

@@ -21,7 +21,6 @@ from ._options import (
     read_part,
     rig_arguments,
     servo_arguments,
-    spline_part,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
@@ -100,8 +99,6 @@ def run_command(args) -> int:
     from driver.trace import Trace
 
     part = read_part(args)
-    if not args.reactive:
-        spline_part(part, args, "the fixed rolls' two-roll rule")
     rolls = args.roll or [20.0, 15.0]
     calibration = Calibration.load(args.calibration) if args.calibration else None
     header = {
@@ -129,7 +126,7 @@ def run_command(args) -> int:
     with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         run, calibration = run_from_here(
             rig,
-            spline_part(part, args, "the fixed rolls' two-roll rule"),
+            part,
             [math.radians(r) for r in rolls],
             calibration=calibration,
             step=math.radians(args.step),

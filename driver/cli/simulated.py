@@ -22,7 +22,6 @@ from ._options import (
     reactive_arguments,
     read_part,
     servo_arguments,
-    spline_part,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
@@ -120,8 +119,6 @@ def simulate_command(args) -> int:
     noise = load_noise(args.noise)
     if not args.roll and not args.reactive:
         raise UsageError("give the rolls (--roll DEG, repeated) or --reactive")
-    if not args.reactive:
-        spline_part(part, args, "the fixed rolls' two-roll rule")
     rolls = [math.radians(r) for r in (args.roll or [20.0])]
     if not 0 <= args.start < part.perimeter:
         raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
@@ -159,7 +156,7 @@ def simulate_command(args) -> int:
         return 0
     run = localize_by_rolling(
         rig,
-        spline_part(part, args, "the fixed rolls' two-roll rule"),
+        part,
         rolls,
         calibration=calibration,
         step=math.radians(args.step),

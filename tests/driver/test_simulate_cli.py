@@ -9,6 +9,7 @@ import pytest
 from driver.cli import main
 from driver.rig import RigError
 from driver.trace import COLUMNS, Trace
+from localizer import CircularArc, load_part
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 
@@ -213,12 +214,24 @@ def test_simulate_reactively_on_a_dxf_outline_with_its_plot(tmp_path, capsys):
     assert png.stat().st_size > 10_000 and out.exists()
 
 
-def test_the_two_roll_rule_refuses_an_outline_and_says_what_works(capsys):
-    for argv in (
-        ["localize", str(PARTS / "bracket.dxf"), "--length", "5", "--turn", "10"],
-        ["simulate", str(PARTS / "profile.svg"), "--start", "10", "--roll", "20", "--out", "x.npz"],
-    ):
-        with pytest.raises(SystemExit) as info:
-            main(argv)
-        err = capsys.readouterr().err
-        assert info.value.code == 2 and "outline from CAD" in err and "--reactive" in err, err
+def test_the_two_roll_rule_runs_on_outlines(capsys, tmp_path):
+    """Fixed rolls on a CAD outline, simulated and localized; and the offline rule on the bracket from
+    the outline's own turns (a roll over a fillet, then along a face: the truth among the candidates)."""
+    rc = main(
+        ["simulate", str(PARTS / "profile.svg"), "--start", "140", "--roll", "20", "--roll", "15"]
+        + ["--noise", "none", "--out", str(tmp_path / "p.npz"), "--json"]
+    )
+    doc = json.loads(capsys.readouterr().out)
+    assert rc == 0 and doc["error_mm"] < 0.3
+    bracket = load_part(PARTS / "bracket.dxf")
+    fillet = next(i for i, p in enumerate(bracket.pieces) if isinstance(p, CircularArc))
+    s0 = float(bracket.starts[fillet]) + 1.0
+    pos = s0 + np.array([0.0, 6.0, 14.0])
+    turns = np.degrees(np.diff(bracket.tangent_angle_at_arc(pos)))
+    rc = main(
+        ["localize", str(PARTS / "bracket.dxf"), "--length", "6", "--turn", repr(float(turns[0]))]
+        + ["--then", "8", repr(float(turns[1])), "--sd-length", "0.02", "--json"]
+    )
+    doc = json.loads(capsys.readouterr().out)
+    ends = [c["end_arc"] for c in doc["candidates"]]
+    assert rc == 0 and min(abs(bracket.arc_offset(e, pos[-1] % bracket.perimeter)) for e in ends) < 0.5

@@ -68,3 +68,23 @@ class DenseCurve:
             else:
                 roots.append(brentq(f, a, b, xtol=1e-13))
         return np.sort(np.mod(roots, self.perimeter))
+
+
+class ChordAngle:
+    """θ by arc position from the directions of a dense polyline's chords (independent of Outline's
+    bookkeeping of corners and pieces)."""
+
+    def __init__(self, outline, spacing=0.002):
+        self.H = spacing  # mm between the points
+        self.P = outline.perimeter
+        s = np.arange(0.0, self.P, self.H)
+        xy = outline.point_at_arc(s)
+        d = np.diff(np.vstack([xy, xy[:1]]), axis=0)
+        raw = np.arctan2(d[:, 1], d[:, 0])
+        self.theta = raw[0] + np.concatenate([[0.0], np.cumsum((np.diff(raw) + np.pi) % (2 * np.pi) - np.pi)])
+        self.mid = s + self.H / 2  # a chord's direction is the tangent's at its middle (to O(H²))
+
+    def __call__(self, sigma):
+        sigma = np.asarray(sigma, dtype=float)
+        lap = np.floor(sigma / self.P)
+        return np.interp(sigma - lap * self.P, self.mid, self.theta) + 2 * np.pi * lap

@@ -278,3 +278,23 @@ def test_the_shipped_bracket_and_profile():
     assert isinstance(via_load_part, Outline) and via_load_part.perimeter == bracket.perimeter
     with pytest.raises(PartError, match="layer='outline'.*point file"):
         load_part(parts / "cam.json", layer="outline")
+
+
+def test_smooth_joins_written_with_rounded_coordinates_are_not_corners(tmp_path):
+    """Béziers joined smoothly, written with 3 decimals (as exporters do): the rounding breaks each
+    join by up to about 1e-4 rad, which must not make corners (a concave one would be a place the
+    jaw cannot touch in the middle of a smooth stretch); the one real corner stays."""
+    a = np.linspace(0, 2 * np.pi, 7)[:-1]
+    pts = np.c_[40 * np.cos(a), 30 * np.sin(a)]
+    tan = np.c_[-40 * np.sin(a), 30 * np.cos(a)] * (2 * np.pi / 6) / 3
+    tan[0] = 0.0  # a sharp point at the first: its controls lie on the chords
+    d = [f"M {pts[0][0]:.3f} {pts[0][1]:.3f}"]
+    for i in range(6):
+        j = (i + 1) % 6
+        # unequal arms on the two sides of a join (still tangent): their rounding errors differ
+        c1 = pts[i] + (0.8 * tan[i] if i else (pts[j] - pts[i]) / 3)
+        c2 = pts[j] - (1.1 * tan[j] if j else (pts[j] - pts[i]) / 3)
+        d.append("C " + " ".join(f"{v:.3f}" for v in (*c1, *c2, *pts[j])))
+    (tmp_path / "r.svg").write_text(f'<svg xmlns="http://www.w3.org/2000/svg"><path d="{" ".join(d)} Z"/></svg>')
+    o = load_outline(tmp_path / "r.svg")
+    assert len(o.corners) == 1 and o.corners[0].arc == 0.0 and o.corners[0].angle > 0.5

@@ -9,27 +9,9 @@ import pytest
 
 from localizer import Line, QueryError, elliptical_arc, load_outline, outline_from_pieces, outline_segments
 
+from .reference import ChordAngle
+
 PARTS = Path(__file__).resolve().parents[2] / "parts"
-H = 0.002  # mm between the reference's points
-
-
-class ChordAngle:
-    """θ by arc position from the directions of a dense polyline's chords (independent of Outline's
-    bookkeeping of corners and pieces)."""
-
-    def __init__(self, outline):
-        self.P = outline.perimeter
-        s = np.arange(0.0, self.P, H)
-        xy = outline.point_at_arc(s)
-        d = np.diff(np.vstack([xy, xy[:1]]), axis=0)
-        raw = np.arctan2(d[:, 1], d[:, 0])
-        self.theta = raw[0] + np.concatenate([[0.0], np.cumsum((np.diff(raw) + np.pi) % (2 * np.pi) - np.pi)])
-        self.mid = s + H / 2  # a chord's direction is the tangent's at its middle (to O(H²))
-
-    def __call__(self, sigma):
-        sigma = np.asarray(sigma, dtype=float)
-        lap = np.floor(sigma / self.P)
-        return np.interp(sigma - lap * self.P, self.mid, self.theta) + 2 * np.pi * lap
 
 
 def near_a_piece_end(outline, sigma, margin):
