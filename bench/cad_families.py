@@ -58,7 +58,7 @@ def _plate(rng: np.random.Generator, path: Path) -> str:
         a_in, a_out = (q - p) / np.linalg.norm(q - p), (r - q) / np.linalg.norm(r - q)
         turn = math.atan2(a_in[0] * a_out[1] - a_in[1] * a_out[0], float(a_in @ a_out))
         if rng.random() < 0.6:
-            shorter = min(np.linalg.norm(q - p), np.linalg.norm(r - q))
+            shorter = float(min(np.linalg.norm(q - p), np.linalg.norm(r - q)))
             f = min(rng.uniform(3.0, 12.0), 0.3 * shorter / max(abs(math.tan(turn / 2)), 1e-6))
             back = f * abs(math.tan(turn / 2))
             t0, t1 = q - a_in * back, q + a_out * back

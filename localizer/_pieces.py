@@ -337,13 +337,26 @@ class CubicBezier:
 def elliptical_arc(
     center: tuple[float, float], u: tuple[float, float], v: tuple[float, float], t0: float, t1: float
 ) -> list[CubicBezier]:
-    """The arc c + u·cos t + v·sin t for t from ``t0`` to ``t1`` (rad; decreasing travels the other
-    way) as exact rational Béziers, one per quarter of t or less.
+    """The arc c + u·cos t + v·sin t for t from ``t0`` to ``t1`` as exact rational Béziers, one per
+    quarter of t or less.
 
-    ``u`` and ``v`` (mm) are conjugate semi-diameters (the semi-axes when perpendicular; any affine
-    image of a circle, e.g. an SVG arc after a skew, is such an arc). A piece over [a, b] is the
-    quadratic with end points C(a), C(b), middle point c + (u·cos m + v·sin m)/cos h and middle
-    weight cos h, m = (a + b)/2, h = (b − a)/2: the rational form of a conic, exact.
+    A piece over [a, b] is the quadratic with end points C(a), C(b), middle point
+    c + (u·cos m + v·sin m)/cos h and middle weight cos h, m = (a + b)/2, h = (b − a)/2: the rational
+    form of a conic, exact.
+
+    Parameters
+    ----------
+    center : (float, float), mm
+        The ellipse's centre c.
+    u, v : (float, float), mm
+        Conjugate semi-diameters: the semi-axes when perpendicular (any affine image of a circle,
+        e.g. an SVG arc after a skew, is such an arc).
+    t0, t1 : float, rad
+        The parameter's first and last value; t1 < t0 travels the other way.
+
+    Returns
+    -------
+    list of CubicBezier
     """
     c, uu, vv = (np.asarray(q, dtype=float) for q in (center, u, v))
     if not (np.all(np.isfinite(np.r_[c, uu, vv, t0, t1])) and t0 != t1):
