@@ -25,7 +25,7 @@ def register(sub) -> None:
     mc.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
     mc.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask distributed scheduler")
     mc.add_argument("--resume", action="store_true", help="keep finished trials, run only the missing ones")
-    mc.set_defaults(interrupted="interrupted: finished trials are kept; rerun with --resume")
+    mc.set_defaults(interrupted="finished trials are kept; rerun with --resume")
 
 
 def montecarlo_command(args) -> int:

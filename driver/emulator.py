@@ -11,6 +11,7 @@ import math
 import os
 import socket
 import threading
+import time
 import tty
 from dataclasses import dataclass
 
@@ -24,20 +25,30 @@ __all__ = ["Faults", "Emulator"]
 
 @dataclass(frozen=True)
 class Faults:
-    """Faults the emulator injects (all off by default).
+    """Faults the emulator injects (all off by default), as a real rig has them.
 
     Attributes
     ----------
     drop : float
-        Probability that a reply is not sent.
+        Probability in [0, 1] that a reply is not sent.
     garble : float
-        Probability that a reply is corrupted (one byte changed).
+        Probability in [0, 1] that a reply is corrupted (one byte changed).
     delay : float, s
-        Added before every reply.
+        Added before every reply (0 to 60).
     disconnect_after : int or None
         Close both devices when the arm receives command N+1.
     saturate : float or None, V
-        The DAQ's channels clip at ±this value.
+        The DAQ's channels clip at ±this value (> 0).
+    encoder_stuck : int or None
+        From the arm's command N+1 on, POSE reports the jaw angle it had then (a stuck encoder).
+    daq_constant : float or None, V
+        The DAQ answers every READ, STREAM and ZERO with this voltage on both channels (a dead
+        amplifier).
+    limit_after : int or None
+        From the arm's command N+1 on, MOVE is refused with ``ERR LIMIT`` (the arm at the edge of its
+        workspace mid-roll).
+    drift : float, V/s
+        The channels' zero drifts by this much per second of the emulator's clock (both channels).
     """
 
     drop: float = 0.0
@@ -45,12 +56,48 @@ class Faults:
     delay: float = 0.0
     disconnect_after: int | None = None
     saturate: float | None = None
+    encoder_stuck: int | None = None
+    daq_constant: float | None = None
+    limit_after: int | None = None
+    drift: float = 0.0
+
+    def __post_init__(self) -> None:
+        def bad(name: str, value: object, why: str) -> RigError:
+            return RigError(f"fault {name.replace('_', '-')}={value!r}: {why}")
+
+        for name in ("drop", "garble"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and 0.0 <= v <= 1.0):
+                raise bad(name, v, "a probability must be in [0, 1]")
+        if not (math.isfinite(self.delay) and 0.0 <= self.delay <= MAX_DELAY):
+            raise bad("delay", self.delay, f"a delay must be in [0, {MAX_DELAY:g}] s")
+        for name in ("disconnect_after", "encoder_stuck", "limit_after"):
+            v = getattr(self, name)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 0):
+                raise bad(name, v, "a number of arm commands must be a whole number ≥ 0")
+        if self.saturate is not None and not (math.isfinite(self.saturate) and self.saturate > 0):
+            raise bad("saturate", self.saturate, "the clipping level must be a positive voltage")
+        if self.daq_constant is not None and not (math.isfinite(self.daq_constant) and abs(self.daq_constant) <= 100):
+            raise bad("daq_constant", self.daq_constant, "a voltage must be finite, within ±100 V")
+        if not (math.isfinite(self.drift) and abs(self.drift) <= 1.0):
+            raise bad("drift", self.drift, "a drift must be finite, within ±1 V/s")
 
     @classmethod
     def parse(cls, specs) -> Faults:
-        """From strings ``name=value`` (``drop``, ``garble``, ``delay``, ``disconnect-after``, ``saturate``)."""
+        """From strings ``name=value`` (the attributes, with ``-`` for ``_``: ``drop=0.05``,
+        ``encoder-stuck=200``, ...)."""
         kwargs = {}
-        names = {"drop": float, "garble": float, "delay": float, "disconnect-after": int, "saturate": float}
+        names = {
+            "drop": float,
+            "garble": float,
+            "delay": float,
+            "disconnect-after": int,
+            "saturate": float,
+            "encoder-stuck": int,
+            "daq-constant": float,
+            "limit-after": int,
+            "drift": float,
+        }
         for spec in specs or ():
             name, _, value = str(spec).partition("=")
             if name not in names or not value:
@@ -60,6 +107,10 @@ class Faults:
             except ValueError:
                 raise RigError(f"fault {spec!r}: {value!r} is not a {names[name].__name__}") from None
         return cls(**kwargs)
+
+
+#: The longest reply delay the emulator injects, s.
+MAX_DELAY = 60.0
 
 
 class Emulator:
@@ -86,17 +137,26 @@ class Emulator:
         self.zero = (0.0, 0.0)
         self.input_range = 10.0  # V: the DAQ's input range, reported by STATUS
         self._closers: list = []
+        self._stuck_phi: float | None = None  # the angle a stuck encoder keeps reporting, rad
+        self._t0 = time.monotonic()  # the drifting zero's clock
         if start_pose is not None:
             rig.move(*start_pose)
 
     # ------------------------------------------------------------ devices
     def _arm(self, seq, cmd, args):
+        f = self.faults
+        if f.encoder_stuck is not None and self.arm_commands > f.encoder_stuck and self._stuck_phi is None:
+            self._stuck_phi = self.rig.pose()[2]
         if cmd == "MOVE":
+            if f.limit_after is not None and self.arm_commands > f.limit_after:
+                return [encode_reply(seq, "ERR", "LIMIT", "outside_the_workspace")]
             x, y, phi_deg = args
             self.rig.move(x, y, math.radians(phi_deg))
             return [encode_reply(seq, "OK")]
         if cmd == "POSE":
             x, y, phi = self.rig.pose()
+            if self._stuck_phi is not None:
+                phi = self._stuck_phi
             return [encode_reply(seq, "OK", float(x), float(y), float(math.degrees(phi)))]
         if cmd == "STOP":
             return [encode_reply(seq, "OK")]
@@ -114,8 +174,11 @@ class Emulator:
         return [encode_reply(seq, "OK", "READY")]
 
     def _sample(self, n):
+        if self.faults.daq_constant is not None:
+            return float(self.faults.daq_constant), float(self.faults.daq_constant)
         v1, v2 = self.rig.read(n)
-        v1, v2 = v1 - self.zero[0], v2 - self.zero[1]
+        drift = self.faults.drift * (time.monotonic() - self._t0)
+        v1, v2 = v1 - self.zero[0] + drift, v2 - self.zero[1] + drift
         s = self.faults.saturate
         if s is not None:
             v1, v2 = float(np.clip(v1, -s, s)), float(np.clip(v2, -s, s))
@@ -133,7 +196,8 @@ class Emulator:
                 return [encode_reply(seq, "ERR", "BADARG", "STREAM n must be in 1..10000")]
             return [encode_reply(seq, "DATA", *self._sample(1)) for _ in range(n)] + [encode_reply(seq, "OK")]
         if cmd == "ZERO":
-            self.zero = self.rig.read(256)
+            if self.faults.daq_constant is None:
+                self.zero = self.rig.read(256)
             return [encode_reply(seq, "OK")]
         return [encode_reply(seq, "OK", "READY", float(self.faults.saturate or self.input_range))]
 

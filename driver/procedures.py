@@ -23,7 +23,18 @@ from scipy.interpolate import CubicSpline
 
 from localizer import ROLL_STEP, Boundary, Localization, Outline, Part, arc_from_jaw_positions, localize
 
-from .rig import Clocked, ForceServo, GroundTruth, Reading, Rig, RigError, SampleLog, Truth
+from .rig import (
+    Clocked,
+    ForceServo,
+    GroundTruth,
+    ImplausibleReading,
+    ProtocolError,
+    Reading,
+    Rig,
+    RigError,
+    SampleLog,
+    Truth,
+)
 
 __all__ = [
     "hold_force",
@@ -42,7 +53,13 @@ __all__ = [
     "roll",
     "roll_sequence",
     "localize_by_rolling",
+    "ANGLE_SLACK",
 ]
+
+
+#: How far the arm's reported jaw angle may be from the commanded one, rad: its encoder reads to 0.03°
+#: and the arm settles within a step or two; a stuck encoder is off by 0.5° after three 0.2° steps.
+ANGLE_SLACK = math.radians(0.5)
 
 
 # ------------------------------------------------------------------ hand
@@ -76,6 +93,26 @@ class Hand:
         """Rotate by ``angle`` rad about the tool axis (the wrist's axis)."""
         x, y, phi = self.pose
         self.go(x, y, phi + angle)
+
+    def measured_angle(self) -> float:
+        """The arm's reported jaw angle, rad, checked against the commanded one: a stuck or misread
+        encoder (or a reply of 1e308°) would otherwise be taken as the jaw's rotation and localize,
+        confidently, somewhere else. Backs the jaw off and raises :class:`RigError` when they differ by
+        more than :data:`ANGLE_SLACK`."""
+        phi = float(self.rig.pose()[2])
+        commanded = self.pose[2]
+        if not (math.isfinite(phi) and abs(phi - commanded) <= ANGLE_SLACK):
+            try:
+                self.press_by(-5.0)
+                backed = "the jaw was backed off 5 mm"
+            except RigError as exc:
+                backed = f"backing the jaw off failed too ({exc})"
+            raise ImplausibleReading(
+                f"the arm reports the jaw at {math.degrees(phi):.6g}° where {math.degrees(commanded):.6g}° was "
+                f"commanded (more than {math.degrees(ANGLE_SLACK):g}° apart): its encoder is stuck or misread. "
+                f"The roll was stopped and {backed}; check the arm before localizing"
+            )
+        return phi
 
 
 # ------------------------------------------------------------ settings
@@ -198,15 +235,25 @@ def press(
     dv1, dv2 = delta_voltages(rig, baseline, n)
     travelled = 0.0
     threshold = 0.1 * target
+    seen = {(dv1, dv2)}
     while dv1 < threshold:
         if travelled >= max_travel:
+            hand.press_by(-travelled)  # back where the search began: with a dead sensor it may be in the part
+            if len(seen) == 1:
+                raise ImplausibleReading(
+                    f"the wrist read exactly Δv1 = {dv1:.6g} V, Δv2 = {dv2:.6g} V at every one of "
+                    f"{round(travelled / search_step) + 1} readings while the jaw moved {travelled:.1f} mm: a "
+                    "working sensor's noise changes every reading, so the DAQ or the strain-gauge amplifier "
+                    f"is not reading. The jaw was moved back {travelled:.1f} mm; check the sensor's wiring"
+                )
             raise RigError(
                 f"no contact after pressing {travelled:.1f} mm along the jaw normal "
-                f"(Δv1 = {dv1:.3f} V); start closer to the part"
+                f"(Δv1 = {dv1:.3f} V); the jaw was moved back; start closer to the part"
             )
         hand.press_by(search_step)
         travelled += search_step
         dv1, dv2 = delta_voltages(rig, baseline, n)
+        seen.add((dv1, dv2))
     prev = None
     for _ in range(max_steps):
         if dv1 > overload:
@@ -506,7 +553,8 @@ def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=Non
     dv1, dv2 = delta_voltages(rig, baseline, n)
     if readings is not None:
         x, y, phi_cmd = hand.pose if hand is not None else (math.nan,) * 3
-        readings.append(Reading(dv1, dv2, rig.pose()[2], _clock(rig), x, y, phi_cmd))
+        phi = hand.measured_angle() if hand is not None else rig.pose()[2]
+        readings.append(Reading(dv1, dv2, phi, _clock(rig), x, y, phi_cmd))
         t = rig.truth() if isinstance(rig, GroundTruth) else {}
         truth.append(Truth(t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
     if dv1 <= 0.1 * calibration.target:
@@ -593,12 +641,14 @@ def roll(
 
     d = [_location(rig, baseline, calibration, n, readings, truth, hand)]
     observe(0)
-    phis = [rig.pose()[2]]
+    phis = [hand.measured_angle()]
     for j in range(k):
         hand.rotate_by(angle / k)
         press(rig, hand, baseline, target=calibration.target, n=n, pressing=pressing)
         try:
             d.append(_location(rig, baseline, calibration, n, readings, truth, hand))
+        except (ImplausibleReading, ProtocolError):
+            raise  # a device fault, not a bridge
         except RigError:
             if bridge_jump is not None and j > 0:  # left the calibrated span in one jump
                 hand.press_by(-5.0)
@@ -608,7 +658,7 @@ def roll(
                     "convex hull there; start where the rolls stay on convex stretches"
                 ) from None
             raise
-        phis.append(rig.pose()[2])
+        phis.append(hand.measured_angle())
         observe(j + 1)
         if bridge_jump is not None and abs(d[-1] - d[-2]) > bridge_jump:
             hand.press_by(-5.0)
@@ -712,8 +762,20 @@ def roll_sequence(
                 )
             )
         except RigError as exc:
-            raise RigError(f"roll {k + 1}: {exc}") from None
+            raise _in_roll(exc, k) from None
     return tuple(results)
+
+
+def _in_roll(exc: RigError, k: int) -> RigError:
+    """``exc`` said of roll ``k`` (0-based), of the same class (a device's refusal stays a
+    :class:`ProtocolError`, an implausible reading an :class:`ImplausibleReading`)."""
+    if isinstance(exc, ProtocolError):
+        out: RigError = ProtocolError(exc.code, f"roll {k + 1}: {exc.message}", exc.seq)
+    else:
+        out = type(exc)(f"roll {k + 1}: {exc}")
+    for note in getattr(exc, "__notes__", []):
+        out.add_note(note)
+    return out
 
 
 def localize_by_rolling(
@@ -750,6 +812,13 @@ def localize_by_rolling(
         pressing=pressing,
     )
     estimates = tuple((r.length, r.turn) for r in results)
+    for k, (length, turn) in enumerate(estimates):
+        if not (math.isfinite(length) and length > 0):
+            raise ImplausibleReading(
+                f"roll {k + 1} measured a contact travel of {length:.4g} mm for a rotation of "
+                f"{math.degrees(turn):+.3f}°: the contact cannot move against the rolling, so the wrist's zero "
+                "drifted or its calibration is off; recalibrate (rolltouch calibrate) and roll again"
+            )
     direction = "ccw" if results[0].step > 0 else "cw"
     loc = localize(part, estimates, rule=rule, direction=direction, sd_length=sd_length, sd_turn=sd_turn)
     return RollingRun(

@@ -48,7 +48,11 @@ import numpy as np
 from localizer import ROLL_STEP, Belief, Boundary, ContactFilter, arc_from_jaw_positions
 
 from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
-from .rig import Reading, Rig, RigError, Truth
+from .rig import ImplausibleReading, ProtocolError, Reading, Rig, RigError, Truth
+
+#: What the rolling never takes for a bridge or a lost contact: a device's own refusal (``ERR``, e.g. a
+#: workspace limit mid-roll) and a reading that cannot be (a stuck encoder, a dead DAQ).
+DEVICE_FAULTS = (ImplausibleReading, ProtocolError)
 
 __all__ = [
     "ReactiveRun",
@@ -311,6 +315,8 @@ class _Roller:
                 pressing=self.pressing,
             )
             return True
+        except DEVICE_FAULTS:
+            raise
         except RigError:
             return False
 
@@ -318,7 +324,7 @@ class _Roller:
         return self.truth[-1].contact_arc if self.truth else math.nan
 
     def turn_now(self) -> float:
-        return self.rig.pose()[2] - self.phi0
+        return self.hand.measured_angle() - self.phi0
 
     # ------------------------------------------------------------------ the run
     def run(self, approach_pose) -> ReactiveRun:
@@ -332,7 +338,7 @@ class _Roller:
         self.jaw_limit = float(np.max(np.abs(self.calibration.positions))) - p.end_margin
         self.d_prev = self.read()
         flt.touch(self.d_prev)  # the first contact's place on the jaw: where the jaw could have been laid
-        self.phi0 = rig.pose()[2]
+        self.phi0 = self.hand.measured_angle()
         self.true_arcs = [self.true_arc()]
         stopped = "max_rotation"
         while self.rotation < p.max_rotation - 1e-12:
@@ -367,6 +373,8 @@ class _Roller:
         self.rotation += p.step
         try:
             d = self.read() if self.pressed() else math.inf
+        except DEVICE_FAULTS:
+            raise
         except RigError:
             d = math.inf  # left the calibrated span, or the press was refused: treated as a bridge
         bridged = not math.isfinite(d) or (abs(d - self.d_prev) > p.bridge_jump and not self._crossed_face(d, s))
@@ -425,6 +433,8 @@ class _Roller:
         self.hand.slide_by(slide)
         try:
             d_new = self.read() if self.pressed() else math.inf
+        except DEVICE_FAULTS:
+            raise
         except RigError:
             d_new = math.inf
         if abs(d_new - target_d) <= p.bridge_jump:
@@ -453,6 +463,8 @@ class _Roller:
             if not self.pressed():
                 raise RigError("the press back was refused")
             self.d_prev = self.read()
+        except DEVICE_FAULTS:
+            raise
         except RigError:
             return "lost"
         # the re-read is a new base for the increments: a new segment with its own offset

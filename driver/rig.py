@@ -15,6 +15,7 @@ from typing import NamedTuple, Protocol, runtime_checkable
 from localizer import RolltouchError
 
 __all__ = [
+    "ImplausibleReading",
     "Rig",
     "ForceServo",
     "Clocked",
@@ -30,6 +31,12 @@ __all__ = [
 
 class RigError(RolltouchError, IOError):
     """A rig that did not do what was asked: no contact, contact off the jaw, a bad reply, a limit."""
+
+
+class ImplausibleReading(RigError):
+    """A device reported what cannot be: an arm angle far from the commanded one (a stuck or misread
+    encoder), a wrist that reads exactly the same while the jaw moves (a dead DAQ). Never taken for a
+    bridge or a lost contact: the run stops on it."""
 
 
 class ProtocolError(RigError):

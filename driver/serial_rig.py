@@ -11,9 +11,15 @@ manager to get it on any error.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import math
+import os
+import signal
+import tempfile
+import threading
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import serial
 
@@ -85,14 +91,25 @@ class SerialRig:
         self._seq = 0
         self._commanded: tuple[float, float, float] | None = None
         self.ports = {}
+        self._locks: list = []
         try:
             for name, url in (("arm", arm_url), ("daq", daq_url)):
+                self._locks.append(_device_lock(name, url))
+                # a local device is also locked by the OS (pyserial's flock), against other programs
+                local = "://" not in url
                 self.ports[name] = serial.serial_for_url(
-                    url, timeout=self.timeout, write_timeout=self.timeout, baudrate=baudrate
+                    url,
+                    timeout=self.timeout,
+                    write_timeout=self.timeout,
+                    baudrate=baudrate,
+                    **({"exclusive": True} if local and os.name == "posix" else {}),
                 )
         except (serial.SerialException, ValueError) as exc:
             self.close()
             raise RigError(f"cannot open the {name} at {url}: {exc}") from None
+        except RigError:
+            self.close()
+            raise
         # the DAQ reports its input range: readings at its ends are saturated
         try:
             status = self._transact("daq", "STATUS")
@@ -145,6 +162,8 @@ class SerialRig:
                     if reply.status == "DATA":
                         continue
                     return reply
+            except RigError:
+                raise  # the device's own refusal (ERR): not a connection failure
             except serial.SerialException as exc:
                 raise RigError(f"the {device} connection failed during {command}: {exc}") from None
             except OSError as exc:
@@ -205,12 +224,29 @@ class SerialRig:
         """STOP the arm."""
         self._transact("arm", "STOP")
 
-    def safe_stop(self) -> None:
-        """Best effort: stop the arm and back the jaw ``backoff`` mm off the part. Never raises."""
-        for action in (self.stop, self._back_off):
-            with contextlib.suppress(RigError, OSError, serial.SerialException):
-                action()
-        self._emit({"event": "safe_stop"})
+    def safe_stop(self) -> str:
+        """Best effort: stop the arm and back the jaw ``backoff`` mm off the part. Never raises; a
+        Ctrl-C or SIGTERM while it runs is held until it is done. Returns what really happened, as a
+        sentence for the user (also logged as the ``safe_stop`` event)."""
+        done = {}
+        with _signals_held():
+            for name, action in (("stop", self.stop), ("back_off", self._back_off)):
+                try:
+                    action()
+                    done[name] = ""
+                except (RigError, OSError, serial.SerialException) as exc:
+                    done[name] = str(exc)
+        if self._commanded is None:
+            done["back_off"] = "no MOVE had been sent, so there was nothing to back off from"
+        stopped = "the arm was stopped" if not done["stop"] else f"STOP failed ({done['stop']})"
+        if not done["back_off"]:
+            backed = f"the jaw was backed off {self.backoff:g} mm"
+        elif self._commanded is None:
+            backed = done["back_off"]
+        else:
+            backed = f"backing the jaw off failed ({done['back_off']}): jog it clear of the part by hand"
+        self._emit({"event": "safe_stop", "stop_problem": done["stop"], "back_off_problem": done["back_off"]})
+        return f"{stopped}; {backed}"
 
     def _back_off(self):
         if self._commanded is None:
@@ -223,12 +259,62 @@ class SerialRig:
         for port in self.ports.values():
             with contextlib.suppress(OSError, serial.SerialException):
                 port.close()
+        for lock in self._locks:
+            with contextlib.suppress(OSError):
+                lock.close()
+        self._locks = []
 
     def __enter__(self):
         return self
 
     def __exit__(self, exc_type, exc, tb):
         if exc_type is not None:
-            self.safe_stop()
+            outcome = self.safe_stop()
+            if isinstance(exc, BaseException):
+                exc.add_note(outcome)  # the CLI prints it after the error: what the host really did
         self.close()
         return False
+
+
+def _device_lock(name: str, url: str):
+    """An exclusive lock on ``url`` for this process (a lock file in the temporary folder, whatever
+    the transport): two host processes driving one arm would interleave their commands and replies.
+    Raises :class:`RigError` naming the holder when another process has it."""
+    path = Path(tempfile.gettempdir()) / f"rolltouch-{hashlib.sha1(url.encode()).hexdigest()[:16]}.lock"
+    handle = open(path, "a+")  # noqa: SIM115 - held open for the rig's lifetime, closed by close()
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: pyserial opens COM ports exclusively itself
+        return handle
+    try:
+        fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        handle.seek(0)
+        holder = handle.read().strip() or "another process"
+        handle.close()
+        raise RigError(
+            f"the {name} at {url} is in use by {holder} (lock {path}): two hosts driving one arm would "
+            "interleave their commands; stop the other run first"
+        ) from None
+    handle.seek(0)
+    handle.truncate()
+    handle.write(f"rolltouch pid {os.getpid()}")
+    handle.flush()
+    return handle
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """Ignore SIGINT, SIGTERM and SIGHUP while the block runs (the main thread only): a second Ctrl-C
+    must not cut the safe stop short. The safe stop is always on the way out (its caller raises next),
+    so a signal that came meanwhile has nothing left to stop."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    names = [getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    old = {sig: signal.signal(sig, signal.SIG_IGN) for sig in names}
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)

@@ -4,7 +4,7 @@ from ._belief import Belief, Mode
 from ._boundary import Boundary
 from ._cad import CAD_SUFFIXES, load_outline
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, SLOPE_ENVELOPE, TEMPER, ContactFilter
-from ._defaults import LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
+from ._defaults import FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._files import load_part
@@ -37,6 +37,7 @@ __all__ = [
     "MIN_SEPARATION",
     "SUCCESS_RADIUS",
     "ROLL_STEP",
+    "FIT_ALPHA",
     "ContactFilter",
     "ParticleFilter",
     "Belief",

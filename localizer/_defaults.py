@@ -7,7 +7,7 @@ experiments and the rolling step of its arm (0.2°, §IV).
 
 import math
 
-__all__ = ["LENGTH_TOL", "TURN_TOL", "MIN_SEPARATION", "SUCCESS_RADIUS", "ROLL_STEP"]
+__all__ = ["LENGTH_TOL", "TURN_TOL", "MIN_SEPARATION", "SUCCESS_RADIUS", "ROLL_STEP", "FIT_ALPHA"]
 
 #: The paper's tolerance on a segment's contact travel, mm.
 LENGTH_TOL = 0.004
@@ -19,3 +19,7 @@ MIN_SEPARATION = 0.5
 SUCCESS_RADIUS = 0.3
 #: The arm's rolling step, rad (0.2°).
 ROLL_STEP = math.radians(0.2)
+#: Readings whose best fit is this improbable under the noise model fit no place on the part: the
+#: χ² test's level (a real fit fails it once in 10 000 chains; a stuck encoder or a misread turn of
+#: degrees as radians fails it by hundreds of standard deviations).
+FIT_ALPHA = 1e-4

@@ -31,9 +31,10 @@ from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
+from scipy.stats import chi2
 
 from ._boundary import Boundary
-from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
+from ._defaults import FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._outline import Outline
 from ._outline_chain import chain_likelihood, chain_paper
@@ -44,6 +45,10 @@ from ._types import FloatArray
 
 __all__ = ["Candidate", "Localization", "localize", "RULES"]
 
+#: The smallest standard deviations :func:`localize` accepts: a contact travel to 0.1 µm, a rotation to
+#: 1e-7 rad (0.02 arc-seconds); below them the likelihood's exponents overflow.
+SD_LENGTH_MIN = 1e-4
+SD_TURN_MIN = 1e-7
 #: Disambiguation rules accepted by :func:`localize`.
 RULES = ("likelihood", "paper")
 
@@ -110,6 +115,10 @@ class Localization:
         Direction the contact moved on the part.
     confidence : float
         Probability the best candidate needs for the result not to be ambiguous.
+    fit_pvalue : float
+        How probable a fit as poor as the best candidate's is under the noise model (the χ² test of
+        its standardized residuals, n − 1 degrees of freedom for n rolls; 1 for one roll, which any
+        feasible segment fits exactly; 0 when nothing fits).
     """
 
     candidates: tuple[Candidate, ...]
@@ -118,6 +127,7 @@ class Localization:
     rule: str
     direction: str
     confidence: float
+    fit_pvalue: float = 1.0
 
     @property
     def best(self) -> Candidate | None:
@@ -125,9 +135,17 @@ class Localization:
         return self.candidates[0] if self.candidates else None
 
     @property
+    def consistent(self) -> bool:
+        """False when the readings fit no place on the part: no candidate, or the best one's fit fails
+        the χ² test at :data:`localizer.FIT_ALPHA` (implausible readings: a stuck encoder, a wrong
+        unit). Then no candidate's probability means anything."""
+        return self.best is not None and self.fit_pvalue >= FIT_ALPHA
+
+    @property
     def ambiguous(self) -> bool:
-        """True when no candidate reaches ``confidence`` (e.g. a symmetric part)."""
-        return self.best is None or self.best.probability < self.confidence
+        """True when no candidate reaches ``confidence`` (e.g. a symmetric part), or the readings fit no
+        place (:attr:`consistent`)."""
+        return not self.consistent or self.best is None or self.best.probability < self.confidence
 
 
 def _check_rolls(part: Boundary, rolls: Iterable[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
@@ -397,9 +415,13 @@ def localize(
         raise QueryError(f"unknown rule {rule!r}; use one of {list(RULES)}")
     if direction not in DIRECTIONS:
         raise QueryError(f"unknown direction {direction!r}; use one of {list(DIRECTIONS)}")
+    for name, val, floor in (("sd_length", sd_length, SD_LENGTH_MIN), ("sd_turn", sd_turn, SD_TURN_MIN)):
+        if not (np.isfinite(val) and val >= floor):
+            raise QueryError(
+                f"{name}={val!r} is below {floor:g} ({'mm' if name == 'sd_length' else 'rad'}): no sensor is that "
+                "precise, and the probabilities would overflow; give the reading's real standard deviation"
+            )
     for name, val in (
-        ("sd_length", sd_length),
-        ("sd_turn", sd_turn),
         ("length_tol", length_tol),
         ("turn_tol", turn_tol),
         ("min_separation", min_separation),
@@ -413,11 +435,19 @@ def localize(
     segs = feasible_segments(part, chain[0][0], chain[0][1], direction=direction)
     if isinstance(part, Outline):
         cands = _on_outline(part, chain, segs, rule, sign, sd_length, sd_turn, length_tol, turn_tol, min_separation)
+        lik = "likelihood"
+        fits = (
+            cands
+            if rule == lik
+            else _on_outline(part, chain, segs, lik, sign, sd_length, sd_turn, 0, 0, min_separation)
+        )
     elif rule == "paper":
         cands = _paper(part, chain, segs, sign, length_tol, turn_tol)
         cands.sort(key=lambda c: (-c.probability, c.score))
+        fits = _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation)
     else:
         cands = _likelihood(part, chain, sign, direction, sd_length, sd_turn, min_separation)
+        fits = cands
     return Localization(
         candidates=tuple(cands),
         segments=tuple(segs),
@@ -425,4 +455,25 @@ def localize(
         rule=rule,
         direction=direction,
         confidence=confidence,
+        fit_pvalue=_fit_pvalue(chain, fits, sd_length, sd_turn),
     )
+
+
+def _fit_pvalue(
+    chain: tuple[tuple[float, float], ...], fits: list[Candidate], sd_length: float, sd_turn: float
+) -> float:
+    """The χ² test of the readings against the part, whichever rule disambiguates: the likelihood
+    rule's best fit (``fits``), its turn residuals over ``sd_turn`` and its lengths' misfit over
+    ``sd_length``, n − 1 degrees of freedom (n rolls: 2n readings; a start and n lengths fitted)."""
+    if not fits:
+        return 0.0
+    n = len(chain)
+    if n < 2:
+        return 1.0
+    best = min(fits, key=lambda c: c.score)
+    res = np.asarray(best.turn_residuals, dtype=float)
+    misfit = np.asarray(best.lengths, dtype=float) - np.array([L for L, _ in chain])
+    stat = float(np.sum((res / sd_turn) ** 2) + np.sum((misfit / sd_length) ** 2))
+    if not np.isfinite(stat):
+        return 0.0
+    return float(chi2.sf(stat, n - 1))

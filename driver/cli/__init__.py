@@ -14,22 +14,34 @@ that do not go together are argparse's own error (usage, status 2).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
+import threading
 from importlib import metadata
 
 from localizer import RolltouchError
 
 from ._options import UsageError, add_command
 
-__all__ = ["main", "build_parser", "add_command", "UsageError", "COMMAND_GROUPS", "ENTRY_POINT_GROUP"]
+__all__ = [
+    "main",
+    "build_parser",
+    "add_command",
+    "UsageError",
+    "Terminated",
+    "COMMAND_GROUPS",
+    "ENTRY_POINT_GROUP",
+]
 
 #: driver's command groups, in the order ``rolltouch --help`` lists them.
 COMMAND_GROUPS = ("driver.cli.offline", "driver.cli.simulated", "driver.cli.rig")
 #: The entry-point group through which other packages add command groups (a ``register(sub)`` each).
 ENTRY_POINT_GROUP = "rolltouch.commands"
-#: What an interrupted command says unless it sets its own (``interrupted`` in its parser's defaults).
-INTERRUPTED = "interrupted: the arm was stopped and the jaw backed off"
+#: What an interrupted command says it did unless the arm's safe stop says (the exception's notes) or
+#: the command sets its own (``interrupted`` in its parser's defaults, or on ``args`` as it goes).
+INTERRUPTED = "no arm command was being run"
 
 
 def _version() -> str:
@@ -60,20 +72,57 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (``timeout``, systemd, a closed terminal): handled as Ctrl-C is, so that the
+    arm is stopped and the jaw backed off on the way out."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _termination_as_interrupt():
+    """SIGTERM and SIGHUP raise :class:`Terminated` while the block runs (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    names = [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    old = {sig: signal.signal(sig, _terminate) for sig in names}
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+
+
+def _notes(exc: BaseException) -> str:
+    """What the host did on the way out (e.g. the safe stop), as the exception's notes say."""
+    return "; ".join(getattr(exc, "__notes__", []))
+
+
 def main(argv=None) -> int:
     """Run ``rolltouch`` with ``argv`` (default: the process's); returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.run(args))
+        with _termination_as_interrupt():
+            return int(args.run(args))
     except UsageError as exc:
         args.parser.error(str(exc))  # exits with status 2
     except RolltouchError as exc:
-        print(f"rolltouch: error: {exc}", file=sys.stderr)
+        notes = _notes(exc)
+        print(f"rolltouch: error: {exc}" + (f" ({notes})" if notes else ""), file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"\nrolltouch: {getattr(args, 'interrupted', INTERRUPTED)}", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        what = f"terminated by {exc.args[0]}" if isinstance(exc, Terminated) else "interrupted"
+        done = _notes(exc) or getattr(args, "interrupted", INTERRUPTED)
+        print(f"\nrolltouch: {what}: {done}", file=sys.stderr)
+        return 128 + exc.signum if isinstance(exc, Terminated) else 130
     except BrokenPipeError:
         return 0
     return 2

@@ -6,12 +6,12 @@ import json
 import math
 import sys
 
-from localizer import SUCCESS_RADIUS, ContactFilter
+from localizer import FIT_ALPHA, SUCCESS_RADIUS, ContactFilter
 
 from ..rig import GroundTruth
 from ._options import pressing
 
-__all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run"]
+__all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run", "no_fit_line"]
 
 
 def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:
@@ -80,6 +80,8 @@ def run_summary(part, trace, loc) -> dict:
         "estimates": [{"length": L, "turn": w, "turn_deg": math.degrees(w)} for L, w in loc.rolls],
         "estimate_arc": estimate,
         "ambiguous": loc.ambiguous,
+        "consistent": loc.consistent,
+        "fit_pvalue": loc.fit_pvalue,
         "candidates": [c.as_dict() for c in loc.candidates],
     }
     true_arc = trace.true_arc
@@ -89,8 +91,9 @@ def run_summary(part, trace, loc) -> dict:
     return doc
 
 
-def emit_run(args, doc, part, trace, loc) -> None:
-    """Print a run's result (JSON or text) and draw it if asked: simulate, locate and run alike."""
+def emit_run(args, doc, part, trace, loc) -> int:
+    """Print a run's result (JSON or text) and draw it if asked: simulate, locate and run alike. Returns
+    the exit status: 2 when the readings fit no place on the part (:func:`no_fit_line`), else 0."""
     if args.json:
         json.dump(doc, sys.stdout, indent=2)
         sys.stdout.write("\n")
@@ -104,6 +107,16 @@ def emit_run(args, doc, part, trace, loc) -> None:
         plot_run(part, trace, loc, args.plot)
         if not args.json:
             print(f"plot written to {args.plot}")
+    return 0 if loc.consistent else 2
+
+
+def no_fit_line(pvalue: float) -> str:
+    """What the CLI says when the readings fit no place on the part."""
+    return (
+        f"NO CONSISTENT CONTACT: the readings fit no place on the part (goodness of fit p = {pvalue:.3g}, "
+        f"below {FIT_ALPHA:g}); check the arm's rotation readings and the contact sensor's calibration. "
+        "No candidate is an answer"
+    )
 
 
 def print_run(doc) -> None:
@@ -111,6 +124,8 @@ def print_run(doc) -> None:
         print(f"roll {k + 1}: L = {e['length']:.3f} mm, Ω = {e['turn_deg']:.3f}°")
     if doc["estimate_arc"] is None:
         print("no place on the part fits these rolls")
+    elif not doc["consistent"]:
+        print(no_fit_line(doc["fit_pvalue"]))
     else:
         verdict = "AMBIGUOUS" if doc["ambiguous"] else "localized"
         print(

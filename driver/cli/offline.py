@@ -12,7 +12,7 @@ import numpy as np
 from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
 
 from ._options import add_command, part_arguments, positive, read_part
-from ._output import emit_run, run_summary
+from ._output import emit_run, no_fit_line, run_summary
 
 __all__ = ["register", "localize_command", "locate_command"]
 
@@ -123,6 +123,8 @@ def localize_command(args) -> int:
             ],
             "best": 0 if result.best is not None else None,
             "ambiguous": result.ambiguous,
+            "consistent": result.consistent,
+            "fit_pvalue": result.fit_pvalue,
         }
         json.dump(doc, sys.stdout, indent=2)
         sys.stdout.write("\n")
@@ -142,14 +144,18 @@ def localize_command(args) -> int:
                 print(f"{k:>3} {c.start_arc:>10.3f} {c.end_arc:>15.3f} {x:>9.3f} {y:>9.3f} {c.probability:>6.3f}")
             verdict = "AMBIGUOUS" if result.ambiguous else "localized"
             best = result.candidates[0]
-            print(f"{verdict}: contact now at arc {best.end_arc:.3f} mm (p={best.probability:.3f}, rule {result.rule})")
+            if result.consistent:
+                where = f"contact now at arc {best.end_arc:.3f} mm"
+                print(f"{verdict}: {where} (p={best.probability:.3f}, rule {result.rule})")
+            else:
+                print(no_fit_line(result.fit_pvalue))
     if args.plot:
         from driver.plotting import plot_localization
 
         plot_localization(part, result, args.plot)
         if not args.json:
             print(f"plot written to {args.plot}")
-    return 0
+    return 0 if result.consistent else 2
 
 
 def locate_command(args) -> int:
@@ -160,5 +166,4 @@ def locate_command(args) -> int:
     estimates = trace.estimates()
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"
     loc = localize(part, estimates, rule=args.rule, direction=direction)
-    emit_run(args, run_summary(part, trace, loc), part, trace, loc)
-    return 0
+    return emit_run(args, run_summary(part, trace, loc), part, trace, loc)

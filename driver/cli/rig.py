@@ -69,12 +69,20 @@ def register(sub) -> None:
     run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
 
 
+#: What an interrupted rig command had done, before it had the arm and after it let it go (inside,
+#: the serial rig's safe stop says what it did).
+CONNECTING = "no motion had been sent to the arm (it was being connected)"
+RELEASED = "the arm's part of the run had ended: nothing was moving"
+
+
 def calibrate_command(args) -> int:
     from driver.procedures import calibrate
     from driver.serial_rig import SerialRig
 
+    args.interrupted = CONNECTING
     with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
         calibration = calibrate(rig, rig.pose())
+    args.interrupted = RELEASED
     calibration.save(args.out)
     print(
         f"calibration written to {args.out}: ratio {calibration.ratios[0]:.5f} at -50 mm to "
@@ -123,6 +131,7 @@ def run_command(args) -> int:
 
     if args.reactive:
         return _run_reactively(args, part, calibration, log, observer)
+    args.interrupted = CONNECTING
     with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         run, calibration = run_from_here(
             rig,
@@ -133,6 +142,7 @@ def run_command(args) -> int:
             observer=observer,
             pressing=pressing(args),
         )
+    args.interrupted = RELEASED
     trace = Trace.from_run(
         run,
         calibration,
@@ -147,8 +157,7 @@ def run_command(args) -> int:
     if log is not None:
         log({"event": "result", **doc})
         log.close()
-    emit_run(args, doc, part, trace, run.localization)
-    return 0
+    return emit_run(args, doc, part, trace, run.localization)
 
 
 @contextlib.contextmanager
@@ -160,7 +169,8 @@ def _ending_progress_line(log):
     except BaseException as exc:
         sys.stderr.write("\n")
         if log is not None:
-            log({"event": "error", "message": str(exc) or type(exc).__name__})
+            notes = "; ".join(getattr(exc, "__notes__", []))
+            log({"event": "error", "message": str(exc) or type(exc).__name__, "host": notes})
             log.close()
         raise
 
@@ -179,6 +189,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
             )
             sys.stderr.flush()
 
+    args.interrupted = CONNECTING
     with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         here = tuple(rig.pose())
         if calibration is None:
@@ -187,6 +198,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
         x, y, phi = here
         start = (x + 40.0 * math.cos(phi), y + 40.0 * math.sin(phi), phi)  # as run_from_here: contact at -40 mm
         doc, _ = run_reactive(args, rig, part, calibration, start, observer=progress)
+    args.interrupted = RELEASED
     if log is not None:
         log({"event": "result", **doc})
         log.close()

@@ -104,7 +104,10 @@ def register(sub) -> None:
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="inject a fault: drop=P, garble=P, delay=S, disconnect-after=N, saturate=V; repeatable",
+        help=(
+            "inject a fault: drop=P, garble=P, delay=S, disconnect-after=N, saturate=V, encoder-stuck=N, "
+            "daq-constant=V, limit-after=N, drift=V_PER_S; repeatable"
+        ),
     )
 
 
@@ -184,8 +187,7 @@ def simulate_command(args) -> int:
     trace.save(args.out)
     doc = run_summary(part, trace, run.localization)
     doc["trace"] = str(args.out)
-    emit_run(args, doc, part, trace, run.localization)
-    return 0
+    return emit_run(args, doc, part, trace, run.localization)
 
 
 def _check_reach(part, start: float, jaw: float) -> None:

@@ -1,0 +1,219 @@
+"""Issue 18: the host under device faults, signals and implausible readings. Each test is one
+measured defect: the robot is stopped and the jaw off the part, the error is one clear line, and
+no reading that cannot be is taken for a localization."""
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from driver.cli import main
+from driver.emulator import Emulator, Faults
+from driver.procedures import Hand, run_from_here
+from driver.rig import ImplausibleReading, ProtocolError, RigError
+from driver.runlog import RunLog
+from driver.serial_rig import SerialRig
+from localizer import load_part
+from sim2d import SimRig
+
+ROOT = Path(__file__).resolve().parents[2]
+PART = load_part(ROOT / "parts" / "trefoil.json")
+ROLLS = [math.radians(20.0), math.radians(15.0)]
+START = 120.0
+
+
+def emulator(faults=Faults(), seed=3):
+    rig = SimRig(PART, noise="paper", seed=seed)
+    return Emulator(rig, start_pose=rig.approach_pose(START, jaw_position=0.0, standoff=1.0), faults=faults)
+
+
+def run_against(faults, tmp_path):
+    """run_from_here over TCP against an emulator with ``faults``: (the error, the log's events, the
+    contact force after, N)."""
+    emu = emulator(faults)
+    arm, daq = emu.serve_tcp(0)
+    log = RunLog(tmp_path / "run.jsonl", {"part": {"name": PART.name}})
+    try:
+        with SerialRig(arm, daq, timeout=0.5, log=log) as rig:
+            run_from_here(rig, PART, ROLLS, observer=log)
+        outcome = None
+    except RigError as exc:
+        outcome = exc
+    finally:
+        log.close()
+    force = emu.rig.world.contact().force
+    emu.close()
+    events = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text().splitlines()]
+    return outcome, events, force
+
+
+def test_a_stuck_encoder_stops_the_roll_instead_of_localizing(tmp_path):
+    outcome, events, force = run_against(Faults(encoder_stuck=150), tmp_path)
+    assert isinstance(outcome, ImplausibleReading), outcome
+    assert "encoder is stuck or misread" in str(outcome) and "backed off" in str(outcome)
+    assert force == 0.0
+    assert not any(e["event"] == "result" for e in events)
+
+
+def test_an_angle_of_1e308_is_refused():
+    class Wild:
+        """A rig whose arm reports φ = 1e308° after its first pose."""
+
+        def __init__(self):
+            self.inner = SimRig(PART, noise="none", seed=1)
+            self.calls = 0
+
+        def move(self, x, y, phi):
+            self.inner.move(x, y, phi)
+
+        def pose(self):
+            self.calls += 1
+            x, y, phi = self.inner.pose()
+            return (x, y, math.radians(1e308) if self.calls > 1 else phi)
+
+    rig = Wild()
+    hand = Hand(rig, rig.inner.approach_pose(START, jaw_position=0.0, standoff=5.0))
+    hand.measured_angle()
+    with pytest.raises(ImplausibleReading, match="1e\\+308"):
+        hand.measured_angle()
+
+
+def test_an_arm_limit_mid_roll_is_named_and_the_host_says_what_it_could_do(tmp_path):
+    outcome, events, _ = run_against(Faults(limit_after=150), tmp_path)
+    assert isinstance(outcome, ProtocolError) and outcome.code == "LIMIT"
+    assert "connection failed" not in str(outcome) and "refused MOVE" in str(outcome)
+    # the arm refuses every MOVE now: the safe stop could stop it but not back off, and says so
+    assert any("jog it clear" in note for note in outcome.__notes__)
+    stop = [e for e in events if e["event"] == "safe_stop"][-1]
+    assert stop["stop_problem"] == "" and "LIMIT" in stop["back_off_problem"]
+
+
+def test_a_dead_daq_is_named_and_the_jaw_moved_back(tmp_path):
+    outcome, _, force = run_against(Faults(daq_constant=0.5), tmp_path)
+    assert isinstance(outcome, ImplausibleReading) and "not reading" in str(outcome)
+    assert force == 0.0
+
+
+@pytest.mark.parametrize(
+    "spec, words",
+    [
+        ("drop=2", "probability must be in [0, 1]"),
+        ("garble=-0.1", "probability must be in [0, 1]"),
+        ("delay=-1", "a delay must be in [0, 60] s"),
+        ("saturate=-1", "positive voltage"),
+        ("disconnect-after=-3", "whole number"),
+        ("encoder-stuck=-1", "whole number"),
+        ("daq-constant=nan", "finite"),
+        ("drift=5", "within ±1 V/s"),
+        ("fly=1", "use NAME=VALUE"),
+    ],
+)
+def test_impossible_faults_are_refused(spec, words):
+    with pytest.raises(RigError) as info:
+        Faults.parse([spec])
+    assert words in str(info.value) and spec.split("=")[0] in str(info.value)
+
+
+def test_two_hosts_cannot_drive_one_arm():
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq) as first:
+            with pytest.raises(RigError, match=f"in use by rolltouch pid {os.getpid()}"):
+                SerialRig(arm, daq)
+            first.pose()  # the first still works
+        with SerialRig(arm, daq) as again:  # released when the first closed
+            again.pose()
+    finally:
+        emu.close()
+
+
+def test_a_device_refusal_is_not_a_connection_failure():
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq) as rig, pytest.raises(ProtocolError) as info:
+            rig._transact("daq", "READ", 0)
+        assert "connection failed" not in str(info.value) and "refused READ" in str(info.value)
+    finally:
+        emu.close()
+
+
+def _run_cli(args, env=None):
+    return subprocess.Popen(
+        [sys.executable, "-m", "driver.cli", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1", **(env or {})),
+    )
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_and_sighup_stop_the_arm_and_back_off(tmp_path, signum):
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    log = tmp_path / "run.jsonl"
+    proc = _run_cli(["run", str(ROOT / "parts" / "trefoil.json"), "--arm", arm, "--daq", daq, "--log", str(log)])
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:  # mid-roll: some readings logged
+            if log.exists() and '"event": "reading"' in log.read_text():
+                break
+            time.sleep(0.05)
+        proc.send_signal(signum)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+        force = emu.rig.world.contact().force
+        emu.close()
+    assert proc.returncode == 128 + signum, err
+    name = signal.Signals(signum).name
+    assert f"terminated by {name}: the arm was stopped; the jaw was backed off 5 mm" in err
+    events = [json.loads(line) for line in log.read_text().splitlines()]
+    assert any(e["event"] == "safe_stop" for e in events)
+    assert events[-1]["event"] == "error" and events[-1]["message"] == name
+    assert force == 0.0
+
+
+def test_ctrl_c_while_connecting_says_nothing_was_sent(tmp_path):
+    emu = emulator(Faults(delay=3.0))  # STATUS is answered after 3 s: the host is still connecting
+    asked = []
+    handle = emu.handle
+    emu.handle = lambda device, line: asked.append(line) or handle(device, line)
+    arm, daq = emu.serve_tcp(0)
+    proc = _run_cli(["run", str(ROOT / "parts" / "trefoil.json"), "--arm", arm, "--daq", daq, "--timeout", "10"])
+    try:
+        deadline = time.monotonic() + 60
+        while not asked and time.monotonic() < deadline:  # the host has sent STATUS
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+        emu.close()
+    assert proc.returncode == 130, err
+    assert "interrupted: no motion had been sent to the arm (it was being connected)" in err
+    assert "backed off" not in err
+
+
+def test_readings_that_fit_no_place_are_not_a_localization(capsys):
+    """The issue's case: a second roll of 1e9° (or one turning the wrong way) on the trefoil."""
+    for turn in ("1e9", "-34.4"):
+        rc = main(
+            ["localize", str(ROOT / "parts" / "trefoil.json"), "--length", "25", "--turn", "31.78"]
+            + ["--then", "20", turn]
+        )
+        out = capsys.readouterr().out
+        assert rc == 2 and "NO CONSISTENT CONTACT" in out and "localized" not in out
+    rc = main(
+        ["localize", str(ROOT / "parts" / "trefoil.json"), "--length", "25", "--turn", "31.78"]
+        + ["--sd-length", "1e-300"]
+    )
+    assert rc == 2 and "sd_length=1e-300" in capsys.readouterr().err
