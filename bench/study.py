@@ -72,11 +72,14 @@ from pathlib import Path
 
 import numpy as np
 
+from driver.procedures import STEP_RANGE_DEG
 from driver.reactive import CONFIDENCE, MAX_ROTATION
 from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
+#: The most trials one study may run (split a larger one: its table is read whole).
+MAX_TRIALS = 100_000
 
 __all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS"]
 
@@ -318,8 +321,16 @@ def load_study(path) -> Study:
             raise StudyError(f"study {path}: {key}={v!r} must be an integer >= {lo}")
     for key, fallback in (("step_deg", STEP_DEG), ("success_radius", SUCCESS_RADIUS)):
         v = data.get(key, fallback)
-        if not isinstance(v, (int, float)) or not v > 0:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0):
             raise StudyError(f"study {path}: {key}={v!r} must be a positive number")
+    step, (step_lo, step_hi) = data.get("step_deg", STEP_DEG), STEP_RANGE_DEG
+    if not step_lo <= step <= step_hi:
+        raise StudyError(
+            f"study {path}: step_deg={step!r} must be between {step_lo:g}° and {step_hi:g}° "
+            "(a smaller step would roll for days)"
+        )
+    if data.get("trials", 100) > MAX_TRIALS:
+        raise StudyError(f"study {path}: trials={data['trials']!r} is more than {MAX_TRIALS}: split the study")
     noise = data.get("noise", "paper")
     from sim2d import PRESETS, NoiseModel, SimError, load_noise
 

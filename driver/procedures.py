@@ -54,9 +54,17 @@ __all__ = [
     "roll_sequence",
     "localize_by_rolling",
     "ANGLE_SLACK",
+    "MAX_ROLL_STEPS",
+    "STEP_RANGE_DEG",
 ]
 
 
+#: The most rolling steps one roll may take (at the paper's 0.2° step, 4000° of rolling): a step of
+#: 1e-7° would otherwise roll for days.
+MAX_ROLL_STEPS = 20_000
+#: The rolling steps a command or a study may ask for, degrees: from a third of the arm encoder's 0.03°
+#: count to 5° (beyond, the contact jumps past the readings the estimate needs).
+STEP_RANGE_DEG = (0.01, 5.0)
 #: How far the arm's reported jaw angle may be from the commanded one, rad: its encoder reads to 0.03°
 #: and the arm settles within a step or two; a stuck encoder is off by 0.5° after three 0.2° steps.
 ANGLE_SLACK = math.radians(0.5)
@@ -600,6 +608,11 @@ def roll(
     if not step > 0:
         raise RigError(f"roll step {step!r} rad must be positive")
     k = max(1, int(round(abs(angle) / step)))
+    if k > MAX_ROLL_STEPS:
+        raise RigError(
+            f"a roll of {math.degrees(angle):g}° in steps of {math.degrees(step):g}° is {k} steps, more than "
+            f"{MAX_ROLL_STEPS}: use a larger step (refused before moving)"
+        )
     if offset is None:
         offset = edge_offset(rig, hand, baseline)
     readings: list[Reading] = []

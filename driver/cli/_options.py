@@ -5,13 +5,22 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+from pathlib import Path
 
 from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part
 
-from ..procedures import PRESS, PressSettings, ServoSettings
+from ..procedures import PRESS, STEP_RANGE_DEG, PressSettings, ServoSettings
 from ..reactive import CONFIDENCE, MAX_ROTATION
 
 __all__ = [
+    "PLOT_SUFFIXES",
+    "roll_degrees",
+    "step_degrees",
+    "budget_degrees",
+    "check_before_moving",
+    "writable_file",
+    "MAX_STEPS",
     "STEP_DEG",
     "MAX_ROTATION_DEG",
     "UsageError",
@@ -63,7 +72,9 @@ def _number(text: str, ok, what: str) -> float:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(value) and ok(value)):
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    if not ok(value):
         raise argparse.ArgumentTypeError(f"{text!r} must be {what}")
     return value
 
@@ -76,6 +87,74 @@ def probability(text: str) -> float:
 def positive(text: str) -> float:
     """A positive finite number (argparse type)."""
     return _number(text, lambda v: v > 0, "a positive number")
+
+
+#: What one command may ask the arm to do, checked before anything moves (issue 18): a rolling step in
+#: :data:`driver.procedures.STEP_RANGE_DEG`; a fixed roll of at most half a turn; a reactive budget of
+#: at most two turns; and at most MAX_STEPS rolling steps in all (at the paper's 0.2° and about 0.3 s a
+#: step on a real arm, 20 000 steps is under two hours; with every command's reply deadline this
+#: bounds a run's time too).
+MIN_STEP_DEG, MAX_STEP_DEG = STEP_RANGE_DEG
+MAX_ROLL_DEG = 180.0
+MAX_BUDGET_DEG = 720.0
+MAX_STEPS = 20_000
+#: What a --plot may be written as (matplotlib takes the format from the suffix).
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+
+
+def roll_degrees(text: str) -> float:
+    """One fixed roll's rotation, degrees: finite, nonzero, at most :data:`MAX_ROLL_DEG` (argparse type)."""
+    return _number(
+        text, lambda v: v != 0 and abs(v) <= MAX_ROLL_DEG, f"nonzero and at most {MAX_ROLL_DEG:g}° either way"
+    )
+
+
+def step_degrees(text: str) -> float:
+    """A rolling step, degrees, in [:data:`MIN_STEP_DEG`, :data:`MAX_STEP_DEG`] (argparse type)."""
+    return _number(
+        text, lambda v: MIN_STEP_DEG <= v <= MAX_STEP_DEG, f"between {MIN_STEP_DEG:g}° and {MAX_STEP_DEG:g}°"
+    )
+
+
+def budget_degrees(text: str) -> float:
+    """A reactive rotation budget, degrees, in (0, :data:`MAX_BUDGET_DEG`] (argparse type)."""
+    return _number(text, lambda v: 0 < v <= MAX_BUDGET_DEG, f"positive and at most {MAX_BUDGET_DEG:g}°")
+
+
+def check_before_moving(args, outputs: dict[str, tuple[str, ...]]) -> None:
+    """Refuse, before the first command reaches the arm, what would fail later: rolls that turn both
+    ways, more than :data:`MAX_STEPS` rolling steps, and output files that cannot be written (``outputs``:
+    argument name → the suffixes it must end in, empty for any). Raises :class:`UsageError`."""
+    rolls = getattr(args, "roll", None) or []
+    if len({r > 0 for r in rolls}) > 1:
+        raise UsageError(f"--roll {' --roll '.join(f'{r:g}' for r in rolls)}: all rolls must turn the same way")
+    step = getattr(args, "step", None)
+    if step is not None:
+        total = args.max_rotation if getattr(args, "reactive", False) else sum(abs(r) for r in rolls) or 35.0
+        steps = total / step
+        if steps > MAX_STEPS:
+            raise UsageError(
+                f"{total:g}° in steps of {step:g}° is {steps:.0f} rolling steps, more than {MAX_STEPS}: "
+                "use a larger --step or less rotation"
+            )
+    for name, suffixes in outputs.items():
+        value = getattr(args, name, None)
+        if value is not None:
+            writable_file(value, f"--{name.replace('_', '-')}", suffixes)
+
+
+def writable_file(path: str, flag: str, suffixes: tuple[str, ...] = ()) -> None:
+    """Refuse an output path that is a folder, lies in no writable folder, or lacks its suffix."""
+    p = Path(path)
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise UsageError(f"{flag} {path}: the file name must end in {' or '.join(suffixes)}")
+    if p.is_dir():
+        raise UsageError(f"{flag} {path} is a folder: give a file name")
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise UsageError(f"{flag} {path}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
+        raise UsageError(f"{flag} {path}: not writable")
 
 
 def rig_arguments(p) -> None:
@@ -114,7 +193,7 @@ def reactive_arguments(p) -> None:
     )
     p.add_argument(
         "--max-rotation",
-        type=positive,
+        type=budget_degrees,
         default=MAX_ROTATION_DEG,
         metavar="DEG",
         help=f"reactive: rotation budget, both directions counted (default {MAX_ROTATION_DEG:g}°)",

@@ -11,7 +11,7 @@ import numpy as np
 
 from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
 
-from ._options import add_command, part_arguments, positive, read_part
+from ._options import PLOT_SUFFIXES, add_command, check_before_moving, part_arguments, positive, read_part
 from ._output import emit_run, no_fit_line, run_summary
 
 __all__ = ["register", "localize_command", "locate_command"]
@@ -94,6 +94,7 @@ def register(sub) -> None:
 
 
 def localize_command(args) -> int:
+    check_before_moving(args, {"plot": PLOT_SUFFIXES})
     part = read_part(args)
     rolls = [(args.length, np.radians(args.turn))] + [(L, np.radians(d)) for L, d in args.then]
     result = localize(
@@ -161,6 +162,7 @@ def localize_command(args) -> int:
 def locate_command(args) -> int:
     from driver.trace import Trace
 
+    check_before_moving(args, {"plot": PLOT_SUFFIXES})
     part = load_part(args.part)
     trace = Trace.load(args.trace)
     estimates = trace.estimates()

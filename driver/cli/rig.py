@@ -12,15 +12,18 @@ import sys
 from localizer import SUCCESS_RADIUS
 
 from ._options import (
+    PLOT_SUFFIXES,
     STEP_DEG,
     add_command,
+    check_before_moving,
     part_arguments,
-    positive,
     pressing,
     reactive_arguments,
     read_part,
     rig_arguments,
+    roll_degrees,
     servo_arguments,
+    step_degrees,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
@@ -54,13 +57,13 @@ def register(sub) -> None:
     run.add_argument("--calibration", metavar="CAL.json", help="calibration from 'rolltouch calibrate'")
     run.add_argument(
         "--roll",
-        type=float,
+        type=roll_degrees,
         action="append",
         metavar="DEG",
         help="a roll's rotation in degrees; repeat (default 20 then 15)",
     )
     run.add_argument(
-        "--step", type=positive, default=STEP_DEG, metavar="DEG", help=f"rolling step (default {STEP_DEG}°)"
+        "--step", type=step_degrees, default=STEP_DEG, metavar="DEG", help=f"rolling step (default {STEP_DEG}°)"
     )
     servo_arguments(run)
     reactive_arguments(run)
@@ -79,6 +82,7 @@ def calibrate_command(args) -> int:
     from driver.procedures import calibrate
     from driver.serial_rig import SerialRig
 
+    check_before_moving(args, {"out": (".json",)})
     args.interrupted = CONNECTING
     with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
         calibration = calibrate(rig, rig.pose())
@@ -106,6 +110,7 @@ def run_command(args) -> int:
     from driver.serial_rig import SerialRig
     from driver.trace import Trace
 
+    check_before_moving(args, {"plot": PLOT_SUFFIXES, "log": ()})
     part = read_part(args)
     rolls = args.roll or [20.0, 15.0]
     calibration = Calibration.load(args.calibration) if args.calibration else None

@@ -13,15 +13,18 @@ from localizer import Outline, QueryError
 
 from ..rig import RigError
 from ._options import (
+    PLOT_SUFFIXES,
     STEP_DEG,
     UsageError,
     add_command,
+    check_before_moving,
     part_arguments,
-    positive,
     pressing,
     reactive_arguments,
     read_part,
+    roll_degrees,
     servo_arguments,
+    step_degrees,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
@@ -48,7 +51,7 @@ def register(sub) -> None:
     )
     sim.add_argument(
         "--roll",
-        type=float,
+        type=roll_degrees,
         action="append",
         metavar="DEG",
         help="a roll's rotation, degrees (positive: counter-clockwise); repeat for more rolls "
@@ -68,7 +71,7 @@ def register(sub) -> None:
     )
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     sim.add_argument(
-        "--step", type=positive, default=STEP_DEG, metavar="DEG", help=f"rolling step, degrees (default {STEP_DEG})"
+        "--step", type=step_degrees, default=STEP_DEG, metavar="DEG", help=f"rolling step, degrees (default {STEP_DEG})"
     )
     servo_arguments(sim)
     reactive_arguments(sim)
@@ -116,6 +119,7 @@ def simulate_command(args) -> int:
     from driver.trace import Trace
     from sim2d import SimRig, load_noise
 
+    check_before_moving(args, {"out": (".npz",), "plot": PLOT_SUFFIXES})
     part = read_part(args)
     if args.engine is None:
         args.engine = "kinematic" if isinstance(part, Outline) else "pymunk"

@@ -110,6 +110,8 @@ def test_dask_local_cluster_gives_the_same_table(reference):
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v2_noise"\nvalues = [-1.0]', "must be >= 0"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\nnoise = "lab"', "noise"),
         ("parts = [", "not valid TOML"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\nstep_deg = 1e-9', r"step_deg=1e-09 must be between 0.01° and 5°"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\ntrials = 10000000', "more than 100000"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["paper", "oracle"]', "methods .* distinct names"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "paper"\nmethods = ["paper"]', "not both"),
         (

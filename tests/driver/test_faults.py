@@ -217,3 +217,43 @@ def test_readings_that_fit_no_place_are_not_a_localization(capsys):
         + ["--sd-length", "1e-300"]
     )
     assert rc == 2 and "sd_length=1e-300" in capsys.readouterr().err
+
+
+BOGUS = ["--arm", "socket://127.0.0.1:1", "--daq", "socket://127.0.0.1:1"]  # never reached: refused first
+TREFOIL = str(ROOT / "parts" / "trefoil.json")
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["run", TREFOIL, *BOGUS, "--roll", "nan"], "'nan' is not a finite number"),
+        (["run", TREFOIL, *BOGUS, "--roll", "20", "--roll", "-15"], "all rolls must turn the same way"),
+        (["run", TREFOIL, *BOGUS, "--roll", "720"], "at most 180°"),
+        (["run", TREFOIL, *BOGUS, "--step", "1e-7"], "must be between 0.01° and 5°"),
+        (["run", TREFOIL, *BOGUS, "--reactive", "--confidence", "2"], "between 0 and 1"),
+        (["run", TREFOIL, *BOGUS, "--reactive", "--max-rotation", "10000"], "at most 720°"),
+        (["run", TREFOIL, *BOGUS, "--reactive", "--max-rotation", "720", "--step", "0.01"], "more than 20000"),
+        (["run", TREFOIL, *BOGUS, "--plot", "/nonexistent/x.png"], "the folder /nonexistent does not exist"),
+        (["calibrate", *BOGUS, "--out", "/nonexistent/c.json"], "the folder /nonexistent does not exist"),
+        (["simulate", TREFOIL, "--start", "100", "--roll", "20", "--out", "noext"], "must end in .npz"),
+        (["simulate", TREFOIL, "--start", "100", "--roll", "20", "--out", "t.npz", "--plot", "/tmp"], "end in .png"),
+    ],
+)
+def test_arguments_are_refused_before_the_arm_moves(argv, words, capsys):
+    """Each of these ran a whole calibration (89-100 arm commands) or a whole run before failing; now
+    the command is refused first: the bogus device URLs are never opened."""
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and words in err and "cannot open" not in err, err
+
+
+def test_a_roll_of_too_many_steps_is_refused_by_the_procedure():
+    from driver.procedures import roll
+
+    rig = SimRig(PART, noise="none", seed=1)
+    hand = Hand(rig, rig.approach_pose(START, jaw_position=0.0, standoff=5.0))
+    moves_before = rig.pose()
+    with pytest.raises(RigError, match="more than 20000"):
+        roll(rig, hand, (0.0, 0.0), None, math.radians(20.0), step=math.radians(1e-7), offset=0.0)
+    assert rig.pose() == moves_before
