@@ -6,11 +6,13 @@ a Dask distributed cluster through its ``concurrent.futures`` executor.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import math
 import os
 import sys
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -42,8 +44,10 @@ def wilson(successes: int, n: int, z: float = 1.96):
     return (max(0.0, min(p, centre - half)), min(1.0, max(p, centre + half)))
 
 
-def read_trials(path) -> list:
-    """Rows of a trials.csv; a truncated last line (a killed run) is dropped."""
+def read_trials(path, *, warn: bool = False) -> list:
+    """Rows of a trials.csv, one per (level, trial): a truncated last line (a killed run) is dropped, a
+    repeated trial keeps its first row, and a row whose level, trial or success is not a whole number
+    (a damaged file) is dropped, so that it runs again on ``--resume``; ``warn`` says so on stderr."""
     path = Path(path)
     if not path.exists():
         return []
@@ -54,12 +58,31 @@ def read_trials(path) -> list:
     if not complete:
         lines = lines[:-1]
     rows = []
+    seen: set[tuple[int, int]] = set()
+    damaged, repeated = [], 0
     reader = csv.DictReader(lines)
     width = len(reader.fieldnames or ())
     for r in reader:
         if r is None or None in r.values() or len(r) != width or width < len(TRIAL_COLUMNS):
             continue
+        try:
+            key = (int(r["level"]), int(r["trial"]))
+            if int(r["success"]) not in (0, 1):
+                raise ValueError
+        except (KeyError, TypeError, ValueError):
+            damaged.append(reader.line_num)
+            continue
+        if key in seen:
+            repeated += 1
+            continue
+        seen.add(key)
         rows.append(r)
+    if warn and (damaged or repeated):
+        sys.stderr.write(
+            f"{path}: dropped {len(damaged)} damaged row(s)"
+            + (f" (lines {', '.join(map(str, damaged[:10]))})" if damaged else "")
+            + f" and {repeated} repeated trial(s); the damaged ones run again\n"
+        )
     return rows
 
 
@@ -92,11 +115,18 @@ def run_study(
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    with _folder_lock(out):
+        return _run_locked(study, out, workers=workers, scheduler=scheduler, resume=resume, progress=progress)
+
+
+def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, progress: bool) -> dict:
     table = out / "trials.csv"
+    if resume and table.exists():
+        _check_same_study(study, out)
     (out / "study.json").write_text(json.dumps(study.as_dict(), indent=2) + "\n")
     done = set()
     if resume and table.exists():
-        rows = read_trials(table)
+        rows = read_trials(table, warn=True)
         done = {(int(r["level"]), int(r["trial"])) for r in rows}
         # rewrite without a truncated tail so that appending continues a clean file
         with open(table, "w", newline="") as f:
@@ -150,17 +180,92 @@ def run_study(
             for s in specs:
                 record(run_trial(s), f, writer)
         else:
-            with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+            pool = ProcessPoolExecutor(
+                max_workers=workers or os.cpu_count(), initializer=_die_with_parent, initargs=(os.getpid(),)
+            )
+            try:
                 futures = [pool.submit(run_trial, s) for s in specs]
                 for fut in as_completed(futures):
                     record(fut.result(), f, writer)
+            except BaseException:
+                # Ctrl-C (or a failure): the queued trials are dropped, not waited for; the finished
+                # ones are in the table already and stay there, summarized below
+                pool.shutdown(wait=False, cancel_futures=True)
+                if progress:
+                    sys.stderr.write("\n")
+                _write_summary(study, table, out, t0)
+                raise
+            pool.shutdown()
     if progress:
         sys.stderr.write("\n")
+    return _write_summary(study, table, out, t0)
+
+
+def _write_summary(study: Study, table: Path, out: Path, t0: float) -> dict:
+    """summary.json and the plots from the finished rows of ``table``."""
     summary = summarize(study, read_trials(table))
     summary["wall_s"] = time.monotonic() - t0
     (out / "summary.json").write_text(json.dumps(json_safe(summary), indent=2, allow_nan=False) + "\n")
     plot_study(study, read_trials(table), out)
     return summary
+
+
+def _check_same_study(study: Study, out: Path) -> None:
+    """Refuse to resume a table that another study wrote (its study.json differs, or is missing)."""
+    saved = out / "study.json"
+    try:
+        before = json.loads(saved.read_text())
+    except (OSError, ValueError):
+        raise StudyError(
+            f"--resume: {out / 'trials.csv'} has no readable study.json beside it, so whose trials it holds "
+            "cannot be told; use another --out or drop --resume"
+        ) from None
+    now = json.loads(json.dumps(study.as_dict()))
+    # where the study file lies is not what it asks for (a copied study is the same study)
+    differ = sorted(k for k in set(before) | set(now) if k != "source" and before.get(k) != now.get(k))
+    if differ:
+        shown = ", ".join(f"{k}: {before.get(k)!r} → {now.get(k)!r}" for k in differ[:4])
+        raise StudyError(
+            f"--resume: {out / 'trials.csv'} belongs to another study ({shown}); use another --out, or drop "
+            "--resume to start this one afresh"
+        )
+
+
+@contextlib.contextmanager
+def _folder_lock(out: Path):
+    """Hold ``out/.lock`` for the run: two runs writing one folder would interleave their rows."""
+    handle = open(out / ".lock", "a+")  # noqa: SIM115 - held for the run
+    try:
+        try:
+            import fcntl
+
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except ImportError:  # not POSIX: no lock (documented)
+            pass
+        except OSError:
+            handle.seek(0)
+            holder = handle.read().strip() or "another process"
+            raise StudyError(f"{out} is being written by {holder}: wait for it, or use another --out") from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"rolltouch montecarlo pid {os.getpid()}")
+        handle.flush()
+        yield
+    finally:
+        handle.close()
+
+
+def _die_with_parent(parent: int) -> None:
+    """A worker's initializer: exit when the parent that started it is gone (SIGKILL leaves workers
+    otherwise running for ever)."""
+
+    def watch() -> None:
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="die-with-parent").start()
 
 
 def json_safe(value):

@@ -308,3 +308,93 @@ def test_a_reactive_table_without_standard_deviations_uses_the_filters_own(tmp_p
     assert reactive_filter(pinned, flt.part, load_noise("paper")).noise_scales == (1.0,)
     with pytest.raises(StudyError, match="noise_scales"):
         small_methods_study(tmp_path, extra="[reactive]\nnoise_scales = [-1.0]")
+
+
+def test_resume_refuses_another_studys_table(reference, tmp_path):
+    _, _, tmp = reference
+    f = study_file(tmp_path, trials=4, extra='[sweep]\nparameter = "v2_noise"\nvalues = [0.0, 0.0006]')
+    f.write_text(f.read_text().replace("seed = 7", "seed = 2005"))
+    with pytest.raises(StudyError, match=r"belongs to another study \(seed: 7 → 2005\)"):
+        run_study(load_study(f), tmp / "a", resume=True, workers=1, progress=False)
+
+
+def test_repeated_and_damaged_rows_do_not_corrupt_the_summary(reference, tmp_path, capsys):
+    study, ref, tmp = reference
+    out = tmp_path / "copy"
+    out.mkdir()
+    lines = (tmp / "a" / "trials.csv").read_text().splitlines()
+    header, rows = lines[0], lines[1:]
+    damaged = rows[1].split(",")
+    damaged[header.split(",").index("success")] = "x"
+    (out / "trials.csv").write_text("\n".join([header, *rows, rows[0], rows[0], ",".join(damaged)]) + "\n")
+    (out / "study.json").write_text((tmp / "a" / "study.json").read_text())
+    assert len(read_trials(out / "trials.csv")) == len(ref)  # the repeats count once
+    (out / "trials.csv").write_text("\n".join([header, rows[0], rows[0], ",".join(damaged), *rows[2:]]) + "\n")
+    summary = run_study(study, out, resume=True, workers=1, progress=False)  # row 1 (damaged) runs again
+    err = capsys.readouterr().err
+    assert "dropped 1 damaged row(s)" in err and "1 repeated trial(s)" in err
+    assert [lv["trials"] for lv in summary["levels"]] == [4, 4]
+    assert table(out) == ref
+
+
+def test_one_output_folder_one_run(reference):
+    from bench.montecarlo import _folder_lock
+
+    study, _, tmp = reference
+    with _folder_lock(tmp / "a"), pytest.raises(StudyError, match="is being written by rolltouch montecarlo pid"):
+        run_study(study, tmp / "a", resume=True, workers=1, progress=False)
+
+
+WORKERS = """
+import os, sys, time
+from concurrent.futures import ProcessPoolExecutor
+from bench.montecarlo import _die_with_parent
+pool = ProcessPoolExecutor(2, initializer=_die_with_parent, initargs=(os.getpid(),))
+futures = [pool.submit(time.sleep, 600) for _ in range(2)]
+time.sleep(1.0)
+print(" ".join(str(p) for p in pool._processes), flush=True)
+time.sleep(600)
+"""
+
+
+def _state(pid):
+    """A process's state letter (Z: a zombie, gone but not reaped)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "Z"
+
+
+def test_workers_die_with_their_parent():
+    parent = subprocess.Popen([sys.executable, "-c", WORKERS], stdout=subprocess.PIPE, text=True, cwd=ROOT)
+    pids = [int(p) for p in parent.stdout.readline().split()]
+    assert len(pids) == 2
+    parent.send_signal(signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 10
+    alive = pids
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.2)
+        alive = [
+            p for p in pids if Path(f"/proc/{p}").exists() and "Z" not in Path(f"/proc/{p}/stat").read_text().split()[2]
+        ]
+    assert not alive
+
+
+def test_ctrl_c_keeps_the_finished_trials_and_does_not_wait_for_the_queue(tmp_path):
+    f = study_file(tmp_path, trials=150)
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "driver.cli", "montecarlo", str(f), "--out", str(out), "--workers", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and len(read_trials(out / "trials.csv")) < 2:
+        time.sleep(0.1)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    _, err = proc.communicate(timeout=60)
+    waited = time.monotonic() - t0
+    finished = read_trials(out / "trials.csv")
+    assert proc.returncode == 130 and "finished trials are kept; rerun with --resume" in err
+    assert waited < 15 and 2 <= len(finished) < 150
+    summary = json.loads((out / "summary.json").read_text())
+    assert sum(lv["trials"] for lv in summary["levels"]) == len(finished)
