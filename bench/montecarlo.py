@@ -24,6 +24,10 @@ from .study import TRIAL_COLUMNS, Study, StudyError, TrialSpec, run_trial
 __all__ = ["run_study", "read_trials", "summarize", "wilson"]
 
 
+#: How long a Dask scheduler has to answer, s.
+SCHEDULER_TIMEOUT = 10.0
+
+
 def wilson(successes: int, n: int, z: float = 1.96):
     """Wilson 95% interval of a success rate, (low, high).
 
@@ -171,7 +175,14 @@ def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, pr
                 from distributed import Client
             except ImportError:
                 raise StudyError("--scheduler needs dask.distributed: pip install 'rolltouch[dask]'") from None
-            with Client(scheduler) as client:
+            try:
+                client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+            except OSError as exc:
+                raise StudyError(
+                    f"--scheduler {scheduler}: no Dask scheduler answered within {SCHEDULER_TIMEOUT:g} s ({exc}); "
+                    "is it running, and is the address tcp://HOST:PORT?"
+                ) from None
+            with client:
                 executor = client.get_executor(pure=False)
                 futures = [executor.submit(run_trial, s) for s in specs]
                 for fut in as_completed(futures):

@@ -74,10 +74,12 @@ import numpy as np
 
 from driver.procedures import STEP_RANGE_DEG
 from driver.reactive import CONFIDENCE, MAX_ROTATION
-from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part
+from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, check_size, load_part
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
+#: The largest study file read, bytes (a study is a page of TOML).
+MAX_STUDY_BYTES = 2**20
 #: The most trials one study may run (split a larger one: its table is read whole).
 MAX_TRIALS = 100_000
 
@@ -269,7 +271,10 @@ def load_study(path) -> Study:
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        check_size(path, MAX_STUDY_BYTES, "study file", StudyError)
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise StudyError(f"study {path}: not a text file (a study is TOML)") from None
     except OSError as exc:
         raise StudyError(f"study {path}: cannot read ({exc.strerror or exc})") from None
     except tomllib.TOMLDecodeError as exc:

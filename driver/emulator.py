@@ -263,11 +263,19 @@ class Emulator:
 
         ``port=0`` lets the system pick two free ports (for tests).
         """
+        if not (port == 0 or 1 <= port <= 65534):
+            raise RigError(f"port {port}: use 1 to 65534 (the DAQ takes the next port), or 0 for any free one")
         urls = []
         for device, p in (("arm", port), ("daq", port + 1 if port else 0)):
             srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
             srv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            srv.bind((host, p))
+            try:
+                srv.bind((host, p))
+            except OSError as exc:
+                srv.close()
+                self.close()
+                why = exc.strerror or exc
+                raise RigError(f"cannot serve the {device} on {host}:{p}: {why} (another program has it?)") from None
             srv.listen(4)
             srv.settimeout(0.2)
             self._closers.append(srv.close)

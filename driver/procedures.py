@@ -256,7 +256,7 @@ def press(
                 )
             raise RigError(
                 f"no contact after pressing {travelled:.1f} mm along the jaw normal "
-                f"(Δv1 = {dv1:.3f} V); the jaw was moved back; start closer to the part"
+                f"(Δv1 = {dv1:.4g} V); the jaw was moved back; start closer to the part"
             )
         hand.press_by(search_step)
         travelled += search_step
@@ -266,7 +266,7 @@ def press(
     for _ in range(max_steps):
         if dv1 > overload:
             hand.press_by(-max_travel)
-            raise RigError(f"Δv1 = {dv1:.3f} V exceeds the overload limit {overload} V: backed off")
+            raise RigError(f"Δv1 = {dv1:.4g} V exceeds the overload limit {overload} V: backed off")
         if abs(dv1 - target) <= tol:
             if servo is not None:
                 hold_force(
@@ -287,7 +287,7 @@ def press(
         hand.press_by(move)
         prev = (move, dv1)
         dv1, dv2 = delta_voltages(rig, baseline, n)
-    raise RigError(f"Δv1 did not settle at {target} ± {tol} V in {max_steps} moves (last {dv1:.3f} V)")
+    raise RigError(f"Δv1 did not settle at {target} ± {tol} V in {max_steps} moves (last {dv1:.4g} V)")
 
 
 def hold_force(
@@ -566,7 +566,7 @@ def _location(rig, baseline, calibration, n, readings=None, truth=None, hand=Non
         t = rig.truth() if isinstance(rig, GroundTruth) else {}
         truth.append(Truth(t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
     if dv1 <= 0.1 * calibration.target:
-        raise RigError(f"lost contact while rolling (Δv1 = {dv1:.3f} V)")
+        raise RigError(f"lost contact while rolling (Δv1 = {dv1:.4g} V)")
     return calibration.position(dv2 / dv1)
 
 

@@ -25,6 +25,8 @@ import time
 
 import numpy as np
 
+from localizer import check_size
+
 from .rig import RigError
 
 __all__ = ["RunLog", "read_log", "LOG_FORMAT"]
@@ -76,6 +78,10 @@ class RunLog:
             self._f.close()
 
 
+#: The largest run log read, bytes (a run's log is a few MB; a day of logging at every sample, ~200 MB).
+MAX_LOG_BYTES = 256 * 2**20
+
+
 def read_log(path):
     """The events of a run log, skipping a truncated last line.
 
@@ -84,9 +90,12 @@ def read_log(path):
     RigError
         Unreadable file, no ``start`` event, a bad line other than the last.
     """
+    check_size(path, MAX_LOG_BYTES, "run log", RigError)
     try:
         with open(path, encoding="utf-8") as f:
             lines = f.read().split("\n")
+    except UnicodeDecodeError:
+        raise RigError(f"run log {path}: not a text file; not a rolltouch run log") from None
     except OSError as exc:
         raise RigError(f"run log {path}: {exc.strerror or exc}") from None
     events = []
@@ -94,11 +103,14 @@ def read_log(path):
         if not line.strip():
             continue
         try:
-            events.append(json.loads(line))
-        except json.JSONDecodeError:
+            event = json.loads(line)
+        except (json.JSONDecodeError, RecursionError):
             if k >= len(lines) - 2:  # the last line, cut off by a killed process
                 break
             raise RigError(f"run log {path}: line {k + 1} is not JSON") from None
+        if not isinstance(event, dict):
+            raise RigError(f"run log {path}: line {k + 1} is not a JSON object (an event)")
+        events.append(event)
     if not events or events[0].get("event") != "start" or events[0].get("format") != LOG_FORMAT:
         raise RigError(f"run log {path}: not a rolltouch run log (no '{LOG_FORMAT}' start event)")
     return events

@@ -106,7 +106,7 @@ class SerialRig:
                 )
         except (serial.SerialException, ValueError) as exc:
             self.close()
-            raise RigError(f"cannot open the {name} at {url}: {exc}") from None
+            raise RigError(f"cannot open the {name} at {url}: {_open_problem(url, exc)}") from None
         except RigError:
             self.close()
             raise
@@ -116,6 +116,12 @@ class SerialRig:
             self.input_range = 10.0
             if len(status.fields) >= 2:
                 self.input_range = float(Reply(status.seq, "OK", status.fields[1:]).numbers(1)[0])
+            elif len(self._transact("arm", "STATUS").fields) >= 2:
+                # a DAQ reports its input range with STATUS, an arm does not: they are the other way round
+                raise RigError(
+                    f"--arm {arm_url} answers STATUS as a DAQ (with an input range) and --daq {daq_url} as an "
+                    "arm (without one): the two are swapped; swap --arm and --daq"
+                )
         except RigError:
             self.close()
             raise
@@ -197,12 +203,12 @@ class SerialRig:
         if max(abs(v1), abs(v2)) >= 0.999 * self.input_range:
             self.safe_stop()
             raise RigError(
-                f"the sensor saturated (v1 = {v1:.3f} V, v2 = {v2:.3f} V at the DAQ's "
+                f"the sensor saturated (v1 = {v1:.4g} V, v2 = {v2:.4g} V at the DAQ's "
                 f"±{self.input_range:g} V range): stopped and backed off"
             )
         if v1 > self.overload:
             self.safe_stop()
-            raise RigError(f"v1 = {v1:.3f} V is above the overload limit {self.overload} V: stopped and backed off")
+            raise RigError(f"v1 = {v1:.4g} V is above the overload limit {self.overload} V: stopped and backed off")
         return v1, v2
 
     def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5) -> dict:
@@ -274,6 +280,23 @@ class SerialRig:
                 exc.add_note(outcome)  # the CLI prints it after the error: what the host really did
         self.close()
         return False
+
+
+def _open_problem(url: str, exc: Exception) -> str:
+    """Why pyserial could not open ``url``, in words that say what to fix (its own text is often the
+    parser's, e.g. "'debug|info|warning|error'" for a socket URL whose port is not a number)."""
+    if url.startswith("socket://"):
+        host, _, port = url[len("socket://") :].partition("/")[0].rpartition(":")
+        if not host or not port.isdigit() or not 0 < int(port) < 65536:
+            return "a socket URL is socket://HOST:PORT, PORT a number from 1 to 65535"
+    errno = getattr(exc, "errno", None)
+    if errno == 2 or "No such file" in str(exc):
+        return "no such device (is it plugged in? `ls /dev/tty*` lists the serial ports)"
+    if errno == 13 or "Permission denied" in str(exc):
+        return "permission denied (add yourself to the group that owns the port, e.g. dialout)"
+    if errno == 111 or "Connection refused" in str(exc):
+        return "connection refused (is the device, or `rolltouch emulate`, listening there?)"
+    return str(exc)
 
 
 def _device_lock(name: str, url: str):

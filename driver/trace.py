@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import json
 import math
+import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
-from localizer import arc_from_jaw_positions
+from localizer import arc_from_jaw_positions, check_size
 
 from .procedures import Calibration, RollingRun
 from .rig import RigError
@@ -27,6 +28,10 @@ __all__ = ["Trace", "COLUMNS", "FORMAT"]
 
 COLUMNS = ("roll", "step", "time", "x", "y", "phi_command", "phi", "dv1", "dv2", "true_arc", "true_jaw_position")
 FORMAT = "rolltouch-trace/1"
+#: The largest trace file read, and the most its columns may unpack to, bytes (a long reactive run of
+#: 2000 readings is 200 kB; a crafted archive of 2 MB can unpack to gigabytes).
+MAX_TRACE_BYTES = 256 * 2**20
+MAX_TRACE_UNPACKED = 512 * 2**20
 
 
 @dataclass(frozen=True)
@@ -85,6 +90,11 @@ class Trace:
 
         events = read_log(path)
         start = events[0]
+        for k, e in enumerate(events):
+            need = {"roll": ("roll", "step", "offset"), "reading": ("roll", "step", "dv1", "dv2", "phi")}
+            missing = [key for key in need.get(e.get("event"), ()) if key not in e]
+            if missing:
+                raise RigError(f"run log {path}: event {k + 1} ({e.get('event')}) has no {', '.join(missing)}")
         rolls = {e["roll"]: e for e in events if e.get("event") == "roll"}
         rows = [e for e in events if e.get("event") == "reading"]
         counts: dict[int, int] = {}
@@ -126,16 +136,38 @@ class Trace:
         """
         if str(path).endswith(".jsonl"):
             return cls.from_log(path)
+        check_size(path, MAX_TRACE_BYTES, "trace", RigError)
+        try:
+            with zipfile.ZipFile(path) as z:
+                unpacked = sum(i.file_size for i in z.infolist())
+        except (zipfile.BadZipFile, OSError, EOFError, ValueError):
+            raise RigError(f"trace {path}: not a rolltouch trace (not an .npz archive, or a damaged one)") from None
+        if unpacked > MAX_TRACE_UNPACKED:
+            raise RigError(
+                f"trace {path}: its columns unpack to {unpacked / 2**20:.0f} MB, more than the "
+                f"{MAX_TRACE_UNPACKED / 2**20:.0f} MB a trace may hold; not a rolltouch trace"
+            )
         try:
             with np.load(path, allow_pickle=False) as data:
+                missing = [name for name in ("metadata", *COLUMNS) if name not in data.files]
+                if missing:
+                    raise RigError(f"trace {path}: not a rolltouch trace (no {', '.join(missing)})")
                 meta = json.loads(str(data["metadata"]))
                 columns = {name: np.array(data[name]) for name in COLUMNS}
-        except FileNotFoundError:
-            raise RigError(f"trace {path}: no such file") from None
-        except (OSError, ValueError, KeyError) as exc:
-            raise RigError(f"trace {path}: not a rolltouch trace ({exc})") from None
-        if meta.get("format") != FORMAT:
-            raise RigError(f"trace {path}: format {meta.get('format')!r}, expected {FORMAT!r}")
+        except RigError:
+            raise
+        except (OSError, ValueError, KeyError, IndexError, TypeError, EOFError, zipfile.BadZipFile, MemoryError):
+            # numpy's own text may suggest allow_pickle=True: a trace never holds Python objects
+            raise RigError(f"trace {path}: not a rolltouch trace (a damaged or crafted .npz)") from None
+        if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+            shown = meta.get("format") if isinstance(meta, dict) else type(meta).__name__
+            raise RigError(f"trace {path}: format {shown!r}, expected {FORMAT!r}")
+        sizes = {a.shape for a in columns.values()}
+        if len(sizes) != 1 or any(a.ndim != 1 or a.dtype.kind not in "fiu" for a in columns.values()):
+            raise RigError(f"trace {path}: its columns are not equal-length numbers; not a rolltouch trace")
+        for key in ("steps", "offsets", "calibration"):
+            if key not in meta:
+                raise RigError(f"trace {path}: its metadata has no {key!r}; not a rolltouch trace")
         return cls(columns, meta)
 
     # ------------------------------------------------------------ analysis

@@ -8,6 +8,7 @@ from ._defaults import FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._files import load_part
+from ._limits import MAX_PART_BYTES, check_size
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
 from ._outline_solver import outline_segments
@@ -38,6 +39,8 @@ __all__ = [
     "SUCCESS_RADIUS",
     "ROLL_STEP",
     "FIT_ALPHA",
+    "MAX_PART_BYTES",
+    "check_size",
     "ContactFilter",
     "ParticleFilter",
     "Belief",

@@ -19,6 +19,7 @@ from typing import Any, cast
 import numpy as np
 
 from ._errors import PartError
+from ._limits import MAX_PART_BYTES, check_size
 from ._outline import JOIN_TOL, Outline, outline_from_pieces
 from ._pieces import CircularArc, CubicBezier, Line, Piece, elliptical_arc
 
@@ -65,6 +66,7 @@ def load_outline(path: str | Path, *, layer: str | None = None, element: str | N
         crosses itself.
     """
     path = Path(path)
+    check_size(path, MAX_PART_BYTES, "CAD file")
     suffix = path.suffix.lower()
     if suffix == ".dxf":
         if element is not None:

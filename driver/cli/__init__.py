@@ -118,6 +118,10 @@ def main(argv=None) -> int:
         notes = _notes(exc)
         print(f"rolltouch: error: {exc}" + (f" ({notes})" if notes else ""), file=sys.stderr)
         return 2
+    except (OSError, MemoryError) as exc:  # not ours (RigError is an OSError too, handled above)
+        shown = f"{exc.filename}: {exc.strerror}" if isinstance(exc, OSError) and exc.filename else str(exc)
+        print(f"rolltouch: error: {shown or type(exc).__name__}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt as exc:
         what = f"terminated by {exc.args[0]}" if isinstance(exc, Terminated) else "interrupted"
         done = _notes(exc) or getattr(args, "interrupted", INTERRUPTED)

@@ -14,6 +14,8 @@ from ..procedures import PRESS, STEP_RANGE_DEG, PressSettings, ServoSettings
 from ..reactive import CONFIDENCE, MAX_ROTATION
 
 __all__ = [
+    "finite",
+    "tcp_port",
     "PLOT_SUFFIXES",
     "roll_degrees",
     "step_degrees",
@@ -82,6 +84,17 @@ def _number(text: str, ok, what: str) -> float:
 def probability(text: str) -> float:
     """A probability strictly between 0 and 1 (argparse type)."""
     return _number(text, lambda v: 0 < v < 1, "between 0 and 1")
+
+
+def finite(text: str) -> float:
+    """Any finite number (argparse type)."""
+    return _number(text, lambda v: True, "finite")
+
+
+def tcp_port(text: str) -> int:
+    """A TCP port for a pair of devices, 1 to 65534 (the DAQ takes the next; argparse type)."""
+    value = _number(text, lambda v: v == int(v) and 1 <= v <= 65534, "a whole number from 1 to 65534")
+    return int(value)
 
 
 def positive(text: str) -> float:

@@ -18,6 +18,7 @@ from ._options import (
     UsageError,
     add_command,
     check_before_moving,
+    finite,
     part_arguments,
     pressing,
     reactive_arguments,
@@ -25,6 +26,7 @@ from ._options import (
     roll_degrees,
     servo_arguments,
     step_degrees,
+    tcp_port,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
 
@@ -44,7 +46,7 @@ def register(sub) -> None:
     part_arguments(sim)
     sim.add_argument(
         "--start",
-        type=float,
+        type=finite,
         required=True,
         metavar="MM",
         help="arc position of the first contact, mm counter-clockwise from the part's first point",
@@ -89,10 +91,10 @@ def register(sub) -> None:
         "until killed.",
     )
     part_arguments(emu)
-    emu.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
+    emu.add_argument("--tcp", type=tcp_port, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
     emu.add_argument(
         "--start",
-        type=float,
+        type=finite,
         metavar="MM",
         help="the hand starts with the jaw's centre facing this arc position, 1 mm off "
         "(default: the part's most curved point that the whole jaw reaches)",

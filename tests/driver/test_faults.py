@@ -257,3 +257,118 @@ def test_a_roll_of_too_many_steps_is_refused_by_the_procedure():
     with pytest.raises(RigError, match="more than 20000"):
         roll(rig, hand, (0.0, 0.0), None, math.radians(20.0), step=math.radians(1e-7), offset=0.0)
     assert rig.pose() == moves_before
+
+
+# ---------------------------------------------------------------- crafted files (items 7, 8, 9)
+def _trace(path, **arrays):
+    import numpy as np
+
+    np.savez(path, **arrays)
+    return path
+
+
+def test_damaged_and_crafted_traces_are_one_clear_error(tmp_path, monkeypatch):
+    import zipfile
+
+    import numpy as np
+
+    from driver.trace import COLUMNS, Trace
+
+    good = {name: np.zeros(3) for name in COLUMNS}
+    meta = np.array(json.dumps({"format": "rolltouch-trace/1", "steps": [], "offsets": [], "calibration": {}}))
+    cases = {
+        "empty": b"",
+        "truncated": _trace(tmp_path / "whole.npz", metadata=meta, **good).read_bytes()[:300],
+        "random": os.urandom(4000),
+    }
+    for name, data in cases.items():
+        (tmp_path / f"{name}.npz").write_bytes(data)
+    paths = [tmp_path / f"{n}.npz" for n in cases] + [
+        _trace(tmp_path / "no-column.npz", metadata=meta),
+        _trace(tmp_path / "objects.npz", metadata=meta, **{**good, "dv1": np.array([{"a": 1}], dtype=object)}),
+        _trace(tmp_path / "list-metadata.npz", metadata=np.array("[1, 2]"), **good),
+    ]
+    for path in paths:
+        with pytest.raises(RigError) as info:
+            Trace.load(path)
+        text = str(info.value)
+        assert str(path) in text and "pickle" not in text, text
+    # a compressed bomb: under 1 MB on disk, 640 MB unpacked, refused before it is unpacked
+    bomb = tmp_path / "bomb.npz"
+    with (
+        zipfile.ZipFile(bomb, "w", compression=zipfile.ZIP_DEFLATED) as z,
+        z.open("dv1.npy", "w", force_zip64=True) as f,
+    ):
+        block = bytes(2**24)
+        for _ in range(150):
+            f.write(block)
+    assert bomb.stat().st_size < 5e6
+    t0 = time.monotonic()
+    with pytest.raises(RigError, match="unpack to"):
+        Trace.load(bomb)
+    assert time.monotonic() - t0 < 2
+
+
+def test_bad_run_logs_are_one_clear_error(tmp_path):
+    from driver.runlog import LOG_FORMAT
+    from driver.trace import Trace
+
+    start = json.dumps({"event": "start", "format": LOG_FORMAT, "calibration": {}})
+    for name, lines in {
+        "not-an-object": [start, "[1, 2, 3]", "{}"],
+        "no-step": [start, json.dumps({"event": "reading", "roll": 0, "dv1": 1, "dv2": 0, "phi": 0}), "{}"],
+    }.items():
+        path = tmp_path / f"{name}.jsonl"
+        path.write_text("\n".join(lines) + "\n")
+        with pytest.raises(RigError) as info:
+            Trace.load(path)
+        text = str(info.value)
+        assert str(path) in text and ("line 2" in text or "event 2" in text), text
+
+
+def test_the_emulators_arguments_and_a_busy_port(capsys):
+    for argv, words in (
+        (["emulate", TREFOIL, "--tcp", "65535"], "from 1 to 65534"),
+        (["emulate", TREFOIL, "--start", "nan"], "'nan' is not a finite number"),
+    ):
+        with pytest.raises(SystemExit):
+            main(argv)
+        assert words in capsys.readouterr().err
+    first = emulator()
+    arm, _ = first.serve_tcp(0)
+    port = int(arm.rsplit(":", 1)[1])
+    try:
+        with pytest.raises(RigError, match=f"cannot serve the arm on 127.0.0.1:{port}: .*in use"):
+            emulator().serve_tcp(port)
+    finally:
+        first.close()
+
+
+def test_unhelpful_open_errors_are_said_plainly():
+    with pytest.raises(RigError, match="a socket URL is socket://HOST:PORT, PORT a number"):
+        SerialRig("socket://h:notaport", "socket://h:1", timeout=0.2)
+    with pytest.raises(RigError, match="no such device"):
+        SerialRig("/dev/rolltouch-no-such-port", "/dev/rolltouch-no-such-port", timeout=0.2)
+
+
+def test_swapped_devices_are_named():
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with pytest.raises(RigError, match="swapped; swap --arm and --daq"):
+            SerialRig(daq, arm, timeout=0.5)
+    finally:
+        emu.close()
+
+
+def test_a_wild_voltage_is_printed_short():
+    """A DAQ that answers 1e308 V: the error is one short line, not a 300-digit number."""
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    emu._sample = lambda n: (1e308, 0.0)
+    try:
+        with SerialRig(arm, daq, timeout=0.5) as rig, pytest.raises(RigError) as info:
+            rig.read(8)
+        assert "1e+308 V" in str(info.value) and len(str(info.value)) < 200
+    finally:
+        emu.close()

@@ -2,6 +2,7 @@
 against closed forms, units, the y flip, the outer loop, the first point, and the errors."""
 
 import math
+import os
 
 import ezdxf
 import numpy as np
@@ -298,3 +299,26 @@ def test_smooth_joins_written_with_rounded_coordinates_are_not_corners(tmp_path)
     (tmp_path / "r.svg").write_text(f'<svg xmlns="http://www.w3.org/2000/svg"><path d="{" ".join(d)} Z"/></svg>')
     o = load_outline(tmp_path / "r.svg")
     assert len(o.corners) == 1 and o.corners[0].arc == 0.0 and o.corners[0].angle > 0.5
+
+
+def test_part_files_that_are_not_parts_name_the_file(tmp_path):
+    from localizer import load_part
+
+    cases = {
+        "binary.json": os.urandom(2000),
+        "deep.json": ("[" * 100_000 + "]" * 100_000).encode(),
+        "wide.csv": ("x,y\n1," + "9" * 200_000 + "\n").encode(),
+    }
+    for name, data in cases.items():
+        (tmp_path / name).write_bytes(data)
+        with pytest.raises(PartError) as info:
+            load_part(tmp_path / name)
+        assert str(tmp_path / name) in str(info.value)
+    huge = tmp_path / "huge.json"
+    with open(huge, "wb") as f:  # sparse: 1 GB that takes no disk
+        f.truncate(2**30)
+    with pytest.raises(PartError, match="more than the 64 MB a part file may have"):
+        load_part(huge)
+    with pytest.raises(PartError, match="more than the 64 MB a CAD file may have"):
+        huge.rename(tmp_path / "huge.dxf")
+        load_outline(tmp_path / "huge.dxf")
