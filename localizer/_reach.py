@@ -40,6 +40,7 @@ from scipy.spatial import ConvexHull
 from ._boundary import Boundary
 from ._cache import per_part
 from ._errors import QueryError
+from ._outline import Outline
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc"]
@@ -258,6 +259,10 @@ def reach_for(part: Boundary, jaw: StraightJaw = DEFAULT_JAW, spacing: float = 0
     )
 
 
+#: How far along a drawing's outline, each way, the calibration point's clearance is judged, mm.
+CALIBRATION_WINDOW = 10.0
+
+
 def calibration_arc(part: Boundary, jaw: StraightJaw = DEFAULT_JAW) -> float:
     """Where to calibrate on ``part``: the most curved point the ``jaw`` touches at every place along it, mm.
 
@@ -272,5 +277,23 @@ def calibration_arc(part: Boundary, jaw: StraightJaw = DEFAULT_JAW) -> float:
         raise QueryError(
             f"no point of {part.name} can be touched along the whole {jaw} jaw: calibrate on another object"
         )
-    kappa = np.asarray(part.curvature_at_arc(r.sigma[ok]))
-    return float(r.sigma[ok[int(np.argmax(kappa))]])
+    sigma = r.sigma[ok]
+    kappa = np.asarray(part.curvature_at_arc(sigma))
+    if not isinstance(part, Outline):
+        return float(sigma[int(np.argmax(kappa))])
+    # On a drawing the most curved point is a small fillet between faces that turn little, and a jaw
+    # laid along its tangent lies nearly flush on the faces beside it: pressed there with the contact
+    # near the jaw's end, it touches the face too, and the calibration comes out non-monotone (6 of
+    # 7 trials on a generated plate). So: a point of a curved piece (a line or a corner has no one
+    # tangent to lay the jaw along) where the part turns away from the jaw most on its nearer side
+    # within CALIBRATION_WINDOW mm, corners' jumps included.
+    w = CALIBRATION_WINDOW
+    theta = part.tangent_angle_at_arc
+    ahead = theta(sigma + w, side="after") - theta(sigma)
+    behind = theta(sigma) - theta(sigma - w, side="before")
+    score = np.where(kappa > 0, np.minimum(ahead, behind), -np.inf)
+    if not np.isfinite(score).any():
+        raise QueryError(
+            f"no curved point of {part.name} can be touched along the whole {jaw} jaw: calibrate on another object"
+        )
+    return float(sigma[int(np.argmax(score))])
