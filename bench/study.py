@@ -295,6 +295,10 @@ def load_study(path) -> Study:
     for p in parts:
         if not Path(p).is_file():
             raise StudyError(f"study {path}: part file {p} does not exist")
+        try:  # read now, so that a bad part is named before any trial runs
+            load_part(p)
+        except RolltouchError as exc:
+            raise StudyError(f"study {path}: {exc}") from None
     rolls = data.get("rolls_deg")
     if (
         not isinstance(rolls, list)

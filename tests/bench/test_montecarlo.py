@@ -398,3 +398,26 @@ def test_ctrl_c_keeps_the_finished_trials_and_does_not_wait_for_the_queue(tmp_pa
     assert waited < 15 and 2 <= len(finished) < 150
     summary = json.loads((out / "summary.json").read_text())
     assert sum(lv["trials"] for lv in summary["levels"]) == len(finished)
+
+
+def test_a_binary_study_or_part_is_one_clear_error(tmp_path):
+    (tmp_path / "bin.toml").write_bytes(bytes(range(256)) * 8)
+    with pytest.raises(StudyError, match="bin.toml: not a text file"):
+        load_study(tmp_path / "bin.toml")
+    (tmp_path / "bin.json").write_bytes(bytes(range(256)) * 8)
+    f = tmp_path / "s.toml"
+    f.write_text(f'parts = ["{tmp_path / "bin.json"}"]\nrolls_deg = [20.0]\n')
+    with pytest.raises(StudyError, match="bin.json: not a text file"):
+        load_study(f)
+
+
+def test_an_absent_scheduler_is_named_quickly(reference, monkeypatch):
+    pytest.importorskip("distributed")
+    import bench.montecarlo
+
+    study, _, tmp = reference
+    monkeypatch.setattr(bench.montecarlo, "SCHEDULER_TIMEOUT", 1.0)
+    t0 = time.monotonic()
+    with pytest.raises(StudyError, match="no Dask scheduler answered within 1 s"):
+        run_study(study, tmp / "nosched", scheduler="tcp://127.0.0.1:1", progress=False)
+    assert time.monotonic() - t0 < 10

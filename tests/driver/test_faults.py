@@ -369,3 +369,16 @@ def test_a_wild_voltage_is_printed_short():
         assert "1e+308 V" in str(info.value) and len(str(info.value)) < 200
     finally:
         emu.close()
+
+
+def test_an_os_error_that_is_not_ours_is_one_line(monkeypatch, capsys):
+    """RigError is an OSError; any other (a full disk, a permission) must not slip past as a traceback."""
+    import driver.cli.offline
+
+    def refuse(args):
+        raise PermissionError(13, "Permission denied", "/data/out.png")
+
+    monkeypatch.setattr(driver.cli.offline, "localize_command", refuse)
+    rc = main(["localize", TREFOIL, "--length", "25", "--turn", "31.78"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.strip() == "rolltouch: error: /data/out.png: Permission denied"
