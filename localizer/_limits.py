@@ -20,7 +20,7 @@ def check_size(path: str | os.PathLike[str], limit: int, what: str, error: type[
     try:
         size = Path(path).stat().st_size
     except FileNotFoundError:
-        raise error(f"{path}: cannot read the {what} (no such file)") from None
+        raise error(f"{path}: cannot read {what} (no such file)") from None
     except OSError as exc:
         raise error(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
     if size > limit:
