@@ -382,3 +382,26 @@ def test_an_os_error_that_is_not_ours_is_one_line(monkeypatch, capsys):
     rc = main(["localize", TREFOIL, "--length", "25", "--turn", "31.78"])
     err = capsys.readouterr().err
     assert rc == 2 and err.strip() == "rolltouch: error: /data/out.png: Permission denied"
+
+
+def test_a_second_ctrl_c_does_not_cut_the_safe_stop_short():
+    """Ctrl-C during the safe stop is held off until it is done: the stop and the back-off both run,
+    and what is said afterwards is what happened."""
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        rig = SerialRig(arm, daq, timeout=0.5)
+        rig.move(*emu.rig.pose())
+        stop = rig.stop
+
+        def impatient():
+            os.kill(os.getpid(), signal.SIGINT)  # the user presses Ctrl-C again, mid-stop
+            time.sleep(0.05)
+            stop()
+
+        rig.stop = impatient
+        outcome = rig.safe_stop()  # no KeyboardInterrupt escapes
+        rig.close()
+    finally:
+        emu.close()
+    assert outcome == "the arm was stopped; the jaw was backed off 5 mm"
