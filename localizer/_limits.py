@@ -16,7 +16,17 @@ MAX_PART_BYTES = 64 * 2**20
 
 def check_size(path: str | os.PathLike[str], limit: int, what: str, error: type[Exception] = PartError) -> None:
     """Raise ``error`` naming ``path`` when the file is larger than ``limit`` bytes (or cannot be
-    examined)."""
+    examined).
+
+    Parameters
+    ----------
+    path : str or Path
+    limit : int, bytes
+    what : str
+        What the file is, for the message ("part file", "trace", ...).
+    error : type
+        The exception raised (a :class:`RolltouchError` subclass; default :class:`PartError`).
+    """
     try:
         size = Path(path).stat().st_size
     except FileNotFoundError:

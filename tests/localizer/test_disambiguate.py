@@ -80,7 +80,7 @@ def test_clockwise_chain():
         (dict(rolls=[(10.0, 0.1), (-2.0, 0.1)]), r"roll 2: length=-2.0 mm"),
         (dict(rolls=[(10.0, float("nan"))]), "roll 1: .* must be finite"),
         (dict(rolls=[(10.0, 0.1)], rule="best"), r"unknown rule 'best'; use one of \['likelihood', 'paper'\]"),
-        (dict(rolls=[(10.0, 0.1)], sd_length=0.0), "sd_length=0.0 must be a positive number"),
+        (dict(rolls=[(10.0, 0.1)], sd_length=0.0), "sd_length=0.0 is below 0.0001"),
         (dict(rolls=[(10.0, 0.1)], confidence=2.0), "confidence=2.0"),
         (dict(rolls=[(10.0, 0.1)], direction="left"), "unknown direction 'left'"),
     ],
