@@ -4,12 +4,14 @@ from .rig import (
     Clocked,
     ForceServo,
     GroundTruth,
+    ImplausibleReading,
     Pose,
     ProtocolError,
     Reading,
     Rig,
     RigError,
     SampleLog,
+    TransportError,
     Truth,
 )
 
@@ -24,4 +26,6 @@ __all__ = [
     "Truth",
     "RigError",
     "ProtocolError",
+    "TransportError",
+    "ImplausibleReading",
 ]

@@ -24,6 +24,7 @@ from scipy.interpolate import CubicSpline
 from localizer import ROLL_STEP, Boundary, Localization, Outline, Part, arc_from_jaw_positions, localize
 
 from .rig import (
+    DEVICE_FAULTS,
     Clocked,
     ForceServo,
     GroundTruth,
@@ -661,7 +662,7 @@ def roll(
         press(rig, hand, baseline, target=calibration.target, n=n, pressing=pressing)
         try:
             d.append(_location(rig, baseline, calibration, n, readings, truth, hand))
-        except (ImplausibleReading, ProtocolError):
+        except DEVICE_FAULTS:
             raise  # a device fault, not a bridge
         except RigError:
             if bridge_jump is not None and j > 0:  # left the calibrated span in one jump

@@ -48,11 +48,7 @@ import numpy as np
 from localizer import ROLL_STEP, Belief, Boundary, ContactFilter, arc_from_jaw_positions
 
 from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
-from .rig import ImplausibleReading, ProtocolError, Reading, Rig, RigError, Truth
-
-#: What the rolling never takes for a bridge or a lost contact: a device's own refusal (``ERR``, e.g. a
-#: workspace limit mid-roll) and a reading that cannot be (a stuck encoder, a dead DAQ).
-DEVICE_FAULTS = (ImplausibleReading, ProtocolError)
+from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 
 __all__ = [
     "ReactiveRun",

@@ -15,6 +15,8 @@ from typing import NamedTuple, Protocol, runtime_checkable
 from localizer import RolltouchError
 
 __all__ = [
+    "TransportError",
+    "DEVICE_FAULTS",
     "ImplausibleReading",
     "Rig",
     "ForceServo",
@@ -37,6 +39,11 @@ class ImplausibleReading(RigError):
     """A device reported what cannot be: an arm angle far from the commanded one (a stuck or misread
     encoder), a wrist that reads exactly the same while the jaw moves (a dead DAQ). Never taken for a
     bridge or a lost contact: the run stops on it."""
+
+
+class TransportError(RigError):
+    """A device that did not answer: no reply, only garbled ones, or the connection gone. Never taken
+    for a bridge or a lost contact."""
 
 
 class ProtocolError(RigError):
@@ -150,3 +157,9 @@ class SampleLog(Protocol):
     """A rig that keeps every raw sample it read (with ground truth on a simulated rig)."""
 
     samples: list
+
+
+#: What the rolling never takes for a bridge or a lost contact: a device that did not answer, a
+#: device's own refusal (``ERR``, e.g. a workspace limit mid-roll) and a reading that cannot be (a
+#: stuck encoder).
+DEVICE_FAULTS = (TransportError, ProtocolError, ImplausibleReading)

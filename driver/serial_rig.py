@@ -24,7 +24,7 @@ from pathlib import Path
 import serial
 
 from .protocol import MAX_LINE, Reply, encode_request, parse_reply
-from .rig import Pose, ProtocolError, RigError
+from .rig import Pose, ProtocolError, RigError, TransportError
 
 __all__ = ["SerialRig", "Workspace"]
 
@@ -171,11 +171,11 @@ class SerialRig:
             except RigError:
                 raise  # the device's own refusal (ERR): not a connection failure
             except serial.SerialException as exc:
-                raise RigError(f"the {device} connection failed during {command}: {exc}") from None
+                raise TransportError(f"the {device} connection failed during {command}: {exc}") from None
             except OSError as exc:
-                raise RigError(f"the {device} connection failed during {command}: {exc}") from None
+                raise TransportError(f"the {device} connection failed during {command}: {exc}") from None
             self._emit({"event": "retry", "device": device, "command": command, "try": attempt + 1, "problem": problem})
-        raise RigError(f"the {device} did not answer {command} after {self.retries + 1} tries: {problem}")
+        raise TransportError(f"the {device} did not answer {command} after {self.retries + 1} tries: {problem}")
 
     def _emit(self, event: dict) -> None:
         if self.log is not None:

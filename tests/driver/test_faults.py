@@ -405,3 +405,28 @@ def test_a_second_ctrl_c_does_not_cut_the_safe_stop_short():
     finally:
         emu.close()
     assert outcome == "the arm was stopped; the jaw was backed off 5 mm"
+
+
+def test_a_device_that_stops_answering_mid_roll_is_not_a_bridge(tmp_path):
+    """The soak run found it: a READ that failed its three tries mid-roll was reported as the roll
+    having "bridged a concave stretch". It is the DAQ that did not answer, and it says so."""
+    from driver.rig import TransportError
+
+    emu = emulator()
+    handle, count = emu.handle, {"daq": 0}
+
+    def deaf_after_a_while(device, line):
+        if device == "daq":
+            count["daq"] += 1
+            if count["daq"] > 200:  # mid-roll: the calibration and the first steps are done
+                return []
+        return handle(device, line)
+
+    emu.handle = deaf_after_a_while
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq, timeout=0.2) as rig, pytest.raises(TransportError) as info:
+            run_from_here(rig, PART, ROLLS)
+    finally:
+        emu.close()
+    assert "daq did not answer READ" in str(info.value) and "bridged" not in str(info.value)
