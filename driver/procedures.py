@@ -247,18 +247,19 @@ def press(
     seen = {(dv1, dv2)}
     while dv1 < threshold:
         if travelled >= max_travel:
-            hand.press_by(-travelled)  # back where the search began: with a dead sensor it may be in the part
             dead = ""
             if len(seen) == 1:
-                # a simulated wrist without noise reads exactly the same too, so this is a hint, not a verdict
+                # a simulated wrist without noise reads exactly the same too, so this is a hint, not a
+                # verdict; a dead sensor may have let the jaw into the part, so it goes back out
+                hand.press_by(-travelled)
                 dead = (
                     f". The wrist read exactly the same at all {round(travelled / search_step) + 1} readings while "
-                    "the jaw moved: a real sensor's noise changes every reading, so on a rig its DAQ or "
-                    "strain-gauge amplifier is not reading (check its wiring)"
+                    f"the jaw moved, and the jaw was moved back {travelled:.1f} mm: a real sensor's noise changes "
+                    "every reading, so on a rig its DAQ or strain-gauge amplifier is not reading (check its wiring)"
                 )
             raise RigError(
                 f"no contact after pressing {travelled:.1f} mm along the jaw normal "
-                f"(Δv1 = {dv1:.4g} V); the jaw was moved back; start closer to the part{dead}"
+                f"(Δv1 = {dv1:.4g} V); start closer to the part{dead}"
             )
         hand.press_by(search_step)
         travelled += search_step

@@ -96,7 +96,7 @@ def test_an_arm_limit_mid_roll_is_named_and_the_host_says_what_it_could_do(tmp_p
 
 def test_a_dead_daq_is_named_and_the_jaw_moved_back(tmp_path):
     outcome, _, force = run_against(Faults(daq_constant=0.5), tmp_path)
-    assert "DAQ or strain-gauge amplifier is not reading" in str(outcome) and "moved back" in str(outcome)
+    assert "DAQ or strain-gauge amplifier is not reading" in str(outcome) and "moved back 15.0 mm" in str(outcome)
     assert force == 0.0
 
 
