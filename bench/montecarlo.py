@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from driver.lockfile import LockHeld, hold_lock
+
 from .study import TRIAL_COLUMNS, Study, StudyError, TrialSpec, run_trial
 
 __all__ = ["run_study", "read_trials", "summarize", "wilson"]
@@ -245,25 +247,12 @@ def _check_same_study(study: Study, out: Path) -> None:
 @contextlib.contextmanager
 def _folder_lock(out: Path):
     """Hold ``out/.lock`` for the run: two runs writing one folder would interleave their rows."""
-    handle = open(out / ".lock", "a+")  # noqa: SIM115 - held for the run
     try:
-        try:
-            import fcntl
-
-            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except ImportError:  # not POSIX: no lock (documented)
-            pass
-        except OSError:
-            handle.seek(0)
-            holder = handle.read().strip() or "another process"
-            raise StudyError(f"{out} is being written by {holder}: wait for it, or use another --out") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"rolltouch montecarlo pid {os.getpid()}")
-        handle.flush()
+        handle = hold_lock(out / ".lock", f"rolltouch montecarlo pid {os.getpid()}")
+    except LockHeld as held:
+        raise StudyError(f"{out} is being written by {held.holder}: wait for it, or use another --out") from None
+    with handle:
         yield
-    finally:
-        handle.close()
 
 
 def _die_with_parent(parent: int) -> None:

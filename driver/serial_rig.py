@@ -16,15 +16,16 @@ import math
 import os
 import signal
 import tempfile
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import serial
 
+from .lockfile import LockHeld, hold_lock
 from .protocol import MAX_LINE, Reply, encode_request, parse_reply
 from .rig import Pose, ProtocolError, RigError, TransportError
+from .signals import handling
 
 __all__ = ["SerialRig", "Workspace"]
 
@@ -235,7 +236,9 @@ class SerialRig:
         Ctrl-C or SIGTERM while it runs is held until it is done. Returns what really happened, as a
         sentence for the user (also logged as the ``safe_stop`` event)."""
         done = {}
-        with _signals_held():
+        # a second Ctrl-C (or SIGTERM) must not cut the safe stop short; it is always on the way out
+        # (its caller raises next), so a signal that came meanwhile has nothing left to stop
+        with handling(("SIGINT", "SIGTERM", "SIGHUP"), signal.SIG_IGN):
             for name, action in (("stop", self.stop), ("back_off", self._back_off)):
                 try:
                     action()
@@ -304,40 +307,10 @@ def _device_lock(name: str, url: str):
     the transport): two host processes driving one arm would interleave their commands and replies.
     Raises :class:`RigError` naming the holder when another process has it."""
     path = Path(tempfile.gettempdir()) / f"rolltouch-{hashlib.sha1(url.encode()).hexdigest()[:16]}.lock"
-    handle = open(path, "a+")  # noqa: SIM115 - held open for the rig's lifetime, closed by close()
     try:
-        import fcntl
-    except ImportError:  # not POSIX: pyserial opens COM ports exclusively itself
-        return handle
-    try:
-        fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        handle.seek(0)
-        holder = handle.read().strip() or "another process"
-        handle.close()
+        return hold_lock(path, f"rolltouch pid {os.getpid()}")
+    except LockHeld as held:
         raise RigError(
-            f"the {name} at {url} is in use by {holder} (lock {path}): two hosts driving one arm would "
+            f"the {name} at {url} is in use by {held.holder} (lock {path}): two hosts driving one arm would "
             "interleave their commands; stop the other run first"
         ) from None
-    handle.seek(0)
-    handle.truncate()
-    handle.write(f"rolltouch pid {os.getpid()}")
-    handle.flush()
-    return handle
-
-
-@contextlib.contextmanager
-def _signals_held():
-    """Ignore SIGINT, SIGTERM and SIGHUP while the block runs (the main thread only): a second Ctrl-C
-    must not cut the safe stop short. The safe stop is always on the way out (its caller raises next),
-    so a signal that came meanwhile has nothing left to stop."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    names = [getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
-    old = {sig: signal.signal(sig, signal.SIG_IGN) for sig in names}
-    try:
-        yield
-    finally:
-        for sig, handler in old.items():
-            signal.signal(sig, handler)

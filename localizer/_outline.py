@@ -169,16 +169,6 @@ class Outline(ArcPositions):
         """:meth:`tangent_angle_at_arc` at ``t`` (the parameter is the arc position, mm)."""
         return self.tangent_angle_at_arc(t)
 
-    @property
-    def curvature_bound(self) -> float:
-        """The largest |κ| over the outline, 1/mm: exact on lines and arcs, from 257 points per Bézier
-        (within a fraction of a per cent of the true maximum for the pieces CAD writes)."""
-        out = 0.0
-        for piece in self.pieces:
-            s = np.linspace(0.0, piece.length, 257)
-            out = max(out, float(np.abs(piece.curvature(s)).max()))
-        return out
-
     def curvature(self, t: ArrayLike) -> FloatArray:
         """:meth:`curvature_at_arc` at ``t`` (the parameter is the arc position, mm), 1/mm."""
         return self.curvature_at_arc(t)

@@ -14,15 +14,14 @@ that do not go together are argparse's own error (usage, status 2).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import importlib
 import signal
 import sys
-import threading
 from importlib import metadata
 
 from localizer import RolltouchError
 
+from ..signals import handling
 from ._options import UsageError, add_command
 
 __all__ = [
@@ -85,21 +84,6 @@ def _terminate(signum: int, frame: object) -> None:
     raise Terminated(signum)
 
 
-@contextlib.contextmanager
-def _termination_as_interrupt():
-    """SIGTERM and SIGHUP raise :class:`Terminated` while the block runs (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    names = [getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n)]
-    old = {sig: signal.signal(sig, _terminate) for sig in names}
-    try:
-        yield
-    finally:
-        for sig, handler in old.items():
-            signal.signal(sig, handler)
-
-
 def _notes(exc: BaseException) -> str:
     """What the host did on the way out (e.g. the safe stop), as the exception's notes say."""
     return "; ".join(getattr(exc, "__notes__", []))
@@ -110,7 +94,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with _termination_as_interrupt():
+        with handling(("SIGTERM", "SIGHUP"), _terminate):  # handled as Ctrl-C is
             return int(args.run(args))
     except UsageError as exc:
         args.parser.error(str(exc))  # exits with status 2
