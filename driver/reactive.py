@@ -400,14 +400,15 @@ class _Roller:
 
     def _crossed_face(self, d: float, s: float) -> bool:
         """Whether a jump of the contact along the jaw, to ``d`` mm after a turn of ``s`` rad, is the jaw
-        tipping over a flat face (the contact passes the face at one jaw angle) rather than a bridge.
+        tipping over a flat face (the contact passes the face at one jaw angle) or a shallow dip the
+        rolling model carries it across, rather than a bridge that ends the convex stretch.
 
-        A flat face is crossed in one step: the jump is then a reading. The belief judges: the
+        Both are crossed in one step: the jump is then a reading. The belief judges: the
         hypotheses that predict a step of about the measured arc (within 1 mm or 10%) against those
-        under which the turn leaves their convex stretch (a bridge). A part without faces has none.
+        under which the turn leaves their convex stretch (a bridge). A part with neither has none.
         """
         tracks = self.flt.tracks
-        if not tracks.has_faces:
+        if not (tracks.has_faces or tracks.bridges):
             return False
         arc = self.direction * arc_from_jaw_positions([self.d_prev, d], s, self.offset)
         posterior = self.flt.posterior()

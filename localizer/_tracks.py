@@ -6,13 +6,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ._boundary import Boundary
 from ._cache import per_part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
-__all__ = ["ModeTracks", "tracks_for", "PIVOT_SPREAD"]
+__all__ = ["ModeTracks", "tracks_for", "PIVOT_SPREAD", "BRIDGE_EXCESS"]
 
 #: How far, mm of the rolling coordinate per radian of jump, a convex corner is spread in the filter's
 #: grid: at the grid's 0.02 mm, one start per 0.2° of jaw angle at the corner.
@@ -26,6 +27,13 @@ NO_TURN = 1e-9
 #: A jaw within this of a face's angle, rad, lies flush on it (a millimetre of the jaw then deviates
 #: from the face by a nanometre; :data:`sim2d` shares the contact's flush depth of 1 µm).
 FLUSH_TURN = 1e-6
+#: A concavity the straight jaw bridges without the contact leaving a convex stretch for good (a
+#: spline's wiggle along a straight stroke, 1–3 mm wide and microns deep) belongs to the convex
+#: stretch around it when the arc it skips is at most this much longer than the jaw's chord across
+#: it, mm: the rolling then reads the chord where the model counts the arc, an error a tenth of the
+#: ``paper`` preset's reading noise (0.1 mm). Deeper ones stay ends of their stretches (the rig
+#: reports their jump as a bridge, or a start rolled into one is ruled out).
+BRIDGE_EXCESS = 0.01
 
 
 def tracks_for(part: Boundary, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> ModeTracks:
@@ -57,6 +65,9 @@ class ModeTracks:
         belongs to the stretch around it) the jaw touches.
     has_faces : bool
         Some start lies on a flat face, which the jaw crosses in one step (a spline has none).
+    bridges : int
+        How many shallow concavities (:data:`BRIDGE_EXCESS`) the table carries the contact across
+        in one step, like a face; the rolling reads a jump there.
 
     Parameters
     ----------
@@ -104,10 +115,14 @@ class ModeTracks:
             kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
         sigma = np.asarray(sigma, dtype=float)
         self.sigma, self.theta, self.kappa = sigma, theta, kappa
+        # a shallow concavity the jaw bridges: its stretch rolls at the bridging chord's angle, which
+        # the table holds like a flat face's (the contact jumps across at that angle)
+        rolled, skipped = _bridge_shallow_dips(part, sigma, theta, jaw.length)
+        self.bridges = int(np.count_nonzero(np.diff(np.concatenate([[False], skipped, [False]]).astype(np.int8)) == 1))
         # three laps so that any rotation of less than a lap stays on the table
         turn = 2.0 * math.pi
         arcs = np.concatenate([sigma - p, sigma, sigma + p, [2 * p]])
-        th = np.concatenate([theta - turn, theta, theta + turn, [theta[0] + 2 * turn]])
+        th = np.concatenate([rolled - turn, rolled, rolled + turn, [rolled[0] + 2 * turn]])
         # a flat face (θ constant) belongs to the convex stretch around it: the jaw passes it flush,
         # at one angle, and the contact jumps from one end to the other
         rising = np.diff(th) >= 0
@@ -157,7 +172,9 @@ class ModeTracks:
         self.touchable = np.maximum(self.lo, -jaw.half) < np.minimum(self.hi, jaw.half)
         # a start on a flat face (κ = 0 within a convex stretch) is where the jaw lay flush: the wrist
         # read the centre of pressure there, and the first turn takes the contact to the face's end
-        self.convex: BoolArray = rising[a][self._run] & (kappa >= 0) & self.touchable
+        # (a start within a bridged dip, or beside it where the jaw along the tangent would cut the
+        # far side, is not one the rolling model follows)
+        self.convex: BoolArray = rising[a][self._run] & (kappa >= 0) & self.touchable & ~skipped
         self.has_faces = bool(np.any(self.convex & (kappa == 0)))
         for arr in (
             self.sigma,
@@ -333,3 +350,107 @@ class ModeTracks:
             arc, node, moved = self.step(idx, float(t))
             ok[idx] = moved & self.touches(arc, jaw + (arc - self.sigma[idx]), -margin, sure=True, node=node)
         return ok
+
+
+def _bridge_shallow_dips(
+    part: Boundary, sigma: FloatArray, theta: FloatArray, jaw_length: float
+) -> tuple[FloatArray, BoolArray]:
+    """The tangent angle the rolling follows at each grid point, with every shallow concavity
+    bridged, and the grid points within a bridge.
+
+    A straight jaw rolling over a concavity narrower than itself touches the two convex stretches
+    around it on one line, the bitangent, at angle φ: up to φ the contact is on the stretch before,
+    past φ on the one after, and the contact jumps the chord between them. So every grid point
+    from the first tangent point a to the second b rolls at φ (a table entry of constant angle, as on
+    a flat face). The concavity is bridged when the arc from a to b exceeds the chord by at most
+    :data:`BRIDGE_EXCESS` and the chord is shorter than the jaw; the bitangent is found by Brent's
+    method on the signed distance of b from the tangent line at a, over the angles both stretches
+    reach.
+
+    Parameters
+    ----------
+    part : Boundary
+    sigma, theta : ndarray, shape (n,)
+        The grid's arc positions (mm, increasing within one lap) and unwrapped tangent angles (rad).
+    jaw_length : float, mm
+
+    Returns
+    -------
+    rolled : ndarray, shape (n,), rad
+        ``theta`` with each bridged stretch [a, b] at φ.
+    skipped : ndarray of bool, shape (n,)
+        Grid points strictly between a and b: no rolling starts there.
+    """
+    n = sigma.size
+    p = part.perimeter
+    turn = 2.0 * math.pi
+    rolled = theta.copy()
+    skipped = np.zeros(n, dtype=bool)
+    # three laps, so that a concavity across the lap's end has both stretches on the table
+    s3 = np.concatenate([sigma - p, sigma, sigma + p])
+    t3 = np.concatenate([theta - turn, theta, theta + turn])
+    falling = np.diff(t3) < 0  # cell i: from node i to node i + 1
+    if not falling[n : 2 * n].any():
+        return rolled, skipped
+    edges = np.flatnonzero(np.diff(falling.astype(np.int8)))
+    starts = edges[np.diff(falling.astype(np.int8))[edges] == 1] + 1  # first falling cell of a run
+    for c0 in starts[(starts >= n) & (starts < 2 * n)]:
+        c1 = c0
+        while c1 + 1 < falling.size and falling[c1 + 1]:
+            c1 += 1
+        i1, i2 = int(c0), int(c1) + 1  # the concavity runs from node i1 (θ highest) to i2 (lowest)
+        a0 = i1
+        while a0 > 0 and not falling[a0 - 1]:
+            a0 -= 1
+        b1 = i2
+        while b1 < falling.size and not falling[b1]:
+            b1 += 1
+        lo, hi = max(t3[i2], t3[a0]), min(t3[i1], t3[b1])
+        if not (hi > lo) or i1 - a0 < 2 or b1 - i2 < 2:
+            continue
+        found = _bitangent(part, (t3[a0 : i1 + 1], s3[a0 : i1 + 1]), (t3[i2 : b1 + 1], s3[i2 : b1 + 1]), lo, hi)
+        if found is None:
+            continue
+        phi, sa, sb = found
+        between = np.linspace(sa, sb, 64)
+        pts = np.asarray(part.point_at_arc(np.mod(between, p)), dtype=float)
+        chord = float(np.hypot(*(pts[-1] - pts[0])))
+        # the jaw on the bitangent keeps the whole stretch on the part's side (a support line)
+        depth = math.cos(phi) * (pts[:, 1] - pts[0, 1]) - math.sin(phi) * (pts[:, 0] - pts[0, 0])
+        if not (chord < jaw_length and (sb - sa) - chord <= BRIDGE_EXCESS and depth.min() >= -1e-6):
+            continue
+        on = np.flatnonzero((s3 >= sa) & (s3 <= sb))
+        rolled[on % n] = phi - (on // n - 1) * turn
+        inner = np.flatnonzero((s3 > sa) & (s3 < sb))
+        skipped[inner % n] = True
+    return rolled, skipped
+
+
+def _bitangent(
+    part: Boundary, before: tuple[FloatArray, FloatArray], after: tuple[FloatArray, FloatArray], lo: float, hi: float
+) -> tuple[float, float, float] | None:
+    """The line touching two convex stretches at one tangent angle φ within [``lo``, ``hi``] (rad):
+    (φ, its arc on the first, its arc on the second, mm), or None when there is not exactly one.
+
+    ``before`` and ``after`` are each stretch's (θ rising, rad; arc, mm) on the grid; the arc of a
+    given θ is interpolated between grid points. The root of the signed distance of the second
+    point from the tangent line at the first is found by Brent's method.
+    """
+
+    def ends(phi: float) -> tuple[float, float]:
+        return float(np.interp(phi, *before)), float(np.interp(phi, *after))
+
+    def side(phi: float) -> float:
+        sa, sb = ends(phi)
+        d = np.asarray(part.point_at_arc(np.mod([sb, sa], part.perimeter)), dtype=float)
+        v = d[0] - d[1]
+        return float(math.cos(phi) * v[1] - math.sin(phi) * v[0])
+
+    phis = np.linspace(lo, hi, 33)
+    g = np.array([side(float(f)) for f in phis])
+    change = np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) <= 0)
+    if change.size != 1:
+        return None
+    k = int(change[0])
+    phi = float(brentq(side, phis[k], phis[k + 1], xtol=1e-12)) if g[k] != g[k + 1] else float(phis[k])
+    return (phi, *ends(phi))
