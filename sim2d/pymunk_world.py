@@ -2,8 +2,9 @@
 
 Units inside the space: millimetres, kilograms, seconds, so a force is in
 kg·mm/s² = mN. The part is a chain of static segments through the spline,
-polygonised to a chord tolerance; the hand is a kinematic body without shapes,
-driven only by commands (velocity control with speed limits); the jaw is a
+polygonised to a chord tolerance (an outline from CAD: through its machined
+sample, one segment per face, every corner a vertex); the hand is a kinematic
+body without shapes, driven only by commands (velocity control with speed limits); the jaw is a
 dynamic box whose edge (local y = 0, x in ±half_span) faces the part. The wrist
 joins them: a groove lets the jaw slide along the jaw normal only, a damped
 spring along that groove gives the wrist's compliance, and a gear joint keeps
@@ -22,10 +23,11 @@ import math
 import numpy as np
 import pymunk
 
-from localizer import Part
+from localizer import Line, Part
 
 from ._errors import SimError
-from .quasistatic import tangent_point
+from .machining import MachinedOutline
+from .quasistatic import outline_touch, tangent_point
 from .world import Contact
 
 __all__ = ["PymunkWorld", "polygonise"]
@@ -42,10 +44,12 @@ def polygonise(part: Part, chord_tolerance: float) -> np.ndarray:
     return _polygon(part, chord_tolerance)[0]
 
 
-def _polygon(part: Part, chord_tolerance: float):
+def _polygon(part: Part | MachinedOutline, chord_tolerance: float):
     """(points, parameters) of :func:`polygonise`."""
     if not chord_tolerance > 0:
         raise SimError(f"chord_tolerance={chord_tolerance!r} mm must be positive")
+    if isinstance(part, MachinedOutline):
+        return _outline_polygon(part, chord_tolerance)
     ts = []
     for i in range(part.n_knots):
         u = i + np.linspace(0.0, 1.0, 33)
@@ -60,13 +64,37 @@ def _polygon(part: Part, chord_tolerance: float):
     return np.vstack([pts, pts[:1]]), t
 
 
+def _outline_polygon(machined: MachinedOutline, chord_tolerance: float):
+    """(points, arcs) of the machined outline's polygon: its sample points at the model's piece ends
+    (so every corner), one chord per line, curves at the spacing whose sagitta κ_max·h²/8 on the model
+    meets the tolerance. The machined deviation between vertices is left to the contact's refinement
+    on the dense sample (:func:`sim2d.quasistatic.outline_touch`)."""
+    model = machined.model
+    arcs = []
+    for start, piece in zip(model.starts[:-1], model.pieces):
+        if isinstance(piece, Line):
+            n = 1
+        else:
+            kappa = float(np.abs(piece.curvature(np.linspace(0.0, piece.length, 65))).max())
+            n = max(1, math.ceil(piece.length / math.sqrt(8.0 * chord_tolerance / max(kappa, 1e-12))))
+        arcs.append(start + piece.length * np.arange(n) / n)
+    want = np.concatenate(arcs)
+    # the nearest sample of the machined boundary (its corners are samples)
+    j = np.clip(np.searchsorted(machined.arcs, want), 1, machined.arcs.size - 1)
+    j = np.where(want - machined.arcs[j - 1] <= machined.arcs[j] - want, j - 1, j)
+    j = np.unique(j)
+    pts = machined.xy[j]
+    return np.vstack([pts, pts[:1]]), machined.arcs[j]
+
+
 class PymunkWorld:
     """The jaw rolling on the part in a pymunk space.
 
     Parameters
     ----------
-    part : Part
-        The real part.
+    part : Part or MachinedOutline
+        The real part: a spline, or an outline from CAD as machined. On an outline the contact's
+        ``param`` is the model's arc position (mm), as in :class:`QuasiStaticWorld`.
     stiffness : float, N/mm
         Wrist compliance along the jaw normal.
     half_span : float, mm
@@ -87,7 +115,7 @@ class PymunkWorld:
 
     def __init__(
         self,
-        part: Part,
+        part: Part | MachinedOutline,
         *,
         stiffness: float = 1.0,
         half_span: float = 50.0,
@@ -211,6 +239,17 @@ class PymunkWorld:
         jb.each_arbiter(visit)
         if total <= 0 or not points:
             return Contact(0.0, 0.0, float("nan"), 0.0, False)
+        depth = float(-((np.array(jb.position) - (hx, hy)) @ m))
+        if isinstance(self.part, MachinedOutline):
+            # the jaw where the solver settled it against the polygon, laid on the dense machined
+            # sample: a corner stays the contact while the jaw pivots, a face flush under the jaw
+            # gives its middle (the quasi-static world's rule). At the hand's angle: the gear joint's
+            # residual twist, microradians of the solver's, would otherwise decide which end of a
+            # flush face bears, a 20 mm jump of the reading that no wrist of the rig's makes
+            _, u_o, arc, _, edge = outline_touch(
+                self.part, (jb.position.x, jb.position.y), self.hand[2], self.half_span
+            )
+            return Contact(total, u_o, arc, depth, edge)
         # The solver spreads the force over the polygon vertices that overlap the
         # edge in no particular way; the deepest one is the polygon's contact. The
         # real part is the spline: refine to its tangent point at the jaw's angle
@@ -221,5 +260,4 @@ class PymunkWorld:
         if abs(float((self.part.point(t) - deepest) @ e)) > 2.0:  # a bridge or a corner: keep the vertex
             t = float(self._poly_t[k])
         u = float((self.part.point(t) - np.array(jb.position)) @ e)
-        depth = float(-((np.array(jb.position) - (hx, hy)) @ m))
         return Contact(total, u, t, depth, abs(u) > self.half_span + 1e-6)

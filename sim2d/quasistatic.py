@@ -26,7 +26,7 @@ from ._errors import SimError
 from .machining import MachinedOutline
 from .world import Contact
 
-__all__ = ["QuasiStaticWorld", "tangent_point", "FLUSH"]
+__all__ = ["QuasiStaticWorld", "tangent_point", "outline_touch", "FLUSH"]
 
 #: Points of an outline within this depth of the deepest share the load (mm): the jaw lies flush. A
 #: nanometre: an exactly flat face at its own angle (up to rounding), as the filter takes it
@@ -57,13 +57,9 @@ class QuasiStaticWorld:
         self.stiffness = float(stiffness)
         self.half_span = float(half_span)
         self._spline = None if isinstance(part, MachinedOutline) else part
-        if isinstance(part, MachinedOutline):
-            self._t, self._xy = part.arcs, part.xy
-            self._period = part.perimeter
-        else:
+        if not isinstance(part, MachinedOutline):
             self._t = np.arange(part.n_knots * 32) / 32.0
             self._xy = part.point(self._t)
-            self._period = float(part.n_knots)
         self.hand: tuple[float, float, float] | None = (0.0, 0.0, 0.0)
 
     def set_hand(self, x: float, y: float, phi: float) -> None:
@@ -73,6 +69,13 @@ class QuasiStaticWorld:
     def contact(self) -> Contact:
         """The contact for the present hand pose (force 0 when the jaw is clear)."""
         x, y, phi = self.hand or (0.0, 0.0, 0.0)
+        spline = self._spline
+        if spline is None:
+            assert isinstance(self.part, MachinedOutline)
+            under, du_o, arc, dd_o, edge = outline_touch(self.part, (x, y), phi, self.half_span)
+            if not under:
+                return Contact(0.0, 0.0, float("nan"), 0.0, False)
+            return Contact(self.stiffness * dd_o if dd_o > 0 else 0.0, du_o, arc, dd_o, edge)
         e = np.array([np.cos(phi), np.sin(phi)])
         m = np.array([-np.sin(phi), np.cos(phi)])
         rel = self._xy - (x, y)
@@ -82,9 +85,6 @@ class QuasiStaticWorld:
         if not inside.any():
             return Contact(0.0, 0.0, float("nan"), 0.0, False)
         k = int(np.argmax(np.where(inside, depth, -np.inf)))
-        spline = self._spline
-        if spline is None:
-            return self._outline_contact(k, u, depth, inside)
         t = tangent_point(spline, self._t[k], phi)
         p = spline.point(t)
         du = float((p - (x, y)) @ e)
@@ -96,20 +96,47 @@ class QuasiStaticWorld:
             return Contact(0.0, du, float(t) % spline.n_knots, dd, at_edge)
         return Contact(self.stiffness * dd, du, float(t) % spline.n_knots, dd, at_edge)
 
-    def _outline_contact(self, k: int, u: np.ndarray, depth: np.ndarray, inside: np.ndarray) -> Contact:
-        """The contact on a sampled outline: the deepest point, or the middle of a flush line contact."""
-        flush = inside & (depth >= depth[k] - FLUSH)
-        P = self._period
-        # arcs relative to the deepest point's, so that a face across the first point stays whole
-        rel = (self._t[flush] - self._t[k] + P / 2) % P - P / 2
-        arc = float((self._t[k] + rel.mean()) % P)
-        du = float(u[flush].mean())
-        dd = float(depth[k])
-        # the deepest point the last one under the jaw, not a line: the jaw's end is what touches
-        line = float(np.ptp(u[flush])) > EDGE
-        at_edge = not line and abs(float(u[k])) >= self.half_span - EDGE
-        force = self.stiffness * dd if dd > 0 else 0.0
-        return Contact(force, du, arc, dd, at_edge)
+
+def outline_touch(
+    outline: MachinedOutline, origin: tuple[float, float], phi: float, half_span: float
+) -> tuple[bool, float, float, float, bool]:
+    """Where a straight edge touches a sampled outline: the deepest point, or the middle of a flush line.
+
+    Parameters
+    ----------
+    outline : MachinedOutline
+    origin : (float, float), mm
+        The point of the edge's line from which places along it are measured (the jaw's centre).
+    phi : float, rad
+        The edge's direction; the part lies on its left.
+    half_span : float, mm
+        Half the edge's length.
+
+    Returns
+    -------
+    under, jaw_position, arc, depth, at_edge
+        Whether any point lies under the edge; the contact's place along the edge (mm), its
+        model arc position (mm), how deep the deepest point lies beyond the edge's line (mm,
+        negative: clear), and whether the edge's end is what touches.
+    """
+    e = np.array([np.cos(phi), np.sin(phi)])
+    m = np.array([-np.sin(phi), np.cos(phi)])
+    rel = outline.xy - origin
+    u = rel @ e
+    depth = -(rel @ m)
+    inside = np.abs(u) <= half_span
+    if not inside.any():
+        return False, 0.0, float("nan"), 0.0, False
+    k = int(np.argmax(np.where(inside, depth, -np.inf)))
+    flush = inside & (depth >= depth[k] - FLUSH)
+    P = outline.perimeter
+    # arcs relative to the deepest point's, so that a face across the first point stays whole
+    rel_arc = (outline.arcs[flush] - outline.arcs[k] + P / 2) % P - P / 2
+    arc = float((outline.arcs[k] + rel_arc.mean()) % P)
+    # the deepest point the last one under the jaw, not a line: the jaw's end is what touches
+    line = float(np.ptp(u[flush])) > EDGE
+    at_edge = not line and abs(float(u[k])) >= half_span - EDGE
+    return True, float(u[flush].mean()), arc, float(depth[k]), at_edge
 
 
 def tangent_point(part: Part, t0: float, phi: float) -> float:

@@ -32,8 +32,8 @@ class SimRig:
     ----------
     part : Part or Outline
         The part's model (what the localizer is given); the simulated part is
-        this one machined with ``noise.machining_error``. An outline from CAD runs on the
-        kinematic engine only.
+        this one machined with ``noise.machining_error`` (an outline from CAD as a dense sample
+        with its corners, :func:`sim2d.machining.machined_outline`).
     noise : str, Path or NoiseModel
         ``"none"``, ``"paper"`` or a TOML file (see :func:`sim2d.noise.load_noise`).
     seed : int
@@ -76,29 +76,21 @@ class SimRig:
         self.part: Part | MachinedOutline
         self.world: World
         if isinstance(part, Outline):
-            if engine != "kinematic":
-                raise SimError(
-                    f"engine={engine!r}: an outline from CAD ({part.name}) runs on the kinematic engine only "
-                    "(the pymunk world is built from a spline's polygon); use engine='kinematic'"
-                )
-            machined = machined_outline(part, self.noise, self.rng)
-            self.part = machined
-            self.world = QuasiStaticWorld(machined, stiffness=stiffness, **(world_options or {}))
+            self.part = machined_outline(part, self.noise, self.rng)
         else:
-            spline = machined_part(part, self.noise, self.rng)
-            self.part = spline
-            if engine == "pymunk":
-                from .pymunk_world import PymunkWorld
+            self.part = machined_part(part, self.noise, self.rng)
+        if engine == "pymunk":
+            from .pymunk_world import PymunkWorld
 
-                self.world = PymunkWorld(
-                    spline,
-                    stiffness=stiffness,
-                    linear_speed=linear_speed,
-                    angular_speed=angular_speed,
-                    **(world_options or {}),
-                )
-            else:
-                self.world = QuasiStaticWorld(spline, stiffness=stiffness, **(world_options or {}))
+            self.world = PymunkWorld(
+                self.part,
+                stiffness=stiffness,
+                linear_speed=linear_speed,
+                angular_speed=angular_speed,
+                **(world_options or {}),
+            )
+        else:
+            self.world = QuasiStaticWorld(self.part, stiffness=stiffness, **(world_options or {}))
         self.wrist = wrist
         self.linear_speed = float(linear_speed)
         self.angular_speed = float(angular_speed)
