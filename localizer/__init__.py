@@ -19,7 +19,7 @@ from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._segment import DIRECTIONS, Segment
 from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
-from ._tracks import ModeTracks, tracks_for
+from ._tracks import BRIDGE_EXCESS, PIVOT_KAPPA, ModeTracks, tracks_for
 
 __all__ = [
     "Boundary",
@@ -47,6 +47,8 @@ __all__ = [
     "Mode",
     "ModeTracks",
     "tracks_for",
+    "BRIDGE_EXCESS",
+    "PIVOT_KAPPA",
     "NOISE_SCALES",
     "SLOPE_ENVELOPE",
     "TEMPER",

@@ -121,7 +121,7 @@ from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
 from ._reach import DEFAULT_JAW, StraightJaw
-from ._tracks import tracks_for
+from ._tracks import PIVOT_KAPPA, tracks_for
 from ._types import ArrayLike, FloatArray, IntArray
 
 __all__ = [
@@ -606,8 +606,10 @@ class ContactFilter:
         if s is None or s["version"] != self._version:
             s = self._solve(factor)
             s["version"] = self._version
-            # only the slope prior itself prunes: the envelope's others judge what it keeps
-            s["ll"] = self._log_likelihood(s, prune=factor == 1.0)
+            # the slope prior prunes alone only without an envelope; with one, a start far below the
+            # best under one prior may carry the mass under another: :meth:`belief` prunes what is
+            # hopeless under all of them
+            s["ll"] = self._log_likelihood(s, prune=factor == 1.0 and not self.slope_envelope)
             self._cached[factor] = s
         return s
 
@@ -658,6 +660,21 @@ class ContactFilter:
                 self._live[drop] = False
                 self._live_idx = np.flatnonzero(self._live)
         return ll
+
+    def _prune_under_every_prior(self) -> None:
+        """Drop the live starts more than ``prune`` nats below the best under the slope prior and under
+        every factor of the envelope (each judged against its own best)."""
+        if not self.prune > 0:
+            return
+        live = self._live_idx
+        hopeless = np.ones(live.size, dtype=bool)
+        for factor in (1.0, *self.slope_envelope):
+            s = self._solved(factor)
+            ll = s["ll"][live]
+            hopeless &= ll < ll.max() - self.prune
+        if hopeless.any():
+            self._live[live[hopeless]] = False
+            self._live_idx = np.flatnonzero(self._live)
 
     def noise_scale(self) -> float:
         """The factor λ on the noise settings that the readings say at the most probable start: the
@@ -710,6 +727,9 @@ class ContactFilter:
         d_var = t2 / (1 + t2 * s["qpp"])
         a_v = a @ s["gi_v"]
         mean[live] = a @ s["gi_wz"] - (1 + d_mean) * a_v
+        # pivoting on a corner the real contact is the corner: machining moves it along the normal
+        # only, so it keeps its arc, whatever the slope term says of the stretch before it
+        mean[live[self.tracks.kappa[self.node[live]] >= PIVOT_KAPPA]] = 0.0
         var0 = self.sd_position**2 * float(a @ np.linalg.solve(s["g"], a))
         # the evidence is tempered (TEMPER): so is what it says of the slope term, whose spread
         # grows by 1/TEMPER in variance as the start's does
@@ -752,6 +772,8 @@ class ContactFilter:
             w_f = self._posterior(factor)
             mean_f, sd_f = self._shift(factor)
             mass = min(mass, self._mass_near(w_f, part.wrap_arc(self.current + mean_f), sd_f, map_arc, radius))
+        if self.slope_envelope:
+            self._prune_under_every_prior()
         modes = self._modes(w, present, radius)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
         prior /= prior.sum()

@@ -13,7 +13,7 @@ from ._cache import per_part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
-__all__ = ["ModeTracks", "tracks_for", "PIVOT_SPREAD", "BRIDGE_EXCESS"]
+__all__ = ["ModeTracks", "tracks_for", "PIVOT_SPREAD", "PIVOT_KAPPA", "BRIDGE_EXCESS"]
 
 #: How far, mm of the rolling coordinate per radian of jump, a convex corner is spread in the filter's
 #: grid: at the grid's 0.02 mm, one start per 0.2° of jaw angle at the corner.

@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from localizer import part_from_points
-from localizer._tracks import BRIDGE_EXCESS, ModeTracks
+from localizer import BRIDGE_EXCESS, ModeTracks, part_from_points
 
 
 def hull_bridges(part, n=40_000):
