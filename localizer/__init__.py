@@ -20,6 +20,7 @@ from ._rolling import arc_from_jaw_positions
 from ._segment import DIRECTIONS, Segment
 from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
 from ._tracks import BRIDGE_EXCESS, PIVOT_KAPPA, ModeTracks, tracks_for
+from ._wheel import Finger, WheelJaw, WheelReach, parse_jaw, wheel_reach_for
 
 __all__ = [
     "Boundary",
@@ -56,6 +57,11 @@ __all__ = [
     "BRIDGE_MISS",
     "ENCODER_SD",
     "StraightJaw",
+    "WheelJaw",
+    "WheelReach",
+    "wheel_reach_for",
+    "parse_jaw",
+    "Finger",
     "DEFAULT_JAW",
     "Reach",
     "reach_for",

@@ -1,9 +1,9 @@
 """The figures of docs/wheel.md: a wheel finger rolling into a concave stretch, the boundary it reaches
 against the straight jaw's, and the Cramér–Rao bound of one roll as a function of its radius.
 
-``python -m bench.reports.wheel_figure --out docs/generated/wheel`` (a few seconds). The reach here
-is the definition of docs/wheel.md evaluated on a dense sample (0.05 mm): the disc tangent at a
-point, outside the part, must keep at least its radius from every other point of the boundary.
+``python -m bench.reports.wheel_figure --out docs/generated/wheel`` (a few seconds). Both fingers'
+reach with the library's default clearance (0.1 mm): `localizer.Reach` (touchable at some place on
+the jaw) and `localizer.WheelReach`.
 """
 
 from __future__ import annotations
@@ -14,9 +14,8 @@ import math
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from localizer import Reach, load_part
+from localizer import Reach, WheelJaw, WheelReach, load_part
 
 ROOT = Path(__file__).resolve().parents[2]
 PARTS = {
@@ -49,15 +48,6 @@ def sample(part):
     )
 
 
-def wheel_reach(points, theta, radius):
-    """Which sample points a disc of ``radius`` mm touches: tangent there, outside the part (the
-    part is counter-clockwise, its outward normal (sin θ, −cos θ)), no other point nearer than
-    ``radius`` to its centre (a tolerance of the sample's sagitta)."""
-    centre = points + radius * np.c_[np.sin(theta), -np.cos(theta)]
-    nearest, _ = cKDTree(points).query(centre)
-    return nearest >= radius - max(1e-3, SPACING**2 / (8 * radius))
-
-
 def roll_bound(kappa, i, j, radius, texture):
     """The Cramér–Rao bound (mm) of the start of a roll from sample i to sample j, one reading of L and
     of Ω at each end (docs/wheel.md): σ² = (σ_Ω² + κ(end)² σ_L²) / (κ(end) − κ(start))²."""
@@ -85,7 +75,7 @@ def figures(out: Path) -> dict:
     ax = axes[0]
     ax.plot(pts[:, 0], pts[:, 1], "k", lw=1.5)
     r = 5.0
-    ok = wheel_reach(pts, th, r)
+    ok = WheelReach(kidney, WheelJaw(r), spacing=SPACING).touchable(s)
     concave = np.flatnonzero(ok & (ka < -1e-3))
     centre = pts + r * np.c_[np.sin(th), -np.cos(th)]
     ax.plot(*centre[ok].T, ".", color="tab:blue", ms=0.6, label=f"axle path, wheel r = {r:g} mm")
@@ -102,7 +92,7 @@ def figures(out: Path) -> dict:
     for name, path in PARTS.items():
         part = load_part(path)
         s, pts, th, ka = sample(part)
-        frac = [float(wheel_reach(pts, th, rr).mean()) for rr in RADII]
+        frac = [float(WheelReach(part, WheelJaw(rr), spacing=SPACING).touchable(s).mean()) for rr in RADII]
         jaw = float(np.mean(Reach(part).touchable(s)))
         numbers["reach"][name] = {"wheel": dict(zip(map(str, RADII), frac)), "straight:100": jaw}
         line = ax.plot(RADII, frac, "o-", label=name)[0]
@@ -121,7 +111,7 @@ def figures(out: Path) -> dict:
     for texture, style in ((0.0, "o-"), (0.5e-3, "s--")):
         med = []
         for rr in RADII:
-            ok = wheel_reach(pts, th, rr)
+            ok = WheelReach(kidney, WheelJaw(rr), spacing=SPACING).touchable(s)
             starts = [i for i in np.flatnonzero(ok & (ka < 0)) if ok[(i + step) % ka.size] and ok[i : i + step].all()]
             b = [roll_bound(ka, i, (i + step) % ka.size, rr, texture) for i in starts]
             med.append(float(np.median(b)) if b else float("nan"))
