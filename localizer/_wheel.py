@@ -65,14 +65,13 @@ def parse_jaw(spec: str) -> Finger:
     'wheel:2.5'
     """
     kind, sep, size = str(spec).strip().lower().partition(":")
-    makers = {"straight": StraightJaw, "wheel": WheelJaw}
-    if not sep or kind not in makers:
+    if not sep or kind not in ("straight", "wheel"):
         raise QueryError(f"jaw {spec!r}: give straight:LENGTH or wheel:RADIUS in mm, e.g. straight:100 or wheel:5")
     try:
         value = float(size)
     except ValueError:
         raise QueryError(f"jaw {spec!r}: {size!r} is not a number of mm (e.g. {kind}:5)") from None
-    return makers[kind](value)
+    return StraightJaw(value) if kind == "straight" else WheelJaw(value)
 
 
 class WheelReach:
