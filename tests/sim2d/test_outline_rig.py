@@ -93,19 +93,25 @@ STARTS = [
 ]
 
 
+def roll_from(bracket, calibration, start, engine="kinematic"):
+    """Noise-free reactive rolling from a STARTS entry: (the run, its error against the truth, mm)."""
+    arc, fraction, jaw = start
+    corner = [c for c in bracket.corners if abs(c.arc - arc) < 1e-9]
+    tilt = -fraction * corner[0].angle if corner else 0.0
+    rig = SimRig(bracket, noise="none", seed=1, engine=engine)
+    res = localize_reactively(
+        rig,
+        bracket,
+        calibration=calibration,
+        approach_pose=rig.approach_pose(arc, jaw_position=jaw, standoff=1.0, tilt=tilt),
+    )
+    return res, abs(float(bracket.arc_offset(res.estimate_arc, rig.truth()["contact_arc"])))
+
+
 def test_noise_free_reactive_localization_from_fillets_faces_and_corners(bracket, calibration):
     sure = 0
     for arc, fraction, jaw in STARTS:
-        corner = [c for c in bracket.corners if abs(c.arc - arc) < 1e-9]
-        tilt = -fraction * corner[0].angle if corner else 0.0
-        rig = SimRig(bracket, noise="none", seed=1)
-        res = localize_reactively(
-            rig,
-            bracket,
-            calibration=calibration,
-            approach_pose=rig.approach_pose(arc, jaw_position=jaw, standoff=1.0, tilt=tilt),
-        )
-        error = abs(float(bracket.arc_offset(res.estimate_arc, rig.truth()["contact_arc"])))
+        res, error = roll_from(bracket, calibration, (arc, fraction, jaw))
         if res.stopped == "confident":
             sure += 1
             assert error < 0.3, (arc, fraction, res.belief.mass, error)
@@ -116,18 +122,9 @@ def test_noise_free_reactive_localization_from_fillets_faces_and_corners(bracket
 
 def test_noise_free_reactive_localization_in_the_pymunk_world(bracket, calibration):
     # a corner, a face and a fillet: the dynamic jaw's readings localize as the static one's do
-    for arc, fraction, jaw in (STARTS[5], STARTS[4], STARTS[1]):
-        corner = [c for c in bracket.corners if abs(c.arc - arc) < 1e-9]
-        tilt = -fraction * corner[0].angle if corner else 0.0
-        rig = SimRig(bracket, noise="none", seed=1, engine="pymunk")
-        res = localize_reactively(
-            rig,
-            bracket,
-            calibration=calibration,
-            approach_pose=rig.approach_pose(arc, jaw_position=jaw, standoff=1.0, tilt=tilt),
-        )
-        error = abs(float(bracket.arc_offset(res.estimate_arc, rig.truth()["contact_arc"])))
-        assert res.stopped == "confident" and error < 0.3, (arc, res.stopped, res.belief.mass, error)
+    for start in (STARTS[5], STARTS[4], STARTS[1]):
+        res, error = roll_from(bracket, calibration, start, engine="pymunk")
+        assert res.stopped == "confident" and error < 0.3, (start, res.stopped, res.belief.mass, error)
 
 
 def test_calibration_on_a_drawing_is_not_where_the_jaw_lies_flush_on_a_face():
