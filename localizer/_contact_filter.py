@@ -103,9 +103,10 @@ alone 0/0/0/11, with {¼} 0/0/0/5, with {¼, 2} 0/0/0/1, with {¼, 4} 0/0/0/0 bu
 100 trials at ×2.8.
 
 The belief over the *present* contact is the push-forward of the posterior over
-σ₀. :meth:`ContactFilter.belief` reports its maximum, the probability within the
-success radius of it, the separate modes, and whether the data said anything at
-all (on a circle every start predicts the same readings).
+σ₀ (with the slope term's offset at the last reading, except on a pivot: there the real contact
+is the corner, which machining moves along its normal only). :meth:`ContactFilter.belief`
+reports its maximum, the probability within the success radius of it, the separate modes, and
+whether the data said anything at all (on a circle every start predicts the same readings).
 """
 
 from __future__ import annotations
@@ -201,7 +202,10 @@ class ContactFilter:
     confidence : float
         Probability the leading mode needs for the belief not to be ``ambiguous``.
     prune : float
-        Hypotheses this many nats below the best are no longer evaluated.
+        Hypotheses this many nats below the best are no longer evaluated (with a slope envelope:
+        below the best under every prior of it, judged at each :meth:`belief`; pruned under the
+        slope prior alone, a start that carries the mass under another prior was gone when that
+        prior was asked).
     refresh : int
         Readings between choices of the reference hypothesis whose radius of
         curvature scales the slope-error term (each choice evaluates the likelihood).
