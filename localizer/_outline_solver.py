@@ -9,9 +9,13 @@ each, so g' = κ(σ + L) − κ(σ) there:
 * on lines and arcs κ is constant on a piece: g is linear between breakpoints, and its root is
   exact; g ≡ 0 on a whole interval (two arcs of equal radius, two lines) is a **continuum** of
   feasible starts (``kind="continuum"``, ``span``);
-* where an end is on a Bézier, g is sampled every ``spacing`` mm and each sign change refined
-  (Brent, to 1e-12 mm); a root pair closer than ``spacing`` can be missed there (not certified,
-  unlike the spline solver).
+* where an end is on a Bézier, the spline solver's certificate (:mod:`localizer._certify`) runs on
+  cells of ``spacing`` mm: g and g' are exact at the cells' ends, and |g''| = |κ'(σ + L) − κ'(σ)| is
+  bounded per cell from each Bézier's κ tabulated every ``spacing``/2 mm (the largest slope of the
+  cell and its neighbours, times :data:`SLOPE_CUSHION`; lines and arcs add nothing). A cell is then
+  certified to hold one root (refined by Brent to 1e-12 mm), none, a near-double root or a flat
+  stretch, or it is bisected. The bound is measured on that dense sample, as the spline table's
+  interpolation error is, not proved.
 
 **Corners.** A jaw laid on a convex corner touches it at every angle within the corner's jump, so
 a start (or an end) exactly at a corner fits every rotation in a range: with θ⁻, θ⁺ the angles
@@ -29,12 +33,20 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from ._cache import per_part
+from ._certify import certify_cells
 from ._errors import QueryError
 from ._outline import Outline
 from ._pieces import CubicBezier
 from ._segment import DIRECTIONS, Segment
 
-__all__ = ["outline_segments"]
+__all__ = ["outline_segments", "SLOPE_CUSHION"]
+
+#: How much the largest sampled slope of κ near a cell is widened to bound |dκ/dσ| on it: on a
+#: smooth piece the slope between samples h apart differs from the cell's largest by O(h·κ'').
+SLOPE_CUSHION = 1.25
+#: The certificate's settings on Bézier cells (the spline solver's defaults, localizer.EXACT).
+_FLAT_TOL, _DOUBLE_WIDTH, _MAX_CELLS = 1e-10, 1e-7, 2_000_000
 
 
 def _theta(outline: Outline, sigma: float, side: str) -> float:
@@ -147,14 +159,7 @@ def _solve_ccw(outline: Outline, L: float, omega: float, spacing: float) -> list
                 s = lo - ga / slope if slope != 0 else lo
                 out.append((float(s), "simple", 0.0, abs(g(min(max(s, lo), hi)))))
             continue
-        n = max(2, int(math.ceil((hi - lo) / spacing)))
-        xs = np.linspace(lo, hi, n + 1)
-        gs = outline.tangent_angle_at_arc(xs + L) - outline.tangent_angle_at_arc(xs) - omega
-        for i in np.flatnonzero(np.sign(gs[:-1]) * np.sign(gs[1:]) < 0):
-            s = brentq(g, float(xs[i]), float(xs[i + 1]), xtol=1e-12)
-            out.append((float(s), "simple", 0.0, abs(g(s))))
-        for i in np.flatnonzero(gs == 0.0):
-            out.append((float(xs[i]), "simple", 0.0, 0.0))
+        out.extend(_certified(outline, L, omega, lo, hi, spacing))
     # corners: a start at corner c, or an end at a corner, fits a range of rotations
     for b in breaks:
         c_start = corner_at.get(round(float(b), 9))
@@ -181,3 +186,85 @@ def _on_bezier(outline: Outline, lo: float, hi: float, L: float) -> bool:
     """Whether an end of the starts in (lo, hi) lies on a Bézier piece."""
     _, k, _ = outline._locate(np.array([0.5 * (lo + hi), 0.5 * (lo + hi) + L]))
     return any(isinstance(outline.pieces[int(i)], CubicBezier) for i in k)
+
+
+def _certified(
+    outline: Outline, L: float, omega: float, lo: float, hi: float, spacing: float
+) -> list[tuple[float, str, float, float]]:
+    """(start, kind, span, residual) of every root of g in (lo, hi), where an end lies on a Bézier."""
+    P = outline.perimeter
+
+    def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        g = outline.tangent_angle_at_arc(x + L) - outline.tangent_angle_at_arc(x) - omega
+        return g, outline.curvature_at_arc(x + L) - outline.curvature_at_arc(x)
+
+    n = max(2, int(math.ceil((hi - lo) / spacing)))
+    xs = np.linspace(lo, hi, n + 1)
+    gs, ds = evaluate(xs)
+    K = _slope_bound(outline, xs, spacing) + _slope_bound(outline, xs + L, spacing)
+    zeros, brackets, doubles, flats = certify_cells(
+        (xs[:-1], xs[1:], gs[:-1], gs[1:], ds[:-1], ds[1:], K),
+        evaluate,
+        P,
+        margin=1e-9,  # θ from the Béziers' arc-length inversion, 1e-9 mm
+        dmargin=1e-9,
+        flat_tol=_FLAT_TOL,
+        double_width=_DOUBLE_WIDTH,
+        max_cells=_MAX_CELLS,
+        degenerate=f"the query length={L!r} mm, turn={omega!r} rad is degenerate on outline {outline.name!r}",
+    )
+
+    def g(x: float) -> float:
+        return float(evaluate(np.array([x]))[0][0])
+
+    out: list[tuple[float, str, float, float]] = [(float(x), "simple", 0.0, 0.0) for x in zeros]
+    if brackets is not None:
+        for a, b, ga, gb, near_double in zip(brackets[0], brackets[1], brackets[2], brackets[3], brackets[6]):
+            x = float(brentq(g, float(a), float(b), xtol=1e-12)) if ga * gb < 0 else float(a if ga == 0 else b)
+            out.append((x, "double" if near_double else "simple", 0.0, abs(g(x))))
+    out += [(float(x), "double", 0.0, abs(g(float(x)))) for x in doubles]
+    # a root on a cell's end is found from both cells, and a near-double one from many at the bottom
+    # width: one per place, a simple root before a double one
+    merged: list[tuple[float, str, float, float]] = []
+    for root in sorted(out, key=lambda r: (r[0], r[1] != "simple")):
+        if merged and root[0] - merged[-1][0] <= 10 * _DOUBLE_WIDTH:
+            continue
+        merged.append(root)
+    flat = [(float(a), "continuum", float(span), 0.0) for a, span in flats]
+    inside = [r for r in merged if not any(a - 1e-9 <= r[0] <= a + span + 1e-9 for a, _, span, _ in flat)]
+    return inside + flat
+
+
+def _slope_bound(outline: Outline, x: np.ndarray, spacing: float) -> np.ndarray:
+    """A bound of |dκ/dσ| (1/mm²) on each cell [x_i, x_i+1] (mm, all on one piece): 0 on lines and arcs."""
+    _, k, local = outline._locate(x)
+    piece = int(k[len(k) // 2])
+    if not isinstance(outline.pieces[piece], CubicBezier):
+        return np.zeros(x.size - 1)
+    h, bound = _bezier_slopes(outline, spacing)[piece]
+    # the piece's arc of each cell end, kept on the piece (an interval's ends are inside it)
+    first = np.clip(np.floor(np.minimum(local[:-1], local[1:]) / h).astype(np.int64), 0, bound.size - 1)
+    last = np.clip(np.floor(np.maximum(local[:-1], local[1:]) / h).astype(np.int64), 0, bound.size - 1)
+    out = bound[first]
+    for j in range(1, 4):  # a cell of ``spacing`` spans at most three of the table's cells of spacing/2
+        out = np.maximum(out, bound[np.minimum(first + j, last)])
+    return np.asarray(out)
+
+
+def _bezier_slopes(outline: Outline, spacing: float) -> dict[int, tuple[float, np.ndarray]]:
+    """Per Bézier piece: (table step h, mm; bound of |dκ/dσ| on each table cell, 1/mm²), built once."""
+
+    def build() -> dict[int, tuple[float, np.ndarray]]:
+        out = {}
+        for i, piece in enumerate(outline.pieces):
+            if not isinstance(piece, CubicBezier):
+                continue
+            m = max(8, int(math.ceil(piece.length / (0.5 * spacing))))
+            h = piece.length / m
+            kappa = np.asarray(piece.curvature(np.linspace(0.0, piece.length, m + 1)))
+            slope = np.abs(np.diff(kappa)) / h
+            near = np.maximum(slope, np.maximum(np.r_[slope[:1], slope[:-1]], np.r_[slope[1:], slope[-1:]]))
+            out[i] = (h, SLOPE_CUSHION * near + 1e-12)
+        return out
+
+    return per_part("bezier_slopes", outline, float(spacing), build)

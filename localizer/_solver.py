@@ -8,21 +8,13 @@ total curvature Ω:
 with θ the unwrapped tangent angle as a function of arc position (exact, no
 integration) and κ the signed curvature.
 
-Completeness comes from a certificate on every cell of a grid in σ. The
-part's table bounds |dκ/dσ| on each of its cells, so ``K = K(base cell) +
-K(end cell)`` bounds |g''| on a cell, and with g and g' known exactly at the
-cell's ends:
-
-* ``g'(a) + g'(b) > K w`` (or ``< -K w``) certifies g strictly monotone on the
-  cell: exactly one root if g changes sign there, none otherwise;
-* otherwise the quadratic envelopes ``g(a) + g'(a) s - K s²/2`` and
-  ``g(b) - g'(b) s - K s²/2`` certify that a cell whose ends have the same sign
-  holds no root when their zero crossings overlap;
-* a cell that passes neither is bisected. Near a double root (g touching
-  zero) the bisection stops at a width of ``double_width`` mm and reports the
-  point as a root of kind ``"double"``; a stretch where |g| stays below
-  ``flat_tol`` everywhere (a circular arc of radius L/Ω) is reported as one
-  ``"continuum"`` segment with its extent, so no root is ever skipped.
+Completeness comes from a certificate on every cell of a grid in σ
+(:func:`localizer._certify.certify_cells`, which the outline solver shares). The part's table
+bounds |dκ/dσ| on each of its cells, so ``K = K(base cell) + K(end cell)`` bounds |g''| on a cell,
+and with g and g' known exactly at the cell's ends a cell is certified to hold one root, none, a
+near-double root (at a width of ``double_width`` mm) or a flat stretch (|g| below ``flat_tol``
+everywhere: a circular arc of radius L/Ω, one ``"continuum"`` segment with its extent), or it is
+bisected; no root is ever skipped.
 
 Bracketed roots are refined together by a safeguarded Newton iteration to
 ``tol`` mm.
@@ -36,6 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ._certify import certify_cells
 from ._errors import QueryError
 from ._march import PAPER_MARCH, MarchOptions, march
 from ._outline import Outline
@@ -165,7 +158,6 @@ def _solve_ccw(
     Returns (simple_roots, double_roots, continua): arrays of start arc
     positions, and a list of (start, span) pairs.
     """
-    flat_tol, double_width, max_cells = options.flat_tol, options.double_width, options.max_cells
     table = arc_table(part)
     P = part.perimeter
     nodes = table.sig[:-1]
@@ -198,67 +190,17 @@ def _solve_ccw(
     slope = table.kappa_slope
     K = slope[cell_s] + slope[cell_e]
 
-    brackets = []  # (lo, hi, glo, ghi, g'lo, g'hi, near_double)
-    exact_zero = [a[ga == 0.0]]
-    doubles = []
-    flats = []
-    processed = 0
-    while a.size:
-        processed += a.size
-        if processed > max_cells:
-            raise QueryError(
-                f"the query length={length!r} mm, turn={turn!r} rad is degenerate on part "
-                f"{part.name!r}: g stays near zero on too many cells ({processed}); the part is "
-                "nearly a circular arc there. Raise flat_tol or max_cells"
-            )
-        w = b - a
-        s = da + db
-        mono = (s > K * w + dmargin) | (s < -(K * w + dmargin))
-        change = ga * gb < 0.0
-        take = mono & change
-        if take.any():
-            brackets.append((a[take], b[take], ga[take], gb[take], da[take], db[take], np.zeros(int(take.sum()), bool)))
-        rest = ~mono
-        # same-sign cells: no root if the quadratic envelopes' zero crossings overlap
-        sg = np.where(ga != 0.0, np.sign(ga), np.sign(gb))
-        Ga, Gb, Da, Db = sg * ga - margin, sg * gb - margin, sg * da, sg * db
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ra = (Da + np.sqrt(np.maximum(Da * Da + 2 * K * Ga, 0.0))) / K
-            rb = (-Db + np.sqrt(np.maximum(Db * Db + 2 * K * Gb, 0.0))) / K
-        excluded = (~change) & (Ga > 0) & (Gb > 0) & (ra + rb > w)
-        M = 0.5 * (np.abs(s) + K * w)
-        flat = np.maximum(np.abs(ga), np.abs(gb)) + 0.5 * M * w + margin <= flat_tol
-        rest &= ~excluded
-        fl = rest & flat
-        if fl.any():
-            flats.append(np.c_[a[fl], b[fl]])
-        rest &= ~flat
-        bottom = rest & (w <= double_width)
-        if bottom.any():
-            bc = bottom & change
-            if bc.any():
-                brackets.append((a[bc], b[bc], ga[bc], gb[bc], da[bc], db[bc], np.ones(int(bc.sum()), bool)))
-            bn = bottom & ~change
-            if bn.any():
-                pick = np.abs(ga[bn]) <= np.abs(gb[bn])
-                doubles.append(np.where(pick, a[bn], b[bn]))
-        split = rest & ~bottom
-        if not split.any():
-            break
-        a, b, ga, gb, da, db, K = (x[split] for x in (a, b, ga, gb, da, db, K))
-        m = 0.5 * (a + b)
-        gm, dm = _g_table(table, m, length, turn)
-        a = np.concatenate([a, m])
-        b = np.concatenate([m, b])
-        ga, gb = np.concatenate([ga, gm]), np.concatenate([gm, gb])
-        da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
-        K = np.concatenate([K, K])
-
-    zeros = np.concatenate(exact_zero)
-    joined = tuple(np.concatenate([x[i] for x in brackets]) for i in range(7)) if brackets else None
-    double_roots = np.concatenate(doubles) if doubles else np.empty(0)
-    continua = _merge_flats(np.concatenate(flats) if flats else np.empty((0, 2)), P)
-    return zeros, joined, double_roots, continua
+    return certify_cells(
+        (a, b, ga, gb, da, db, K),
+        lambda m: _g_table(table, m, length, turn),
+        P,
+        margin=margin,
+        dmargin=dmargin,
+        flat_tol=options.flat_tol,
+        double_width=options.double_width,
+        max_cells=options.max_cells,
+        degenerate=f"the query length={length!r} mm, turn={turn!r} rad is degenerate on part {part.name!r}",
+    )
 
 
 def _hermite_root(g0: np.ndarray, g1: np.ndarray, d0: np.ndarray, d1: np.ndarray, iterations: int = 2) -> np.ndarray:
@@ -347,23 +289,6 @@ def _refine(
         x[idx] = np.where(g == 0.0, xi, xn)
         active[idx[done]] = False
     return x
-
-
-def _merge_flats(cells: np.ndarray, P: float) -> list[tuple[float, float]]:
-    """Overlapping flat cells (start, end) merged, across σ = 0 too: (start, span) pairs, mm."""
-    if len(cells) == 0:
-        return []
-    cells = cells[np.argsort(cells[:, 0])]
-    out = [list(cells[0])]
-    for a, b in cells[1:]:
-        if a <= out[-1][1] + 1e-9:
-            out[-1][1] = max(out[-1][1], b)
-        else:
-            out.append([a, b])
-    if len(out) > 1 and out[0][0] <= 1e-9 and out[-1][1] >= P - 1e-9:  # joins across σ = 0
-        first = out.pop(0)
-        out[-1][1] = P + first[1]
-    return [(a, b - a) for a, b in out]
 
 
 def _distinct(x: np.ndarray, P: float, sep: float) -> np.ndarray:

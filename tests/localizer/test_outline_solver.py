@@ -103,3 +103,30 @@ def test_feasible_segments_solves_an_outline_with_the_outline_solver():
     assert found > 0
     with pytest.raises(QueryError, match="marching reference is for splines"):
         feasible_segments(bracket, 12.0, 0.3, method="march")
+
+
+def test_two_roots_closer_than_the_sampling_step_are_both_found_on_bezier_pieces():
+    # cam-05 of the held-out CAD family: for L = 5 mm, h(σ) = θ(σ + L) − θ(σ) has a maximum near
+    # σ = 75.74 with both ends on Béziers. Just below it, two starts 0.002 mm apart fit: sampling
+    # every 0.01 mm and refining sign changes missed both; the certified cells find both, against
+    # a reference of sign changes on a 1e-5 mm grid refined by Brent
+    from scipy.optimize import brentq, minimize_scalar
+
+    cam = load_outline(Path(__file__).resolve().parents[2] / "bench" / "parts" / "cad-heldout" / "cam-05.svg")
+    L = 5.0
+
+    def h(x):
+        return cam.tangent_angle_at_arc(np.asarray(x) + L) - cam.tangent_angle_at_arc(x)
+
+    top = minimize_scalar(lambda x: -float(h(x)), bounds=(75.6, 75.9), method="bounded", options={"xatol": 1e-10})
+    for sep in (0.002, 0.0005):
+        omega = float(h(top.x)) - 0.11076 * (sep / 2) ** 2 / 2
+        grid = np.arange(top.x - 0.01, top.x + 0.01, 1e-5)
+        gs = h(grid) - omega
+        ref = [
+            brentq(lambda x: float(h(x)) - omega, grid[i], grid[i + 1], xtol=1e-13)
+            for i in np.flatnonzero(np.sign(gs[:-1]) * np.sign(gs[1:]) < 0)
+        ]
+        assert len(ref) == 2 and abs(ref[1] - ref[0] - sep) < 0.1 * sep
+        found = sorted(s.start_arc for s in outline_segments(cam, L, omega) if abs(s.start_arc - top.x) < 0.05)
+        assert len(found) == 2 and np.allclose(found, ref, atol=1e-8), (sep, found, ref)
