@@ -23,7 +23,7 @@ import numpy as np
 from ._boundary import ArcPositions
 from ._errors import PartError
 from ._part import _segments_cross
-from ._pieces import Piece
+from ._pieces import CubicBezier, Piece
 from ._types import ArrayLike, FloatArray
 
 __all__ = ["Outline", "Corner", "outline_from_pieces"]
@@ -141,6 +141,21 @@ class Outline(ArcPositions):
             out = out - (at * angles).sum(axis=-1)
         result: FloatArray = out
         return result
+
+    def angle_and_curvature_at_arc(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(:meth:`tangent_angle_at_arc`, :meth:`curvature_at_arc`) at ``sigma`` (mm), the angle after a
+        corner's jump; a Bézier's arc length inverted once for both."""
+        lap, k, local = self._locate(sigma)
+        theta, kappa = np.empty(np.shape(local)), np.empty(np.shape(local))
+        for i in np.unique(k):
+            sel = k == i
+            piece = self.pieces[int(i)]
+            if isinstance(piece, CubicBezier):
+                th, kappa[sel] = piece.angle_and_curvature(local[sel])
+            else:
+                th, kappa[sel] = piece.tangent_angle(local[sel]), piece.curvature(local[sel])
+            theta[sel] = self._theta0[int(i)] + th - float(piece.tangent_angle(0.0))
+        return theta + 2.0 * np.pi * lap, kappa
 
     def curvature_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Signed curvature at arc positions ``sigma`` (mm), 1/mm (zero on lines, ±1/r on arcs)."""

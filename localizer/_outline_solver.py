@@ -195,8 +195,9 @@ def _certified(
     P = outline.perimeter
 
     def evaluate(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        g = outline.tangent_angle_at_arc(x + L) - outline.tangent_angle_at_arc(x) - omega
-        return g, outline.curvature_at_arc(x + L) - outline.curvature_at_arc(x)
+        th_s, k_s = outline.angle_and_curvature_at_arc(x)
+        th_e, k_e = outline.angle_and_curvature_at_arc(x + L)
+        return th_e - th_s - omega, k_e - k_s
 
     n = max(2, int(math.ceil((hi - lo) / spacing)))
     xs = np.linspace(lo, hi, n + 1)

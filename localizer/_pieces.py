@@ -305,10 +305,20 @@ class CubicBezier:
 
     def curvature(self, s: ArrayLike) -> FloatArray:
         """κ = (x'y'' − y'x'') / |α'|³ at arc lengths ``s``, 1/mm."""
-        u = self.param(s)
+        return self._curvature_at(self.param(s))
+
+    def _curvature_at(self, u: FloatArray) -> FloatArray:
         d1, d2 = self._d1(u), self._d2(u)
         out: FloatArray = (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]) / self._speed(u) ** 3
         return out
+
+    def angle_and_curvature(self, s: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(:meth:`tangent_angle`, :meth:`curvature`) at arc lengths ``s``, with one inversion of the
+        arc length (the costly part of either)."""
+        u = self.param(s)
+        ref = np.interp(u, np.linspace(0.0, 1.0, 65), self._theta)
+        theta: FloatArray = ref + _wrap(self._raw_angle(u) - ref)
+        return theta, self._curvature_at(u)
 
     @classmethod
     def from_quadratic(
