@@ -124,7 +124,7 @@ def test_two_roots_closer_than_the_sampling_step_are_both_found_on_bezier_pieces
         grid = np.arange(top.x - 0.01, top.x + 0.01, 1e-5)
         gs = h(grid) - omega
         ref = [
-            brentq(lambda x: float(h(x)) - omega, grid[i], grid[i + 1], xtol=1e-13)
+            brentq(lambda x, w=omega: float(h(x)) - w, grid[i], grid[i + 1], xtol=1e-13)
             for i in np.flatnonzero(np.sign(gs[:-1]) * np.sign(gs[1:]) < 0)
         ]
         assert len(ref) == 2 and abs(ref[1] - ref[0] - sep) < 0.1 * sep
