@@ -524,6 +524,7 @@ def run_trial(spec: TrialSpec) -> dict:
                     calibration=cal,
                     step=math.radians(s.step_deg),
                     approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0),
+                    faces=part.faces if isinstance(part, Outline) else (),
                 )
             except RigError:
                 continue

@@ -587,6 +587,7 @@ def roll(
     observer=None,
     index: int = 0,
     pressing: PressSettings = PRESS,
+    faces: tuple[tuple[float, float], ...] = (),
 ) -> RollResult:
     """Roll by ``angle`` rad (positive: counter-clockwise) in steps of about ``step`` (paper §III-C).
 
@@ -599,7 +600,9 @@ def roll(
     contact jumping along the jaw while the jaw does not turn. Such a roll
     measures the part's convex hull, not the part, so a step whose contact
     moves more than ``bridge_jump`` mm on the jaw stops the roll with
-    :class:`RigError` (None: no check).
+    :class:`RigError` (None: no check). On a part drawn with flat faces the jaw tipping over a face
+    jumps as well: ``faces``, the part's (tangent angle rad, length mm) pairs
+    (:attr:`localizer.Outline.faces`), tell it from a bridge (:func:`crossed_face`).
 
     ``observer``, if given, is called with a dict for the roll's start
     (``event="roll"``) and for every contact-location reading
@@ -676,14 +679,13 @@ def roll(
             raise
         phis.append(hand.measured_angle())
         observe(j + 1)
-        if bridge_jump is not None and abs(d[-1] - d[-2]) > bridge_jump:
+        jump = abs(d[-1] - d[-2])
+        if bridge_jump is not None and jump > bridge_jump and not crossed_face(faces, phis[-2], phis[-1], jump, j == 0):
             hand.press_by(-5.0)
             raise RigError(
                 f"step {j + 1} of the roll bridged a concave stretch: the contact jumped "
                 f"{abs(d[-1] - d[-2]):.1f} mm on the jaw (limit {bridge_jump} mm). A straight jaw "
-                "touches the convex hull there; start where the rolls stay on convex stretches. (On a "
-                "part drawn with flat faces a jaw tipping over a face jumps as well, which fixed rolls "
-                "cannot tell from a bridge: roll reactively, --reactive, whose belief tells them apart)"
+                "touches the convex hull there; start where the rolls stay on convex stretches"
             )
     sign = 1.0 if angle > 0 else -1.0
     du = np.diff(d)
@@ -736,6 +738,35 @@ class RollingRun:
         }
 
 
+#: A face is crossed in a step whose jaw angles reach within this of the face's angle, rad (the arm
+#: encoder's steps and the jaw's twist under load).
+FACE_ANGLE_TOL = math.radians(0.1)
+#: ... and whose jump matches the face's length within this, mm (the rolling on the fillets either side
+#: in that step, the reading's error).
+FACE_JUMP_TOL = 0.5
+
+
+def crossed_face(faces, phi_from: float, phi_to: float, jump: float, first: bool) -> bool:
+    """Whether a jump of ``jump`` mm along the jaw, in a step that turned it from ``phi_from`` to
+    ``phi_to`` (rad), is the jaw tipping over one of ``faces`` ((tangent angle rad, length mm) pairs).
+
+    The jaw lies flush on a face when its angle passes the face's: the contact then jumps the face's
+    length (from where the piece before it ends to where the one after begins), or, in a roll's first
+    step from a start laid flush on the face, at most that length. A bridge across a concavity jumps
+    at other angles or by other lengths (over a notch between two collinear faces, by both and the
+    notch).
+    """
+    span = phi_to - phi_from
+    for angle, length in faces:
+        off = (angle - phi_from + math.pi) % (2 * math.pi) - math.pi
+        lo, hi = min(0.0, span), max(0.0, span)
+        if not (lo - FACE_ANGLE_TOL <= off <= hi + FACE_ANGLE_TOL):
+            continue
+        if (jump <= length + FACE_JUMP_TOL) if first else (abs(jump - length) <= FACE_JUMP_TOL):
+            return True
+    return False
+
+
 def roll_sequence(
     rig: Rig,
     rolls,
@@ -747,11 +778,13 @@ def roll_sequence(
     bridge_jump: float = 3.0,
     observer=None,
     pressing: PressSettings = PRESS,
+    faces: tuple[tuple[float, float], ...] = (),
 ) -> tuple:
     """Establish contact and roll by each angle of ``rolls`` (rad), all the same way; no localization.
 
     Returns the tuple of :class:`RollResult`. A roll that bridges a concave stretch is
-    refused (:func:`roll`, ``bridge_jump``) with :class:`RigError` naming the roll.
+    refused (:func:`roll`, ``bridge_jump``) with :class:`RigError` naming the roll; one that tips
+    over one of ``faces`` is not.
     """
     rolls = [float(a) for a in rolls]
     if not rolls:
@@ -775,6 +808,7 @@ def roll_sequence(
                     observer=observer,
                     index=k,
                     pressing=pressing,
+                    faces=faces,
                 )
             )
         except RigError as exc:
@@ -814,7 +848,7 @@ def localize_by_rolling(
 
     All rolls turn the same way. Rolls that bridge a concave stretch are
     refused (:func:`roll`, ``bridge_jump``): the pipeline localizes on the part,
-    never on its convex hull.
+    never on its convex hull. On a drawing, rolls that tip over its faces are measured across them.
     """
     results = roll_sequence(
         rig,
@@ -826,6 +860,7 @@ def localize_by_rolling(
         bridge_jump=bridge_jump,
         observer=observer,
         pressing=pressing,
+        faces=part.faces if isinstance(part, Outline) else (),
     )
     estimates = tuple((r.length, r.turn) for r in results)
     for k, (length, turn) in enumerate(estimates):

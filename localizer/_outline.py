@@ -23,7 +23,7 @@ import numpy as np
 from ._boundary import ArcPositions
 from ._errors import PartError
 from ._part import _segments_cross
-from ._pieces import CubicBezier, Piece
+from ._pieces import CubicBezier, Line, Piece
 from ._types import ArrayLike, FloatArray
 
 __all__ = ["Outline", "Corner", "outline_from_pieces"]
@@ -141,6 +141,16 @@ class Outline(ArcPositions):
             out = out - (at * angles).sum(axis=-1)
         result: FloatArray = out
         return result
+
+    @property
+    def faces(self) -> tuple[tuple[float, float], ...]:
+        """The straight pieces, where a straight jaw lies flush: (tangent angle, rad in [−π, π);
+        length, mm) each, in order."""
+        return tuple(
+            (float(math.atan2(p.end[1] - p.start[1], p.end[0] - p.start[0])), float(p.length))
+            for p in self.pieces
+            if isinstance(p, Line)
+        )
 
     def angle_and_curvature_at_arc(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """(:meth:`tangent_angle_at_arc`, :meth:`curvature_at_arc`) at ``sigma`` (mm), the angle after a

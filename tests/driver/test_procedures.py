@@ -182,3 +182,40 @@ def test_a_simulated_rig_has_every_optional_capability():
 
     sim = SimRig(load_part(PARTS / "cam.json"), noise="none", seed=0)
     assert all(isinstance(sim, p) for p in (Rig, ForceServo, Clocked, GroundTruth, SampleLog))
+
+
+def test_fixed_rolls_on_a_drawing_cross_its_faces_and_refuse_its_notch():
+    # the bracket: a 10 mm fillet at 203.1 mm turns onto a 30 mm face at 270°, which ends at a
+    # convex corner; the top edge is two collinear faces at 180° with a 20 mm notch between them
+    from localizer import load_outline
+
+    bracket = load_outline(Path(__file__).resolve().parents[2] / "parts" / "bracket.dxf")
+    cal = calibration_for(bracket)
+    rig = SimRig(bracket, noise="none", seed=3)
+    # from the fillet, the second roll tips the jaw over the face and pivots on the corner
+    run = localize_by_rolling(
+        rig,
+        bracket,
+        [math.radians(20.0), math.radians(60.0)],
+        calibration=cal,
+        approach_pose=rig.approach_pose(210.0, jaw_position=-40.0, standoff=1.0),
+        sd_length=0.05,  # noise-free readings: the 8 mm fillets' rolls differ by 0.7 mm
+    )
+    truth = run.rolls[-1].truth[-1].contact_arc
+    assert run.rolls[1].largest_jump > 25.0  # the face was crossed in one step
+    # the rest of the fillet, the face, then the corner (no arc)
+    rest = 10.0 * (1.5 * math.pi - (math.pi + (210.0 - 203.13274) / 10.0 + math.radians(20.0)))
+    assert run.estimates[1][0] == pytest.approx(rest + 30.0, abs=0.5)
+    # the most probable place is right (a roll that might end flush on that face, from a start 29° back
+    # on the fillet, fits too: any L is a place on the face; the rule gives it a third)
+    assert abs(float(bracket.arc_offset(run.estimate_arc, truth))) < 0.3
+    # from the second fillet, tipping over the top edge jumps both faces and the notch: a bridge
+    rig = SimRig(bracket, noise="none", seed=3)
+    with pytest.raises(RigError, match="bridged a concave stretch"):
+        localize_by_rolling(
+            rig,
+            bracket,
+            [math.radians(60.0)],
+            calibration=cal,
+            approach_pose=rig.approach_pose(115.0, jaw_position=-40.0, standoff=1.0),
+        )
