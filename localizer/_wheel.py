@@ -174,7 +174,9 @@ class WheelReach:
 
 
 def wheel_reach_for(part: Boundary, wheel: WheelJaw, spacing: float = 0.05, clearance: float = 0.1) -> WheelReach:
-    """The ``part``'s :class:`WheelReach` for ``wheel``, built once per part and settings (shared, read-only)."""
+    """The ``part``'s :class:`WheelReach` for ``wheel``, built once per part and settings (shared, read-only).
+
+    ``spacing`` (mm) and ``clearance`` (mm) as for :class:`WheelReach`."""
     return per_part(
         "wheel_reach",
         part,
