@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from localizer import Reach, WheelJaw, WheelReach, load_part
+from localizer import Reach, WheelJaw, WheelReach, load_part, roll_bound
 
 ROOT = Path(__file__).resolve().parents[2]
 PARTS = {
@@ -48,15 +48,15 @@ def sample(part):
     )
 
 
-def roll_bound(kappa, i, j, radius, texture):
-    """The Cramér–Rao bound (mm) of the start of a roll from sample i to sample j, one reading of L and
-    of Ω at each end (docs/wheel.md): σ² = (σ_Ω² + κ(end)² σ_L²) / (κ(end) − κ(start))²."""
-    k0, k1 = kappa[i], kappa[j]
+def roll_sds(kappa_ends, radius, texture):
+    """The standard deviations (mm, rad) of one roll's L and Ω for a wheel of ``radius`` mm, one
+    reading at each end (docs/wheel.md): the axle encoder and the calibrated radius's error in L;
+    the arm encoder, the wrist's residual direction and the surface texture the disc follows (tilts
+    of variance a / (2 R*) at each end, R* = 1 / (1/r + κ) the contact's relative radius) in Ω."""
     var_l = 2 * (radius * AXLE_SD) ** 2 + (ROLL * RADIUS_REL) ** 2
-    # the texture the disc follows, at each end: tilts of variance a / (2 R*), with R* = 1 / (1/r + κ)
-    # the contact's relative radius (docs/wheel.md)
-    var_o = 2 * ARM_SD**2 + 2 * DIRECTION_SD**2 + sum(0.5 * texture * max(1.0 / radius + k, 0.0) for k in (k0, k1))
-    return math.sqrt(var_o + k1**2 * var_l) / max(abs(k1 - k0), 1e-12)
+    texture_var = sum(0.5 * texture * np.maximum(1.0 / radius + k, 0.0) for k in kappa_ends)
+    var_o = 2 * ARM_SD**2 + 2 * DIRECTION_SD**2 + texture_var
+    return math.sqrt(var_l), np.sqrt(var_o)
 
 
 def figures(out: Path) -> dict:
@@ -113,8 +113,13 @@ def figures(out: Path) -> dict:
         for rr in RADII:
             ok = WheelReach(kidney, WheelJaw(rr), spacing=SPACING).touchable(s)
             starts = [i for i in np.flatnonzero(ok & (ka < 0)) if ok[(i + step) % ka.size] and ok[i : i + step].all()]
-            b = [roll_bound(ka, i, (i + step) % ka.size, rr, texture) for i in starts]
-            med.append(float(np.median(b)) if b else float("nan"))
+            idx = np.asarray(starts, dtype=int)
+            if idx.size == 0:
+                med.append(float("nan"))
+                continue
+            sd_l, sd_o = roll_sds((ka[idx], ka[(idx + step) % ka.size]), rr, texture)
+            b = roll_bound(kidney, s[idx], ROLL, sd_length=sd_l, sd_turn=sd_o)
+            med.append(float(np.median(b)))
         numbers["bound_mm"][f"texture {texture * 1e3:g} um"] = dict(zip(map(str, RADII), med))
         ax.plot(RADII, med, style, label=f"surface texture amplitude {texture * 1e3:g} µm")
     ax.set_xscale("log")
