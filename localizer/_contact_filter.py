@@ -122,7 +122,7 @@ from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
 from ._reach import DEFAULT_JAW, StraightJaw
-from ._tracks import PIVOT_KAPPA, tracks_for
+from ._tracks import tracks_for
 from ._types import ArrayLike, FloatArray, IntArray
 
 __all__ = [
@@ -733,7 +733,7 @@ class ContactFilter:
         mean[live] = a @ s["gi_wz"] - (1 + d_mean) * a_v
         # pivoting on a corner the real contact is the corner: machining moves it along the normal
         # only, so it keeps its arc, whatever the slope term says of the stretch before it
-        mean[live[self.tracks.kappa[self.node[live]] >= PIVOT_KAPPA]] = 0.0
+        mean[live[self.tracks.pivot[self.node[live]]]] = 0.0
         var0 = self.sd_position**2 * float(a @ np.linalg.solve(s["g"], a))
         # the evidence is tempered (TEMPER): so is what it says of the slope term, whose spread
         # grows by 1/TEMPER in variance as the start's does

@@ -146,11 +146,7 @@ class Outline(ArcPositions):
     def faces(self) -> tuple[tuple[float, float], ...]:
         """The straight pieces, where a straight jaw lies flush: (tangent angle, rad in [−π, π);
         length, mm) each, in order."""
-        return tuple(
-            (float(math.atan2(p.end[1] - p.start[1], p.end[0] - p.start[0])), float(p.length))
-            for p in self.pieces
-            if isinstance(p, Line)
-        )
+        return tuple((float(p.tangent_angle(0.0)), float(p.length)) for p in self.pieces if isinstance(p, Line))
 
     def angle_and_curvature_at_arc(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """(:meth:`tangent_angle_at_arc`, :meth:`curvature_at_arc`) at ``sigma`` (mm), the angle after a

@@ -298,7 +298,9 @@ class CubicBezier:
 
     def tangent_angle(self, s: ArrayLike) -> FloatArray:
         """θ at arc lengths ``s``, unwrapped along the piece from θ at ``p0`` (in [-π, π)), rad."""
-        u = self.param(s)
+        return self._angle_at(self.param(s))
+
+    def _angle_at(self, u: FloatArray) -> FloatArray:
         ref = np.interp(u, np.linspace(0.0, 1.0, 65), self._theta)
         out: FloatArray = ref + _wrap(self._raw_angle(u) - ref)
         return out
@@ -316,9 +318,7 @@ class CubicBezier:
         """(:meth:`tangent_angle`, :meth:`curvature`) at arc lengths ``s``, with one inversion of the
         arc length (the costly part of either)."""
         u = self.param(s)
-        ref = np.interp(u, np.linspace(0.0, 1.0, 65), self._theta)
-        theta: FloatArray = ref + _wrap(self._raw_angle(u) - ref)
-        return theta, self._curvature_at(u)
+        return self._angle_at(u), self._curvature_at(u)
 
     @classmethod
     def from_quadratic(

@@ -43,7 +43,14 @@ from ._errors import QueryError
 from ._outline import Outline
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
-__all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc"]
+__all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "grid_neighbours"]
+
+
+def grid_neighbours(arc: ArrayLike, h: float, n: int) -> tuple[IntArray, IntArray]:
+    """Indices of the two points of a uniform grid of ``n`` points, ``h`` mm apart round the boundary,
+    on either side of arc position(s) ``arc`` (mm)."""
+    i = np.floor(np.asarray(arc, dtype=float) / h).astype(np.int64)
+    return np.mod(i, n), np.mod(i + 1, n)
 
 
 @dataclass(frozen=True)
@@ -195,13 +202,6 @@ class Reach:
         here = (block & (w == 0)).any(axis=1)
         return np.where(here, np.inf, half - w_plus), np.where(here, -np.inf, -half - w_minus)
 
-    def _bracket(self, arc: ArrayLike) -> tuple[IntArray, IntArray]:
-        """Indices of the two grid points on either side of arc position(s) ``arc`` (mm)."""
-        x = np.asarray(arc, dtype=float) / self.h
-        i = np.floor(x).astype(np.int64)
-        n = self.sigma.size
-        return np.mod(i, n), np.mod(i + 1, n)
-
     def interval(self, arc: ArrayLike, sure: bool = False) -> tuple[FloatArray, FloatArray]:
         """(lo, hi) jaw positions, mm, at which the jaw can touch at arc position(s) ``arc`` (mm).
 
@@ -213,7 +213,7 @@ class Reach:
         generous interval is the union of the two neighbouring grid points', and the sure one
         their intersection.
         """
-        i, j = self._bracket(arc)
+        i, j = grid_neighbours(arc, self.h, self.sigma.size)
         if sure:
             return np.maximum(self.lo_sure[i], self.lo_sure[j]), np.minimum(self.hi_sure[i], self.hi_sure[j])
         return np.minimum(self.lo[i], self.lo[j]), np.maximum(self.hi[i], self.hi[j])

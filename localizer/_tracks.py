@@ -63,6 +63,8 @@ class ModeTracks:
     convex : ndarray of bool
         Where a rolling can be: a convex stretch (θ not falling, κ ≥ 0: a flat face of an outline
         belongs to the stretch around it) the jaw touches.
+    pivot : ndarray of bool
+        The grid points on a convex corner (one per jaw angle within its jump).
     has_faces : bool
         Some start lies on a flat face, which the jaw crosses in one step (a spline has none).
     bridges : int
@@ -110,15 +112,16 @@ class ModeTracks:
             theta = np.where(within, theta - (1.0 - frac) * jump, theta)
             kappa = np.where(within, PIVOT_KAPPA, kappa)
         else:
+            within = np.zeros(n, dtype=bool)
             sigma = u
             theta = np.asarray(part.tangent_angle_at_arc(sigma), dtype=float)
             kappa = np.asarray(part.curvature_at_arc(sigma), dtype=float)
         sigma = np.asarray(sigma, dtype=float)
         self.sigma, self.theta, self.kappa = sigma, theta, kappa
+        self.pivot: BoolArray = within
         # a shallow concavity the jaw bridges: its stretch rolls at the bridging chord's angle, which
         # the table holds like a flat face's (the contact jumps across at that angle)
-        rolled, skipped = _bridge_shallow_dips(part, sigma, theta, jaw.length)
-        self.bridges = int(np.count_nonzero(np.diff(np.concatenate([[False], skipped, [False]]).astype(np.int8)) == 1))
+        rolled, skipped, self.bridges = _bridge_shallow_dips(part, sigma, theta, jaw.length)
         # three laps so that any rotation of less than a lap stays on the table
         turn = 2.0 * math.pi
         arcs = np.concatenate([sigma - p, sigma, sigma + p, [2 * p]])
@@ -180,6 +183,7 @@ class ModeTracks:
             self.sigma,
             self.theta,
             self.kappa,
+            self.pivot,
             self.lo,
             self.hi,
             self.lo_sure,
@@ -354,7 +358,7 @@ class ModeTracks:
 
 def _bridge_shallow_dips(
     part: Boundary, sigma: FloatArray, theta: FloatArray, jaw_length: float
-) -> tuple[FloatArray, BoolArray]:
+) -> tuple[FloatArray, BoolArray, int]:
     """The tangent angle the rolling follows at each grid point, with every shallow concavity
     bridged, and the grid points within a bridge.
 
@@ -380,6 +384,8 @@ def _bridge_shallow_dips(
         ``theta`` with each bridged stretch [a, b] at φ.
     skipped : ndarray of bool, shape (n,)
         Grid points strictly between a and b: no rolling starts there.
+    bridged : int
+        How many concavities were bridged.
     """
     n = sigma.size
     p = part.perimeter
@@ -391,20 +397,16 @@ def _bridge_shallow_dips(
     t3 = np.concatenate([theta - turn, theta, theta + turn])
     falling = np.diff(t3) < 0  # cell i: from node i to node i + 1
     if not falling[n : 2 * n].any():
-        return rolled, skipped
-    edges = np.flatnonzero(np.diff(falling.astype(np.int8)))
-    starts = edges[np.diff(falling.astype(np.int8))[edges] == 1] + 1  # first falling cell of a run
-    for c0 in starts[(starts >= n) & (starts < 2 * n)]:
-        c1 = c0
-        while c1 + 1 < falling.size and falling[c1 + 1]:
-            c1 += 1
-        i1, i2 = int(c0), int(c1) + 1  # the concavity runs from node i1 (θ highest) to i2 (lowest)
-        a0 = i1
-        while a0 > 0 and not falling[a0 - 1]:
-            a0 -= 1
-        b1 = i2
-        while b1 < falling.size and not falling[b1]:
-            b1 += 1
+        return rolled, skipped, 0
+    # runs of falling cells: run r covers cells first[r] .. past[r] - 1, so the concavity runs from node
+    # first[r] (θ highest) to node past[r] (lowest), between the rising runs that end and begin there
+    edge = np.diff(np.concatenate([[0], falling.astype(np.int8), [0]]))
+    first, past = np.flatnonzero(edge == 1), np.flatnonzero(edge == -1)
+    bridged = 0
+    for r in np.flatnonzero((first >= n) & (first < 2 * n)):
+        i1, i2 = int(first[r]), int(past[r])
+        a0 = int(past[r - 1]) if r > 0 else 0
+        b1 = int(first[r + 1]) if r + 1 < first.size else falling.size
         lo, hi = max(t3[i2], t3[a0]), min(t3[i1], t3[b1])
         if not (hi > lo) or i1 - a0 < 2 or b1 - i2 < 2:
             continue
@@ -423,7 +425,8 @@ def _bridge_shallow_dips(
         rolled[on % n] = phi - (on // n - 1) * turn
         inner = np.flatnonzero((s3 > sa) & (s3 < sb))
         skipped[inner % n] = True
-    return rolled, skipped
+        bridged += 1
+    return rolled, skipped, bridged
 
 
 def _bitangent(

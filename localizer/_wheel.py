@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 from ._boundary import Boundary
 from ._cache import per_part
 from ._errors import QueryError
-from ._reach import StraightJaw
+from ._reach import StraightJaw, grid_neighbours
 from ._types import ArrayLike, BoolArray, FloatArray
 
 __all__ = ["WheelJaw", "WheelReach", "wheel_reach_for", "parse_jaw", "Finger"]
@@ -141,21 +141,15 @@ class WheelReach:
             out[i] = off.size > 0 and off[0] <= 0 <= off[-1] and bool(np.all(np.diff(off) == 1))
         return out
 
-    def _bracket(self, arc: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        x = np.asarray(arc, dtype=float) / self.h
-        i = np.floor(x).astype(np.int64)
-        n = self.sigma.size
-        return np.mod(i, n), np.mod(i + 1, n)
-
     def touchable(self, arc: ArrayLike) -> BoolArray:
         """Whether the wheel can touch at arc position(s) ``arc`` (mm): either neighbouring grid point."""
-        i, j = self._bracket(arc)
+        i, j = grid_neighbours(arc, self.h, self.sigma.size)
         out: BoolArray = self.reached[i] | self.reached[j]
         return out
 
     def clear(self, arc: ArrayLike) -> BoolArray:
         """Whether the wheel surely touches at ``arc`` (mm) and nowhere else: both neighbouring grid points."""
-        i, j = self._bracket(arc)
+        i, j = grid_neighbours(arc, self.h, self.sigma.size)
         out: BoolArray = self.sure[i] & self.sure[j]
         return out
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from localizer import Reach, WheelJaw, WheelReach, load_part, roll_bound
+from localizer import Reach, WheelJaw, load_part, roll_bound, wheel_reach_for
 
 ROOT = Path(__file__).resolve().parents[2]
 PARTS = {
@@ -70,12 +70,14 @@ def figures(out: Path) -> dict:
     numbers: dict = {"radii_mm": list(RADII), "reach": {}, "bound_mm": {}}
 
     # 1. a wheel of 5 mm rolling along the kidney's concave side
-    kidney = load_part(PARTS["kidney (shipped)"])
+    # each part read once, so that each wheel's reach is built once (wheel_reach_for keeps it)
+    parts = {name: load_part(path) for name, path in PARTS.items()}
+    kidney = parts["kidney (shipped)"]
     s, pts, th, ka = sample(kidney)
     ax = axes[0]
     ax.plot(pts[:, 0], pts[:, 1], "k", lw=1.5)
     r = 5.0
-    ok = WheelReach(kidney, WheelJaw(r), spacing=SPACING).touchable(s)
+    ok = wheel_reach_for(kidney, WheelJaw(r), SPACING).touchable(s)
     concave = np.flatnonzero(ok & (ka < -1e-3))
     centre = pts + r * np.c_[np.sin(th), -np.cos(th)]
     ax.plot(*centre[ok].T, ".", color="tab:blue", ms=0.6, label=f"axle path, wheel r = {r:g} mm")
@@ -89,10 +91,9 @@ def figures(out: Path) -> dict:
 
     # 2. the reachable fraction of the boundary against the radius, with the straight jaw's
     ax = axes[1]
-    for name, path in PARTS.items():
-        part = load_part(path)
+    for name, part in parts.items():
         s, pts, th, ka = sample(part)
-        frac = [float(WheelReach(part, WheelJaw(rr), spacing=SPACING).touchable(s).mean()) for rr in RADII]
+        frac = [float(wheel_reach_for(part, WheelJaw(rr), SPACING).touchable(s).mean()) for rr in RADII]
         jaw = float(np.mean(Reach(part).touchable(s)))
         numbers["reach"][name] = {"wheel": dict(zip(map(str, RADII), frac)), "straight:100": jaw}
         line = ax.plot(RADII, frac, "o-", label=name)[0]
@@ -111,7 +112,7 @@ def figures(out: Path) -> dict:
     for texture, style in ((0.0, "o-"), (0.5e-3, "s--")):
         med = []
         for rr in RADII:
-            ok = WheelReach(kidney, WheelJaw(rr), spacing=SPACING).touchable(s)
+            ok = wheel_reach_for(kidney, WheelJaw(rr), SPACING).touchable(s)
             starts = [i for i in np.flatnonzero(ok & (ka < 0)) if ok[(i + step) % ka.size] and ok[i : i + step].all()]
             idx = np.asarray(starts, dtype=int)
             if idx.size == 0:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import PIVOT_KAPPA, ContactFilter, load_outline
+from localizer import ContactFilter, load_outline
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 H = 0.002  # mm between the reference's points
@@ -140,7 +140,7 @@ def replay_checks(name, **settings):
         if call == "update" and flt.steps % 5 == 0:
             b = flt.belief()
             truth = float(part.wrap_arc(flt.current[true]))
-            pivot = bool(flt.tracks.kappa[flt.node[true]] >= PIVOT_KAPPA)
+            pivot = bool(flt.tracks.pivot[flt.node[true]])
             out.append((b.mass, abs(float(part.arc_offset(b.map_arc, truth))), pivot))
     return out
 
