@@ -3,8 +3,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
-__all__ = ["Belief", "Mode"]
+import numpy as np
+
+from ._types import FloatArray
+
+__all__ = ["Belief", "Mode", "find_modes"]
 
 
 @dataclass(frozen=True)
@@ -55,3 +60,46 @@ class Belief:
     ambiguous: bool
     informative: bool
     steps: int
+
+
+def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray, radius: float) -> list[Mode]:
+    """Connected groups of probable present contacts, binned at ``radius`` mm, most probable first.
+
+    Parameters
+    ----------
+    part : Part or Outline
+    w : ndarray
+        Each hypothesis' probability.
+    present, starts : ndarray, mm
+        Each hypothesis' present contact and start.
+    radius : float, mm
+    """
+    nb = max(8, int(part.perimeter / radius))
+    b = np.minimum((present / part.perimeter * nb).astype(int), nb - 1)
+    mass = np.bincount(b, weights=w, minlength=nb)
+    live = mass > 1e-4 * mass.max()
+    if live.all():
+        labels = np.zeros(nb, dtype=int)
+    else:
+        # label runs of live bins around the circle
+        start = int(np.flatnonzero(~live)[0])
+        order = (np.arange(nb) + start) % nb
+        labels = np.full(nb, -1)
+        label = -1
+        prev = False
+        for k in order:
+            if live[k] and not prev:
+                label += 1
+            if live[k]:
+                labels[k] = label
+            prev = live[k]
+    out: list[Mode] = []
+    for lab in range(int(labels.max()) + 1):
+        bins = labels == lab
+        sel = bins[b]
+        if not sel.any():
+            continue
+        top = int(np.argmax(np.where(sel, w, -1.0)))
+        out.append(Mode(arc=float(present[top]), mass=float(mass[bins].sum()), start_arc=float(starts[top])))
+    out.sort(key=lambda m: -m.mass)
+    return out

@@ -117,7 +117,7 @@ from typing import Any
 import numpy as np
 from scipy.special import ndtr
 
-from ._belief import Belief, Mode
+from ._belief import Belief, Mode, find_modes
 from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
@@ -809,33 +809,4 @@ class ContactFilter:
 
     def _modes(self, w: FloatArray, present: FloatArray, radius: float) -> list[Mode]:
         """Connected groups of probable present contacts, binned at ``radius``."""
-        part = self.part
-        nb = max(8, int(part.perimeter / radius))
-        b = np.minimum((present / part.perimeter * nb).astype(int), nb - 1)
-        mass = np.bincount(b, weights=w, minlength=nb)
-        live = mass > 1e-4 * mass.max()
-        if live.all():
-            labels = np.zeros(nb, dtype=int)
-        else:
-            # label runs of live bins around the circle
-            start = int(np.flatnonzero(~live)[0])
-            order = (np.arange(nb) + start) % nb
-            labels = np.full(nb, -1)
-            label = -1
-            prev = False
-            for k in order:
-                if live[k] and not prev:
-                    label += 1
-                if live[k]:
-                    labels[k] = label
-                prev = live[k]
-        out: list[Mode] = []
-        for lab in range(int(labels.max()) + 1):
-            bins = labels == lab
-            sel = bins[b]
-            if not sel.any():
-                continue
-            top = int(np.argmax(np.where(sel, w, -1.0)))
-            out.append(Mode(arc=float(present[top]), mass=float(mass[bins].sum()), start_arc=float(self.grid[top])))
-        out.sort(key=lambda m: -m.mass)
-        return out
+        return find_modes(self.part, w, present, self.grid, radius)

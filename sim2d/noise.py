@@ -46,6 +46,9 @@ class NoiseModel:
         RMS normal deviation of the real part from its model (smooth, random).
     machining_wavelength : float, mm
         Shortest wavelength of the machining deviation.
+    axle_encoder_step : float, rad
+        Quantization of a wheel finger's axle encoder (docs/wheel.md: 12 bits, 0.088°); unused by the
+        straight jaw.
     """
 
     v1_noise: float = 0.0
@@ -61,13 +64,14 @@ class NoiseModel:
     encoder_step: float = 0.0
     machining_error: float = 0.0
     machining_wavelength: float = 20.0
+    axle_encoder_step: float = 0.0
 
     def __post_init__(self):
         for f in fields(self):
             v = getattr(self, f.name)
             if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
                 raise SimError(f"noise model: {f.name}={v!r} must be a finite number")
-        for name in ("v1_noise", "v2_noise", "adc_step", "encoder_step", "machining_error"):
+        for name in ("v1_noise", "v2_noise", "adc_step", "encoder_step", "machining_error", "axle_encoder_step"):
             if getattr(self, name) < 0:
                 raise SimError(f"noise model: {name}={getattr(self, name)!r} must be >= 0")
         if self.machining_wavelength <= 0:
@@ -104,6 +108,7 @@ PRESETS = {
         encoder_step=math.radians(0.03),
         machining_error=0.009,
         machining_wavelength=20.0,
+        axle_encoder_step=2 * math.pi / 4096,
     ),
 }
 

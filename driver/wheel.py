@@ -1,0 +1,359 @@
+"""Rolling a wheel finger and localizing with it (issue 17; the physics in docs/wheel.md).
+
+The hand pose (x, y, φ) is the axle's place and the hand's angle; the hand's axis m = (−sin φ, cos φ)
+points at the part, as the straight jaw's normal does, so :func:`driver.procedures.press` presses a
+wheel too. Each rolling step:
+
+1. moves the axle ``step`` mm along the hand's tangent e = (cos φ, sin φ) (times the direction);
+2. servos the hand to the contact: reads the wrist's force direction α relative to the hand axis
+   (atan2 of the two channels against their clear values, less the calibrated direction zero), turns
+   the hand by α and moves the axle along the contact's direction until the force is back at the
+   target, a few times, until |α| and the force error are small;
+3. reads the arm's angle φ, the wrist's residual α and the axle encoder ψ_e. Since the start the
+   part's tangent has turned by Ω = Δφ + Δα and the contact has travelled L = r·(Δψ_e − Δα) on the
+   part (the encoder reads relative to the hand; r the calibrated radius);
+4. checks the step: on the part the turn can change by at most the part's largest |κ| times the arc
+   rolled; a larger change with the contact hardly moving is the disc straddling a pocket it cannot
+   enter (or a corner): a **jump**, undone (the hand goes back to the step's start) and the direction
+   turned round;
+5. checks for **slip**: under pure rolling the commanded axle, pressed δ into the wrist, runs along
+   the part's offset at r − δ, so its path between two steps is L + (r − δ)·Ω of that step; the
+   difference summed over the run is the rim's slip (reported; beyond :attr:`WheelPolicy.max_slip`
+   the rolling stops, as the L readings are no longer the part's arc).
+
+:func:`localize_with_wheel` rolls one way, turning round at a jump, and gives the readings to a
+:class:`localizer.WheelFilter` until it is sure (or the budget is spent).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from localizer import Belief, Part, WheelFilter, WheelJaw
+
+from .procedures import PRESS, Hand, PressSettings, delta_voltages, press, zero
+from .reactive import CONFIDENCE, MAX_ROTATION
+from .rig import GroundTruth, Rig, RigError
+
+__all__ = [
+    "AxleEncoder",
+    "WheelCalibration",
+    "WheelPolicy",
+    "WheelRun",
+    "localize_with_wheel",
+    "JUMP_FLOOR",
+]
+
+#: A step's change of turn beyond the part's steepest turning over the rolled arc by this (rad) is a jump:
+#: 0.5°, twenty times the wrist's residual direction.
+JUMP_FLOOR = math.radians(0.5)
+
+
+@runtime_checkable
+class AxleEncoder(Protocol):
+    """A rig with a wheel finger: it reads the disc's angle on its axle."""
+
+    def axle(self) -> float:
+        """The axle encoder: the disc's angle relative to the hand, rad (counting, not wrapped)."""
+        ...
+
+
+@dataclass(frozen=True)
+class WheelCalibration:
+    """What turns a wheel rig's readings into (L, Ω) (docs/wheel.md, calibration).
+
+    Attributes
+    ----------
+    jaw : str
+        The finger calibrated (``"wheel:5"``); a calibration is refused for another finger.
+    radius : float, mm
+        The wheel's effective rolling radius.
+    direction_zero : float, rad
+        The wrist channels' mounting rotation: subtracted from atan2(Δv2, Δv1).
+    """
+
+    jaw: str
+    radius: float
+    direction_zero: float = 0.0
+
+    @classmethod
+    def nominal(cls, wheel: WheelJaw) -> WheelCalibration:
+        """The wheel's drawing: its nominal radius, no mounting rotation."""
+        return cls(jaw=str(wheel), radius=wheel.radius)
+
+    def check(self, wheel: WheelJaw) -> None:
+        """Refuse this calibration for another finger."""
+        if self.jaw != str(wheel):
+            raise RigError(f"the calibration is for {self.jaw}, the finger is {wheel}: calibrate this finger first")
+
+
+@dataclass(frozen=True)
+class WheelPolicy:
+    """How the wheel rolls and when it stops.
+
+    Attributes
+    ----------
+    step : float, mm
+        Axle travel per rolling step.
+    target : float, V
+        Contact force held, as the wrist's |Δv| (the straight jaw's 0.4 V).
+    force_tol : float, V
+    angle_tol : float, rad
+        The servo ends when the force is within ``force_tol`` and |α| within this.
+    servo_iterations : int
+    check_every : int
+        Steps between two looks at the belief.
+    confidence : float
+        Probability within the filter's radius that stops the rolling.
+    max_rotation : float, rad
+        Budget of the hand's turning, both ways counted.
+    max_arc : float or None, mm
+        Budget of rolled arc (default: the part's perimeter).
+    max_slip : float, mm
+        Summed slip beyond this stops the rolling (the readings are no longer the part's arc).
+    n : int
+        Samples averaged per wrist reading.
+    """
+
+    step: float = 0.25
+    target: float = 0.4
+    force_tol: float = 0.02
+    angle_tol: float = math.radians(0.005)
+    servo_iterations: int = 6
+    check_every: int = 4
+    confidence: float = CONFIDENCE
+    max_rotation: float = MAX_ROTATION
+    max_arc: float | None = None
+    max_slip: float = 0.1
+    n: int = 32
+
+    def __post_init__(self) -> None:
+        for name in ("step", "target", "force_tol", "angle_tol", "max_rotation", "max_slip"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise RigError(f"wheel policy {name}={v!r} must be a positive number")
+        if not 0 < self.confidence < 1:
+            raise RigError(f"wheel policy confidence={self.confidence!r} must be in (0, 1)")
+        if self.servo_iterations < 1 or self.check_every < 1 or self.n < 1:
+            raise RigError("wheel policy servo_iterations, check_every and n must be at least 1")
+
+
+@dataclass(frozen=True)
+class WheelRun:
+    """Result of :func:`localize_with_wheel`.
+
+    Attributes
+    ----------
+    belief : Belief
+    rotation : float, rad
+        The hand's turning, both ways counted.
+    arc : float, mm
+        Arc rolled, both ways counted.
+    steps : int
+    stopped : str
+        "confident", "max_rotation", "max_arc", "blocked" (jumps both ways) or "slip".
+    reversals, jumps : int
+    slip : float, mm
+        The rim's slip summed over the run (module notes, step 5).
+    depth : float, mm
+        The wrist's give at the target force (measured at the first press).
+    history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
+    lengths, turns, true_arcs : tuple of float
+        Every reading's L (mm) and Ω (rad) since the start, and the true contact (NaN on a real rig).
+    """
+
+    belief: Belief
+    rotation: float
+    arc: float
+    steps: int
+    stopped: str
+    reversals: int
+    jumps: int
+    slip: float
+    depth: float
+    history: tuple = field(repr=False, default=())
+    lengths: tuple = field(repr=False, default=())
+    turns: tuple = field(repr=False, default=())
+    true_arcs: tuple = field(repr=False, default=())
+
+    @property
+    def estimate_arc(self) -> float:
+        return self.belief.map_arc
+
+
+def _direction(dv1: float, dv2: float, cal: WheelCalibration) -> float:
+    return math.atan2(dv2, dv1) - cal.direction_zero
+
+
+def localize_with_wheel(
+    rig: Rig,
+    part: Part,
+    wheel: WheelJaw,
+    *,
+    approach_pose,
+    calibration: WheelCalibration | None = None,
+    filter: WheelFilter | None = None,
+    policy: WheelPolicy = WheelPolicy(),
+    pressing: PressSettings = PRESS,
+    observer=None,
+) -> WheelRun:
+    """Roll the wheel from ``approach_pose`` until the contact is known (module notes).
+
+    Parameters
+    ----------
+    rig : Rig with an axle encoder (:class:`AxleEncoder`)
+    part : Part
+        The part's model.
+    wheel : WheelJaw
+    approach_pose : (x mm, y mm, φ rad)
+        Clear of the part, the hand's axis pointing at it.
+    calibration : WheelCalibration, optional
+        Default: the wheel's nominal radius, no mounting rotation.
+    filter : WheelFilter, optional
+        Default: ``WheelFilter(part, wheel)``.
+    policy : WheelPolicy
+    pressing : PressSettings
+        The first press.
+    observer : callable, optional
+        Called with ``{"event": "belief", ...}`` at every check.
+    """
+    if not isinstance(rig, AxleEncoder):
+        raise RigError(f"{type(rig).__name__} has no axle encoder: a wheel finger needs one (docs/wheel.md)")
+    cal = calibration if calibration is not None else WheelCalibration.nominal(wheel)
+    cal.check(wheel)
+    flt = filter if filter is not None else WheelFilter(part, wheel)
+    flt.reset()
+    return _WheelRoller(rig, part, wheel, cal, flt, policy, pressing, observer).run(approach_pose)
+
+
+class _WheelRoller:
+    def __init__(self, rig, part, wheel, cal, flt, policy, pressing, observer):
+        self.rig, self.part, self.wheel, self.cal, self.flt = rig, part, wheel, cal, flt
+        self.policy, self.pressing, self.observer = policy, pressing, observer
+        self.kappa_max = float(part.curvature_bound)
+        self.max_arc = policy.max_arc if policy.max_arc is not None else float(part.perimeter)
+
+    # --------------------------------------------------------------- sensing
+    def _read(self) -> tuple[float, float]:
+        """(|Δv| V, α rad) from the wrist."""
+        dv1, dv2 = delta_voltages(self.rig, self.baseline, self.policy.n)
+        return math.hypot(dv1, dv2), _direction(dv1, dv2, self.cal)
+
+    def _settle(self) -> tuple[float, float]:
+        """Servo the hand to the contact normal and the force to the target (module notes, step 2)."""
+        pol = self.policy
+        f, a = self._read()
+        for _ in range(pol.servo_iterations):
+            if abs(a) <= pol.angle_tol and abs(f - pol.target) <= pol.force_tol:
+                break
+            x, y, phi = self.hand.pose
+            beta = phi + a
+            if f < 0.1 * pol.target:  # clear of the part: press back along the hand's axis
+                push = self.pressing.search_step
+            else:
+                push = float(np.clip((pol.target - f) / self.stiffness, -1.0, 1.0))
+            self.hand.go(x - push * math.sin(beta), y + push * math.cos(beta), beta)
+            f, a = self._read()
+        if f < 0.1 * pol.target:
+            raise RigError(f"the wheel lost the part (|Δv| = {f:.3g} V after the step): start again closer")
+        return f, a
+
+    def _state(self) -> tuple[float, float, float, float, float]:
+        """(φ, α, ψ_e, x, y) at a settled pose."""
+        f, a = self._settle()
+        x, y, _ = self.rig.pose()
+        phi = float(self.hand.measured_angle())
+        return phi, a, float(self.rig.axle()), float(x), float(y)
+
+    def _truth(self) -> float:
+        return float(self.rig.truth()["contact_arc"]) if isinstance(self.rig, GroundTruth) else math.nan
+
+    # ------------------------------------------------------------------- run
+    def run(self, approach_pose) -> WheelRun:
+        pol, flt = self.policy, self.flt
+        self.baseline = zero(self.rig)
+        self.hand = Hand(self.rig, approach_pose)
+        dv1, _ = press(self.rig, self.hand, self.baseline, target=pol.target, n=pol.n, pressing=self.pressing)
+        # the wrist's stiffness seen at the contact (V/mm): back off 0.2 mm and read again
+        self.hand.press_by(-0.2)
+        lighter, _ = self._read()
+        self.hand.press_by(0.2)
+        self.stiffness = max((dv1 - lighter) / 0.2, 1e-3)
+        depth = pol.target / self.stiffness
+        r = self.cal.radius
+        start = self._state()
+        prev = start
+        lengths, turns, truths, history = [0.0], [0.0], [self._truth()], []
+        flt.update(0.0, 0.0)
+        direction, reversals, jumps, steps = 1, 0, 0, 0
+        rotation = arc = slip = 0.0
+        blocked_since = None
+        stopped = "max_rotation"
+        belief = flt.belief()
+        while True:
+            pose_before = self.hand.pose
+            x, y, phi = pose_before
+            self.hand.go(x + direction * pol.step * math.cos(phi), y + direction * pol.step * math.sin(phi), phi)
+            now = self._state()
+            d_turn = (now[0] + now[1]) - (prev[0] + prev[1])
+            d_len = r * ((now[2] - prev[2]) - (now[1] - prev[1]))
+            if abs(d_turn) > self.kappa_max * abs(d_len) * 1.5 + JUMP_FLOOR:
+                # a jump: back to where the step started, the other way
+                self.hand.go(*pose_before)
+                prev = self._state()
+                jumps += 1
+                if blocked_since is not None and abs(lengths[-1] - blocked_since) < 2 * pol.step:
+                    stopped = "blocked"
+                    break
+                blocked_since = lengths[-1]
+                direction, reversals = -direction, reversals + 1
+                continue
+            path = math.hypot(now[3] - prev[3], now[4] - prev[4])
+            slip += path - abs(d_len + (r - depth) * d_turn)
+            rotation += abs(d_turn)
+            arc += abs(d_len)
+            steps += 1
+            L = lengths[-1] + d_len
+            om = (now[0] + now[1]) - (start[0] + start[1])
+            lengths.append(L)
+            turns.append(om)
+            truths.append(self._truth())
+            flt.update(L, om)
+            prev = now
+            if abs(slip) > pol.max_slip:
+                stopped = "slip"
+                break
+            if steps % pol.check_every == 0:
+                belief = flt.belief()
+                history.append((rotation, belief.map_arc, belief.mass, truths[-1]))
+                if self.observer is not None:
+                    self.observer({"event": "belief", "rotation": rotation, "arc": arc, "belief": belief})
+                if belief.mass >= pol.confidence:
+                    stopped = "confident"
+                    break
+            if rotation >= pol.max_rotation:
+                stopped = "max_rotation"
+                break
+            if arc >= self.max_arc:
+                stopped = "max_arc"
+                break
+        belief = flt.belief()
+        return WheelRun(
+            belief=belief,
+            rotation=rotation,
+            arc=arc,
+            steps=steps,
+            stopped=stopped,
+            reversals=reversals,
+            jumps=jumps,
+            slip=slip,
+            depth=depth,
+            history=tuple(history),
+            lengths=tuple(lengths),
+            turns=tuple(turns),
+            true_arcs=tuple(truths),
+        )

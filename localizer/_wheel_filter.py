@@ -1,0 +1,297 @@
+"""The sequential filter of a wheel finger: a belief over the roll's start, the rolled arc as the coordinate.
+
+The straight jaw's :class:`~localizer.ContactFilter` moves its hypotheses by the measured turn, along
+stretches where the tangent angle rises, so that each turn names one place. A wheel also rolls
+through concave stretches, where θ falls and a turn names several places (docs/wheel.md). Here the
+rolling coordinate is the arc L the axle encoder reads (the wheel's L = r·Δψ_e), and the reading is
+the hand's net turn Ω. For a start s the model's turn after L is
+
+    Ω̂(s, L) = Θ(s + L) − Θ(s),          Θ the unwrapped tangent angle,
+
+and the residuals ρ_k = Ω_k − Ω̂(s, L_k) of the readings of one roll share their errors:
+
+- the start's angle error (the arm's, the wrist's direction and the machined part's slope at s), one
+  offset for the roll;
+- the machined part's slope error along the roll, a smooth random function of the arc: Gaussian
+  covariance ``sd_slope``² · exp(−ΔL²/2ℓ²) with ℓ = ``slope_length``;
+- independent errors of each reading: the arm's angle and the wrist's direction (``sd_turn``), and L's
+  error seen through the tangent's turning, κ(s + L)·σ_L with σ_L² = ``sd_length``² + (L·``sd_scale``)²
+  (the encoder and the calibrated radius's relative error).
+
+The first three depend on the readings' L only, the same for every start: their covariance is
+factored once, a row per reading (a Cholesky factor grown by one row), and every start's residuals
+are whitened against it, so the log-likelihood is exact for them at O(starts × readings) per
+reading; the last term is added to each start's innovation variance. Readings closer than ``thin``
+mm of arc to the last one used only move the present contact (their errors are not independent of
+the last one's: the arm encoder's quantization is a function of the angle).
+
+Where the wheel reaches (:class:`~localizer.WheelReach`) is the prior, and a start is ruled out once
+the arc rolled from it, either way, runs over a point the wheel cannot touch (it would have jumped
+there, which the rolling procedure detects and undoes instead).
+
+A stated probability is the least over ``noise_scales`` (the covariance times each factor squared):
+readings noisier than the filter was told lower it instead of making it confidently wrong.
+
+Outlines with corners are refused: at a corner the wheel pivots, Ω changing while L does not, so Ω is
+not a function of L there (not built).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._belief import Belief, find_modes
+from ._defaults import SUCCESS_RADIUS
+from ._errors import QueryError
+from ._part import Part
+from ._types import BoolArray, FloatArray
+from ._wheel import WheelJaw, wheel_reach_for
+
+__all__ = ["WheelFilter", "WHEEL_SD_TURN", "WHEEL_SD_SLOPE", "WHEEL_SLOPE_LENGTH", "WHEEL_NOISE_SCALES"]
+
+#: One reading's independent angle error (rad): the arm encoder's 0.03° step (0.009° rms) and the wrist's
+#: residual direction after the servo (0.02°, docs/wheel.md), rounded up.
+WHEEL_SD_TURN = math.radians(0.025)
+#: The machined part's slope error (rad rms): the straight jaw's reactive studies' measured 0.8e-3 to 1.9e-3.
+WHEEL_SD_SLOPE = 0.002
+#: Its correlation length along the arc (mm): the machining's shortest wavelength, 20 mm, over 2π.
+WHEEL_SLOPE_LENGTH = 20.0 / (2 * math.pi)
+#: Noise scales under which a stated probability must hold (its least is stated).
+WHEEL_NOISE_SCALES = (1.0, 2.0)
+
+
+class WheelFilter:
+    """Belief over where a wheel's roll started, from cumulative (L, Ω) readings.
+
+    Parameters
+    ----------
+    part : Part
+    wheel : WheelJaw
+    spacing : float, mm
+        Grid of starts.
+    sd_turn, sd_slope, slope_length : float
+        The error model (module notes; rad, rad, mm).
+    sd_length : float, mm
+        One reading's error of L (the axle encoder's step times the radius, over √12, rounded up).
+    sd_scale : float
+        Relative error of L (the calibrated radius).
+    thin : float, mm
+        Arc between two readings the likelihood uses.
+    radius : float, mm
+        A belief's mass is taken within this of its most probable contact.
+    confidence, mode_floor : float
+        A belief is ambiguous when two or more modes hold ``mode_floor`` each and the first does not
+        reach ``confidence``.
+    noise_scales : tuple of float
+        The stated mass is the least under these factors of the error model.
+
+    Examples
+    --------
+    On an ellipse of semi-axes 40 and 25 mm, a noise-free roll of 10 mm from s = 20 mm:
+
+    >>> from localizer import part_from_points
+    >>> a = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    >>> ellipse = part_from_points(np.c_[40 * np.cos(a), 25 * np.sin(a)])
+    >>> f = WheelFilter(ellipse, WheelJaw(5.0))
+    >>> theta = lambda s: float(ellipse.tangent_angle(ellipse.param_at_arc(s)))
+    >>> for L in np.arange(0.5, 10.01, 0.5):
+    ...     f.update(L, theta(20.0 + L) - theta(20.0))
+    >>> b = f.belief()
+    >>> round(abs(float(ellipse.arc_offset(b.map_arc, 30.0))), 1), b.ambiguous
+    (0.0, True)
+    """
+
+    def __init__(
+        self,
+        part: Part,
+        wheel: WheelJaw,
+        *,
+        spacing: float = 0.02,
+        sd_turn: float = WHEEL_SD_TURN,
+        sd_slope: float = WHEEL_SD_SLOPE,
+        slope_length: float = WHEEL_SLOPE_LENGTH,
+        sd_length: float = 0.005,
+        sd_scale: float = 2e-4,
+        thin: float = 1.0,
+        radius: float = SUCCESS_RADIUS,
+        confidence: float = 0.95,
+        mode_floor: float = 0.05,
+        noise_scales: tuple[float, ...] = WHEEL_NOISE_SCALES,
+    ) -> None:
+        if not isinstance(part, Part):
+            raise QueryError(
+                f"{part.name}: the wheel's filter takes spline parts only; a drawing's corners are not built "
+                "(at a corner the wheel pivots and Ω is not a function of L)"
+            )
+        for name, v in (("spacing", spacing), ("slope_length", slope_length), ("thin", thin), ("radius", radius)):
+            if not (math.isfinite(v) and v > 0):
+                raise QueryError(f"{name}={v!r} mm must be a positive number")
+        for name, v in (("sd_turn", sd_turn), ("sd_slope", sd_slope), ("sd_length", sd_length), ("sd_scale", sd_scale)):
+            if not (math.isfinite(v) and v >= 0):
+                raise QueryError(f"{name}={v!r} must be ≥ 0")
+        if sd_turn <= 0:
+            raise QueryError(f"sd_turn={sd_turn!r} rad must be positive (it keeps the covariance invertible)")
+        if not noise_scales or not all(math.isfinite(f) and f >= 1 for f in noise_scales):
+            raise QueryError(f"noise_scales={noise_scales!r}: give factors ≥ 1")
+        self.part, self.wheel = part, wheel
+        self.sd_turn, self.sd_slope, self.slope_length = float(sd_turn), float(sd_slope), float(slope_length)
+        self.sd_length, self.sd_scale, self.thin = float(sd_length), float(sd_scale), float(thin)
+        self.radius, self.confidence, self.mode_floor = float(radius), float(confidence), float(mode_floor)
+        self.noise_scales = tuple(float(f) for f in noise_scales)
+        P = float(part.perimeter)
+        n = max(64, int(math.ceil(P / spacing)))
+        self.h = P / n
+        self.grid: FloatArray = np.arange(n, dtype=float) * self.h
+        self._theta0 = self._theta(self.grid)
+        reach = wheel_reach_for(part, wheel)
+        touch = reach.touchable(self.grid)
+        self.prior: FloatArray = np.asarray(touch, dtype=float)
+        if not touch.any():
+            raise QueryError(f"a {wheel} touches {part.name} nowhere")
+        self._ahead, self._behind = _free_runs(touch, self.h)
+        self.reset()
+
+    # ------------------------------------------------------------ geometry
+    def _theta(self, sigma: FloatArray) -> FloatArray:
+        """Unwrapped tangent angle Θ at unrolled arc positions (rad): continuous, Θ(σ + P) = Θ(σ) + 2π."""
+        part = self.part
+        sigma = np.asarray(sigma, dtype=float)
+        laps = np.floor(sigma / part.perimeter)
+        t = part.param_at_arc(sigma - laps * part.perimeter)
+        out: FloatArray = part.tangent_angle(t) + 2 * math.pi * laps
+        return out
+
+    # ------------------------------------------------------------- readings
+    def reset(self) -> None:
+        """Forget every reading (a new roll from a new start)."""
+        self.L_used: list[float] = []
+        self._chol = np.zeros((0, 0))
+        self._z = np.zeros((self.grid.size, 0))
+        self._quad = np.zeros(self.grid.size)
+        self._logdet = np.zeros(self.grid.size)
+        self.current = 0.0
+        self.span = (0.0, 0.0)
+        self.steps = 0
+
+    def _cov(self, a: FloatArray, b: FloatArray) -> FloatArray:
+        """Covariance of the shared errors of residuals at arcs ``a`` and ``b`` (mm) rolled from the start."""
+        a, b = np.asarray(a, dtype=float)[:, None], np.asarray(b, dtype=float)[None, :]
+        ell2 = 2 * self.slope_length**2
+        slope = self.sd_slope**2 * (
+            np.exp(-((a - b) ** 2) / ell2) - np.exp(-(a**2) / ell2) - np.exp(-(b**2) / ell2) + 1.0
+        )
+        # the start's independent reading error: in every residual
+        out: FloatArray = slope + self.sd_turn**2 * (1.0 + (a == b))
+        return out
+
+    def update(self, length: float, turn: float) -> None:
+        """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
+        clockwise), and the hand's net turn since the start, ``turn`` rad."""
+        L, om = float(length), float(turn)
+        if not (math.isfinite(L) and math.isfinite(om)):
+            raise QueryError(f"reading (length={length!r} mm, turn={turn!r} rad) must be finite")
+        self.current = L
+        self.span = (min(self.span[0], L), max(self.span[1], L))
+        self.steps += 1
+        last = self.L_used[-1] if self.L_used else 0.0
+        if abs(L - last) < self.thin:
+            return
+        used = np.array(self.L_used)
+        c_new = self._cov(used, np.array([L]))[:, 0] if used.size else np.zeros(0)
+        c_nn = float(self._cov(np.array([L]), np.array([L]))[0, 0])
+        if used.size:
+            from scipy.linalg import solve_triangular
+
+            ell = solve_triangular(self._chol, c_new, lower=True)
+        else:
+            ell = np.zeros(0)
+        d2 = max(c_nn - float(ell @ ell), 1e-18)
+        kappa = np.asarray(self.part.curvature_at_arc(self.part.wrap_arc(self.grid + L)), dtype=float)
+        extra = kappa**2 * (self.sd_length**2 + (L * self.sd_scale) ** 2)
+        rho = om - (self._theta(self.grid + L) - self._theta0)
+        var = d2 + extra
+        z = (rho - self._z @ ell) / np.sqrt(var)
+        self._quad += z**2
+        self._logdet += np.log(var)
+        self._z = np.column_stack([self._z, z * np.sqrt(var / d2)])  # whitened by the shared part alone
+        k = used.size
+        chol = np.zeros((k + 1, k + 1))
+        chol[:k, :k] = self._chol
+        chol[k, :k] = ell
+        chol[k, k] = math.sqrt(d2)
+        self._chol = chol
+        self.L_used.append(L)
+
+    # --------------------------------------------------------------- belief
+    def alive(self) -> BoolArray:
+        """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
+        lo, hi = self.span
+        tol = 2 * self.h
+        ok: BoolArray = (self._ahead + tol >= hi) & (self._behind + tol >= -lo) & (self.prior > 0)
+        return ok
+
+    def _posterior(self, factor: float) -> FloatArray:
+        ll = -0.5 * self._quad / factor**2 - 0.5 * self._logdet
+        ll = np.where(self.alive(), ll, -np.inf)
+        top = ll.max()
+        if not np.isfinite(top):
+            raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
+        w = np.exp(ll - top)
+        out: FloatArray = w / w.sum()
+        return out
+
+    def posterior(self) -> FloatArray:
+        """Posterior probability of each start on :attr:`grid` (sums to 1)."""
+        return self._posterior(self.noise_scales[0])
+
+    def present(self) -> FloatArray:
+        """Each start's present contact, mm."""
+        out: FloatArray = self.part.wrap_arc(self.grid + self.current)
+        return out
+
+    def belief(self, radius: float | None = None) -> Belief:
+        """The belief over the present contact; its mass the least over :attr:`noise_scales`."""
+        radius = self.radius if radius is None else float(radius)
+        present = self.present()
+        w = self.posterior()
+        i = int(np.argmax(w))
+        map_arc = float(present[i])
+        mass = 1.0
+        for f in self.noise_scales:
+            wf = w if f == self.noise_scales[0] else self._posterior(f)
+            near = np.abs(np.asarray(self.part.arc_offset(present, map_arc))) <= radius
+            mass = min(mass, float(wf[near].sum()))
+        modes = find_modes(self.part, w, present, self.grid, radius)
+        prior = self.prior / self.prior.sum()
+        nz = w > 0
+        informative = float(np.sum(w[nz] * np.log(w[nz] / prior[nz]))) > 0.05
+        strong = [m for m in modes if m.mass >= self.mode_floor]
+        ambiguous = informative and len(strong) > 1 and modes[0].mass < self.confidence
+        return Belief(
+            map_arc=map_arc,
+            mass=mass,
+            radius=radius,
+            modes=tuple(modes),
+            ambiguous=ambiguous,
+            informative=informative,
+            steps=self.steps,
+        )
+
+
+def _free_runs(touch: np.ndarray, h: float) -> tuple[FloatArray, FloatArray]:
+    """For each grid point, the arc (mm) ahead and behind before the first untouchable point (inf when
+    the whole boundary is touchable)."""
+    n = touch.size
+    bad = np.flatnonzero(~touch)
+    if bad.size == 0:
+        inf = np.full(n, np.inf)
+        return inf, inf.copy()
+    idx = np.arange(n)
+    ext = np.concatenate([bad - n, bad, bad + n])
+    nxt = ext[np.searchsorted(ext, idx, side="left")]
+    prv = ext[np.searchsorted(ext, idx, side="right") - 1]
+    ahead = np.where(touch, (nxt - idx - 1) * h, -1.0)
+    behind = np.where(touch, (idx - prv - 1) * h, -1.0)
+    return ahead, behind

@@ -1,0 +1,159 @@
+"""A kinematic world for the wheel finger: a disc on an axle, pressed on the part through a compliant wrist.
+
+The hand pose (x, y, φ) puts the axle at (x, y); the hand's axis points from the axle towards the
+part along m = (−sin φ, cos φ), as the straight jaw's normal does. The disc of radius r touches the
+part at the part's point nearest to the axle (the disc cannot cut in; the wrist gives by the depth
+r − distance, and the force is the wrist's stiffness times that depth). The force acts along the line
+from the contact to the axle: its angle β, with the contact at direction (−sin β, cos β) from the
+axle, is the contact normal's tangent angle (β = θ on a smooth stretch).
+
+The disc turns on its bearing only by rolling (docs/wheel.md): while the contact runs along the part
+by dσ, the disc turns by dθ + dσ/r in the world (its material point at the contact at rest), i.e.
+by the change of the direction from the contact to the axle plus the arc over the radius. At a corner
+of an outline, or where the disc straddles a pocket it cannot enter and the contact jumps to the far
+side, no arc of the part is rolled: the disc pivots about the contact with the axle, ψ turning with
+the direction alone. The axle encoder reads ψ − φ (relative to the hand).
+
+``slip`` makes the disc lose that fraction of the rolled arc (a slipping rim), which the rolling
+procedure must report.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from localizer import Part
+
+from ._errors import SimError
+from .machining import MachinedOutline
+
+__all__ = ["WheelWorld", "WheelContact", "SAMPLE_STEP", "JUMP_EXCESS"]
+
+#: Spacing of the dense sample of the real boundary the disc is pressed on (mm). A chord of the sample
+#: lies off a curve of curvature κ by h²κ/8: 3 nm at κ = 0.2/mm.
+SAMPLE_STEP = 0.01
+#: A contact that moved along the part by more than its straight-line move plus this (mm) jumped across
+#: what the disc could not enter (the straight jaw's bridge test, localizer.BRIDGE_EXCESS).
+JUMP_EXCESS = 0.01
+
+
+@dataclass(frozen=True)
+class WheelContact:
+    """Where and how hard the disc touches the part.
+
+    Attributes
+    ----------
+    force : float, N
+        Contact force (0 when clear).
+    normal : float, rad
+        Tangent angle of the contact normal β: the contact lies at (−sin β, cos β) from the axle.
+    arc : float, mm
+        The model's arc position of the contact (NaN when clear).
+    depth : float, mm
+        How far the part would cut into the rigid disc (the wrist's give); negative: clear by that much.
+    """
+
+    force: float
+    normal: float
+    arc: float
+    depth: float
+
+
+class WheelWorld:
+    """A disc of ``radius`` mm at static equilibrium on the part for each commanded axle pose.
+
+    Parameters
+    ----------
+    part : Part or MachinedOutline
+        The real part (machined, if so).
+    model : Part or Outline
+        The model whose arc positions the contacts report.
+    radius : float, mm
+    stiffness : float, N/mm
+        The wrist's compliance along the contact normal.
+    slip : float
+        Fraction of the rolled arc the rim loses (0: pure rolling).
+    """
+
+    def __init__(self, part, model, radius: float, *, stiffness: float = 1.0, slip: float = 0.0):
+        if not (math.isfinite(radius) and radius > 0):
+            raise SimError(f"wheel radius={radius!r} mm must be positive")
+        if not (math.isfinite(stiffness) and stiffness > 0):
+            raise SimError(f"stiffness={stiffness!r} N/mm must be positive")
+        if not (math.isfinite(slip) and 0 <= slip < 1):
+            raise SimError(f"slip={slip!r} must be in [0, 1)")
+        self.radius, self.stiffness, self.slip = float(radius), float(stiffness), float(slip)
+        self.perimeter = float(model.perimeter)
+        if isinstance(part, MachinedOutline):
+            self._xy, self._arc = np.asarray(part.xy, dtype=float), np.asarray(part.arcs, dtype=float)
+        elif isinstance(part, Part):
+            n = max(256, int(math.ceil(part.perimeter / SAMPLE_STEP)))
+            t = np.asarray(part.param_at_arc(np.arange(n) * part.perimeter / n), dtype=float)
+            self._xy = np.asarray(part.point(t), dtype=float)
+            # the machined spline's parameters are the model's (sim2d.machining.machined_part)
+            self._arc = np.asarray(model.wrap_arc(model.arc_at_param(t)), dtype=float)
+        else:
+            raise SimError(f"a wheel world needs a Part or a MachinedOutline, not {type(part).__name__}")
+        self._tree = cKDTree(self._xy)
+        self.hand: tuple[float, float, float] | None = None
+        self.psi = 0.0
+        self._last: tuple[float, np.ndarray, np.ndarray] | None = None  # (arc, point, axle) of the last contact
+
+    # ----------------------------------------------------------- geometry
+    def _nearest(self, c: np.ndarray) -> tuple[float, np.ndarray, float]:
+        """(model arc mm, point, distance mm) of the boundary point nearest to ``c``."""
+        _, k = self._tree.query(c)
+        n = self._xy.shape[0]
+        best = (math.inf, 0.0, self._xy[k])
+        for j in (k - 1, k):  # the two sample chords at the nearest sample
+            a, b = self._xy[j % n], self._xy[(j + 1) % n]
+            ab = b - a
+            u = float(np.clip((c - a) @ ab / max(float(ab @ ab), 1e-300), 0.0, 1.0))
+            p = a + u * ab
+            d = float(np.hypot(*(c - p)))
+            if d < best[0]:
+                a0, a1 = self._arc[j % n], self._arc[(j + 1) % n]
+                da = (a1 - a0 + self.perimeter / 2) % self.perimeter - self.perimeter / 2
+                best = (d, float((a0 + u * da) % self.perimeter), p)
+        return best[1], best[2], best[0]
+
+    def set_hand(self, x: float, y: float, phi: float) -> None:
+        """Put the axle at (``x``, ``y``) mm and the hand at angle ``phi`` rad; the disc rolls there."""
+        self.hand = (float(x), float(y), float(phi))
+        c = np.array([x, y], dtype=float)
+        arc, p, d = self._nearest(c)
+        if d >= self.radius:  # clear: the disc keeps its angle on the bearing
+            self._last = None
+            return
+        if self._last is not None:
+            arc0, p0, c0 = self._last
+            turn = _angle(c - p) - _angle(c0 - p0)
+            turn = (turn + math.pi) % (2 * math.pi) - math.pi
+            along = (arc - arc0 + self.perimeter / 2) % self.perimeter - self.perimeter / 2
+            rolled = abs(along) <= float(np.hypot(*(p - p0))) + JUMP_EXCESS
+            self.psi += turn + (along * (1.0 - self.slip) / self.radius if rolled else 0.0)
+        self._last = (arc, p, c)
+
+    def contact(self) -> WheelContact:
+        """The contact for the present axle pose (force 0 when the disc is clear)."""
+        if self.hand is None:
+            return WheelContact(0.0, math.nan, math.nan, -math.inf)
+        c = np.array(self.hand[:2])
+        arc, p, d = self._nearest(c)
+        depth = self.radius - d
+        if depth <= 0:
+            return WheelContact(0.0, math.nan, math.nan, depth)
+        v = p - c  # from the axle to the contact: (−sin β, cos β)
+        return WheelContact(self.stiffness * depth, math.atan2(-v[0], v[1]), arc, depth)
+
+    def encoder(self) -> float:
+        """The disc's angle relative to the hand, rad (unwrapped, as an incremental encoder counts)."""
+        return self.psi - (self.hand[2] if self.hand else 0.0)
+
+
+def _angle(v: np.ndarray) -> float:
+    return math.atan2(float(v[1]), float(v[0]))
