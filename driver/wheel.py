@@ -12,14 +12,16 @@ wheel too. Each rolling step:
 3. reads the arm's angle φ, the wrist's residual α and the axle encoder ψ_e. Since the start the
    part's tangent has turned by Ω = Δφ + Δα and the contact has travelled L = r·(Δψ_e − Δα) on the
    part (the encoder reads relative to the hand; r the calibrated radius);
-4. checks the step: on the part the turn can change by at most the part's largest |κ| times the arc
-   rolled; a larger change with the contact hardly moving is the disc straddling a pocket it cannot
-   enter (or a corner): a **jump**, undone (the hand goes back to the step's start) and the direction
-   turned round;
+4. checks the step: rolling on the part, the turn changes by κ times the arc rolled, κ within the
+   curvatures of the stretches the wheel reaches (widened by half way to −1/r on the concave side,
+   where a disc jammed between two walls reads exactly −1/r, and by half on the convex side). Outside
+   that is the disc straddling a pocket it cannot enter, or jammed in one: a **jump**, undone (the hand
+   goes back to the step's start, the filter told) and the direction turned round;
 5. checks for **slip**: under pure rolling the commanded axle, pressed δ into the wrist, runs along
-   the part's offset at r − δ, so its path between two steps is L + (r − δ)·Ω of that step; the
-   difference summed over the run is the rim's slip (reported; beyond :attr:`WheelPolicy.max_slip`
-   the rolling stops, as the L readings are no longer the part's arc).
+   the part's offset at r − δ, so its path between two steps is L + (r − δ)·Ω of that step. A step
+   that breaks this by a quarter of the step is a jump too (step 4); smaller differences summed over
+   the run are the rim's slip (reported; beyond :attr:`WheelPolicy.max_slip` the rolling stops with
+   :class:`WheelSlip`, as the L readings are no longer the part's arc).
 
 :func:`localize_with_wheel` rolls one way, turning round at a jump, and gives the readings to a
 :class:`localizer.WheelFilter` until it is sure (or the budget is spent).
@@ -33,7 +35,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from localizer import Belief, Part, WheelFilter, WheelJaw
+from localizer import Belief, Part, WheelFilter, WheelJaw, wheel_reach_for
 
 from .procedures import PRESS, Hand, PressSettings, delta_voltages, press, zero
 from .reactive import CONFIDENCE, MAX_ROTATION
@@ -46,11 +48,20 @@ __all__ = [
     "WheelRun",
     "localize_with_wheel",
     "JUMP_FLOOR",
+    "JUMP_MISMATCH",
+    "WheelSlip",
 ]
 
-#: A step's change of turn beyond the part's steepest turning over the rolled arc by this (rad) is a jump:
-#: 0.5°, twenty times the wrist's residual direction.
+#: A step's change of turn outside the part's turning over the rolled arc by this (rad) is a jump: 0.5°,
+#: twenty times the wrist's residual direction.
 JUMP_FLOOR = math.radians(0.5)
+#: A step whose axle path and encoders disagree by more than this fraction of the step is a jump (slip
+#: is gradual: a rim that loses this much in one step has lost the contact).
+JUMP_MISMATCH = 0.25
+
+
+class WheelSlip(RigError):
+    """The wheel's rim slipped on the part beyond the policy's limit: its L readings are not the part's arc."""
 
 
 @runtime_checkable
@@ -155,7 +166,8 @@ class WheelRun:
         Arc rolled, both ways counted.
     steps : int
     stopped : str
-        "confident", "max_rotation", "max_arc", "blocked" (jumps both ways) or "slip".
+        "confident", "max_rotation", "max_arc" or "blocked" (jumps both ways); slip beyond the
+        policy's limit raises :class:`WheelSlip` instead.
     reversals, jumps : int
     slip : float, mm
         The rim's slip summed over the run (module notes, step 5).
@@ -234,7 +246,10 @@ class _WheelRoller:
     def __init__(self, rig, part, wheel, cal, flt, policy, pressing, observer):
         self.rig, self.part, self.wheel, self.cal, self.flt = rig, part, wheel, cal, flt
         self.policy, self.pressing, self.observer = policy, pressing, observer
-        self.kappa_max = float(part.curvature_bound)
+        reach = wheel_reach_for(part, wheel)
+        kappa = np.asarray(part.curvature_at_arc(reach.sigma[reach.reached]), dtype=float)
+        lo, hi = float(kappa.min()), float(kappa.max())
+        self.kappa_band = (lo - 0.5 * (lo + 1.0 / wheel.radius), hi + 0.5 * abs(hi))
         self.max_arc = policy.max_arc if policy.max_arc is not None else float(part.perimeter)
 
     # --------------------------------------------------------------- sensing
@@ -301,10 +316,14 @@ class _WheelRoller:
             now = self._state()
             d_turn = (now[0] + now[1]) - (prev[0] + prev[1])
             d_len = r * ((now[2] - prev[2]) - (now[1] - prev[1]))
-            if abs(d_turn) > self.kappa_max * abs(d_len) * 1.5 + JUMP_FLOOR:
+            path = math.hypot(now[3] - prev[3], now[4] - prev[4])
+            mismatch = path - abs(d_len + (r - depth) * d_turn)
+            band = sorted((self.kappa_band[0] * d_len, self.kappa_band[1] * d_len))
+            if not (band[0] - JUMP_FLOOR <= d_turn <= band[1] + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step:
                 # a jump: back to where the step started, the other way
                 self.hand.go(*pose_before)
                 prev = self._state()
+                flt.jumped(direction, margin=1.0 + pol.step)
                 jumps += 1
                 if blocked_since is not None and abs(lengths[-1] - blocked_since) < 2 * pol.step:
                     stopped = "blocked"
@@ -312,8 +331,7 @@ class _WheelRoller:
                 blocked_since = lengths[-1]
                 direction, reversals = -direction, reversals + 1
                 continue
-            path = math.hypot(now[3] - prev[3], now[4] - prev[4])
-            slip += path - abs(d_len + (r - depth) * d_turn)
+            slip += mismatch
             rotation += abs(d_turn)
             arc += abs(d_len)
             steps += 1
@@ -325,8 +343,11 @@ class _WheelRoller:
             flt.update(L, om)
             prev = now
             if abs(slip) > pol.max_slip:
-                stopped = "slip"
-                break
+                raise WheelSlip(
+                    f"the wheel's rim slipped {slip:+.3f} mm over {arc:.1f} mm rolled (the axle's path against the "
+                    f"encoders, more than {pol.max_slip} mm): its readings are not the part's arc, so the rolling "
+                    "stopped with the wheel on the part. Clean the rim and the part, or press harder"
+                )
             if steps % pol.check_every == 0:
                 belief = flt.belief()
                 history.append((rotation, belief.map_arc, belief.mass, truths[-1]))

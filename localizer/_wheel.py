@@ -6,7 +6,8 @@ the counter-clockwise boundary. It touches there when no other point of the part
 than r: the straight jaw's definition (the finger placed tangent at P does not cut into the part
 elsewhere, :mod:`localizer._reach`) for a finger that is the same all round, so one yes or no per
 point instead of an interval of places. On a concave stretch this needs the part's concave radius of
-curvature to be at least r (1 + r·κ ≥ 0), and the pocket to be wide enough for the disc.
+curvature to be at least r (1 + r·κ ≥ 0, checked on its own: a tighter arc comes nearer to the axle
+only to second order, by less than the clearance below), and the pocket to be wide enough for the disc.
 
 As for the straight jaw, ``clearance`` makes the set a little generous (a model point nearer than
 r by less than that does not block: the machined part differs from its model), and the *sure* set
@@ -125,7 +126,10 @@ class WheelReach:
         # sagitta seen from the axle, h²/(8r): the sample's own slack
         slack = self.h**2 / (8.0 * r)
         nearest, _ = tree.query(self.axle)
-        self.reached: BoolArray = nearest >= r - self.clearance - slack
+        # the disc fits the curve where it touches (1 + rκ ≥ 0): a concave arc tighter than the disc
+        # comes nearer to the axle only to second order, by less than the clearance
+        kappa = np.asarray(part.curvature_at_arc(self.sigma), dtype=float)
+        self.reached: BoolArray = (nearest >= r - self.clearance - slack) & (1.0 + r * kappa >= 0.0)
         self.sure: BoolArray = self.reached & self._only_own_stretch(tree, n, r + self.clearance + slack)
         for arr in (self.sigma, self.axle, self.reached, self.sure):
             arr.setflags(write=False)

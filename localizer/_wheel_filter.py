@@ -25,12 +25,16 @@ reading; the last term is added to each start's innovation variance. Readings cl
 mm of arc to the last one used only move the present contact (their errors are not independent of
 the last one's: the arm encoder's quantization is a function of the angle).
 
-Where the wheel reaches (:class:`~localizer.WheelReach`) is the prior, and a start is ruled out once
-the arc rolled from it, either way, runs over a point the wheel cannot touch (it would have jumped
-there, which the rolling procedure detects and undoes instead).
+Where the wheel reaches (:class:`~localizer.WheelReach`) is the prior. A start from which the arc
+rolled so far, either way, runs over a point the wheel cannot touch (it would have jumped there,
+which the rolling procedure detects and undoes instead) is made :data:`~localizer.CONTRADICTION`
+times less likely at each reading used: soft, as the straight jaw's reach is, so that a model error in
+the reach does not rule out the truth.
 
-A stated probability is the least over ``noise_scales`` (the covariance times each factor squared):
-readings noisier than the filter was told lower it instead of making it confidently wrong.
+Trust, as the straight jaw's filter (its notes, "Trust"): the readings' likelihood is raised to the
+power :data:`~localizer.TEMPER`, and a stated probability is the least over ``noise_scales`` (the
+covariance times each factor squared), so that readings noisier than the filter was told lower it
+instead of making it confidently wrong.
 
 Outlines with corners are refused: at a corner the wheel pivots, Ω changing while L does not, so Ω is
 not a function of L there (not built).
@@ -43,6 +47,7 @@ import math
 import numpy as np
 
 from ._belief import Belief, find_modes
+from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
@@ -171,6 +176,7 @@ class WheelFilter:
         self._z = np.zeros((self.grid.size, 0))
         self._quad = np.zeros(self.grid.size)
         self._logdet = np.zeros(self.grid.size)
+        self._penalty = np.zeros(self.grid.size)
         self.current = 0.0
         self.span = (0.0, 0.0)
         self.steps = 0
@@ -215,6 +221,7 @@ class WheelFilter:
         z = (rho - self._z @ ell) / np.sqrt(var)
         self._quad += z**2
         self._logdet += np.log(var)
+        self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
         self._z = np.column_stack([self._z, z * np.sqrt(var / d2)])  # whitened by the shared part alone
         k = used.size
         chol = np.zeros((k + 1, k + 1))
@@ -224,17 +231,29 @@ class WheelFilter:
         self._chol = chol
         self.L_used.append(L)
 
+    def jumped(self, direction: int, margin: float = 1.0) -> None:
+        """The wheel jumped (and was taken back) when rolling on from the present contact in
+        ``direction`` (+1: counter-clockwise). The starts under which the wheel could still have rolled
+        on for ``margin`` mm there are made :data:`~localizer.BRIDGE_MISS` times less likely (soft: a
+        jump may be read where there was none)."""
+        if direction not in (1, -1):
+            raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
+        n = self.grid.size
+        here = np.rint(self.part.wrap_arc(self.grid + self.current) / self.h).astype(np.int64) % n
+        free = (self._ahead if direction > 0 else self._behind)[here]
+        self._penalty += np.where(free > margin, math.log(BRIDGE_MISS), 0.0)
+
     # --------------------------------------------------------------- belief
-    def alive(self) -> BoolArray:
+    def _clear(self) -> BoolArray:
         """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
         lo, hi = self.span
         tol = 2 * self.h
-        ok: BoolArray = (self._ahead + tol >= hi) & (self._behind + tol >= -lo) & (self.prior > 0)
+        ok: BoolArray = (self._ahead + tol >= hi) & (self._behind + tol >= -lo)
         return ok
 
     def _posterior(self, factor: float) -> FloatArray:
-        ll = -0.5 * self._quad / factor**2 - 0.5 * self._logdet
-        ll = np.where(self.alive(), ll, -np.inf)
+        ll = TEMPER * (-0.5 * self._quad / factor**2 - 0.5 * self._logdet) + self._penalty
+        ll = np.where(self.prior > 0, ll, -np.inf)
         top = ll.max()
         if not np.isfinite(top):
             raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")

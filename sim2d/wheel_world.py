@@ -1,11 +1,12 @@
 """A kinematic world for the wheel finger: a disc on an axle, pressed on the part through a compliant wrist.
 
-The hand pose (x, y, φ) puts the axle at (x, y); the hand's axis points from the axle towards the
-part along m = (−sin φ, cos φ), as the straight jaw's normal does. The disc of radius r touches the
-part at the part's point nearest to the axle (the disc cannot cut in; the wrist gives by the depth
-r − distance, and the force is the wrist's stiffness times that depth). The force acts along the line
-from the contact to the axle: its angle β, with the contact at direction (−sin β, cos β) from the
-axle, is the contact normal's tangent angle (β = θ on a smooth stretch).
+The hand pose (x, y, φ) commands the axle at (x, y); the hand's axis points from the axle towards the
+part along m = (−sin φ, cos φ), as the straight jaw's normal does. The rigid disc of radius r cannot
+cut into the part: the wrist gives, the disc's centre displaced from the commanded axle to the nearest
+place where nothing of the part is nearer than r (pushed out along the contact normal; in a pocket
+too narrow for it, the disc rests on both walls). The force is the wrist's stiffness times the
+displacement (the depth), along it: its angle β, the displacement being along (sin β, −cos β), is the
+contact normal's tangent angle (β = θ on a smooth stretch).
 
 The disc turns on its bearing only by rolling (docs/wheel.md): while the contact runs along the part
 by dσ, the disc turns by dθ + dσ/r in the world (its material point at the contact at rest), i.e.
@@ -121,33 +122,50 @@ class WheelWorld:
                 best = (d, float((a0 + u * da) % self.perimeter), p)
         return best[1], best[2], best[0]
 
+    def _seat(self, c: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, float]:
+        """Where the disc sits with its axle commanded at ``c``: (model arc of the contact, contact point,
+        the disc's centre, depth mm). The wrist gives so that no point of the part comes nearer to the
+        disc's centre than r: the centre is pushed out from the nearest point, again until nothing is
+        nearer (in a pocket too narrow for the disc it settles touching both walls). Depth ≤ 0: clear."""
+        arc, p, d = self._nearest(c)
+        if d >= self.radius:
+            return arc, p, c, self.radius - d
+        if d < 1e-9:
+            raise SimError(f"the axle was commanded onto the part at {tuple(np.round(c, 4))}: press less")
+        centre = c
+        for _ in range(200):
+            centre = p + (centre - p) * (self.radius / d)
+            arc, p, d = self._nearest(centre)
+            if d >= self.radius - 1e-9:
+                break
+        return arc, p, centre, float(np.hypot(*(centre - c)))
+
     def set_hand(self, x: float, y: float, phi: float) -> None:
         """Put the axle at (``x``, ``y``) mm and the hand at angle ``phi`` rad; the disc rolls there."""
         self.hand = (float(x), float(y), float(phi))
-        c = np.array([x, y], dtype=float)
-        arc, p, d = self._nearest(c)
-        if d >= self.radius:  # clear: the disc keeps its angle on the bearing
+        arc, p, centre, depth = self._seat(np.array([x, y], dtype=float))
+        if depth <= 0:  # clear: the disc keeps its angle on the bearing
             self._last = None
             return
         if self._last is not None:
             arc0, p0, c0 = self._last
-            turn = _angle(c - p) - _angle(c0 - p0)
+            turn = _angle(centre - p) - _angle(c0 - p0)
             turn = (turn + math.pi) % (2 * math.pi) - math.pi
             along = (arc - arc0 + self.perimeter / 2) % self.perimeter - self.perimeter / 2
             rolled = abs(along) <= float(np.hypot(*(p - p0))) + JUMP_EXCESS
             self.psi += turn + (along * (1.0 - self.slip) / self.radius if rolled else 0.0)
-        self._last = (arc, p, c)
+        self._last = (arc, p, centre)
 
     def contact(self) -> WheelContact:
-        """The contact for the present axle pose (force 0 when the disc is clear)."""
+        """The contact for the present axle pose (force 0 when the disc is clear). The force is the
+        wrist's spring, along the disc's displacement from the commanded axle."""
         if self.hand is None:
             return WheelContact(0.0, math.nan, math.nan, -math.inf)
         c = np.array(self.hand[:2])
-        arc, p, d = self._nearest(c)
-        depth = self.radius - d
+        arc, p, centre, depth = self._seat(c)
         if depth <= 0:
             return WheelContact(0.0, math.nan, math.nan, depth)
-        v = p - c  # from the axle to the contact: (−sin β, cos β)
+        v = c - centre  # the spring pulls the disc back towards the commanded axle: (−sin β, cos β)
         return WheelContact(self.stiffness * depth, math.atan2(-v[0], v[1]), arc, depth)
 
     def encoder(self) -> float:
