@@ -89,14 +89,16 @@ class WheelWorld:
             raise SimError(f"slip={slip!r} must be in [0, 1)")
         self.radius, self.stiffness, self.slip = float(radius), float(stiffness), float(slip)
         self.perimeter = float(model.perimeter)
+        self._spline: Part | None = None
         if isinstance(part, MachinedOutline):
             self._xy, self._arc = np.asarray(part.xy, dtype=float), np.asarray(part.arcs, dtype=float)
         elif isinstance(part, Part):
             n = max(256, int(math.ceil(part.perimeter / SAMPLE_STEP)))
-            t = np.asarray(part.param_at_arc(np.arange(n) * part.perimeter / n), dtype=float)
-            self._xy = np.asarray(part.point(t), dtype=float)
+            self._t = np.asarray(part.param_at_arc(np.arange(n) * part.perimeter / n), dtype=float)
+            self._xy = np.asarray(part.point(self._t), dtype=float)
             # the machined spline's parameters are the model's (sim2d.machining.machined_part)
-            self._arc = np.asarray(model.wrap_arc(model.arc_at_param(t)), dtype=float)
+            self._arc = np.asarray(model.wrap_arc(model.arc_at_param(self._t)), dtype=float)
+            self._spline, self._model = part, model
         else:
             raise SimError(f"a wheel world needs a Part or a MachinedOutline, not {type(part).__name__}")
         self._tree = cKDTree(self._xy)
@@ -110,6 +112,7 @@ class WheelWorld:
         _, k = self._tree.query(c)
         n = self._xy.shape[0]
         best = (math.inf, 0.0, self._xy[k])
+        t_chord = (int(k), 0.0)
         for j in (k - 1, k):  # the two sample chords at the nearest sample
             a, b = self._xy[j % n], self._xy[(j + 1) % n]
             ab = b - a
@@ -120,7 +123,31 @@ class WheelWorld:
                 a0, a1 = self._arc[j % n], self._arc[(j + 1) % n]
                 da = (a1 - a0 + self.perimeter / 2) % self.perimeter - self.perimeter / 2
                 best = (d, float((a0 + u * da) % self.perimeter), p)
-        return best[1], best[2], best[0]
+                t_chord = (j % n, u)
+        if self._spline is None:
+            return best[1], best[2], best[0]
+        return self._on_spline(c, *t_chord)
+
+    def _on_spline(self, c: np.ndarray, j: int, u: float) -> tuple[float, np.ndarray, float]:
+        """The nearest point refined on the spline from the chord's (Newton on (P − c)·T = 0)."""
+        spline = self._spline
+        assert spline is not None
+        t0, t1 = self._t[j], self._t[(j + 1) % self._t.size]
+        if t1 < t0:
+            t1 += spline.n_knots
+        t = t0 + u * (t1 - t0)
+        for _ in range(3):
+            p = spline.point(t)
+            th, k, v = float(spline.tangent_angle(t)), float(spline.curvature(t)), float(spline.speed(t))
+            rel = p - c
+            f = rel[0] * math.cos(th) + rel[1] * math.sin(th)
+            df = v * (1.0 + k * (-rel[0] * math.sin(th) + rel[1] * math.cos(th)))
+            if df <= 0:
+                break
+            t -= f / df
+        p = spline.point(t)
+        arc = float(self._model.wrap_arc(self._model.arc_at_param(t)))
+        return arc, p, float(np.hypot(*(c - p)))
 
     def _seat(self, c: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, float]:
         """Where the disc sits with its axle commanded at ``c``: (model arc of the contact, contact point,

@@ -1,0 +1,92 @@
+"""Localizing with a wheel finger on the kinematic wheel rig (issue 17): noise-free from starts inside
+concave stretches, jumps over pockets undone, slip and a wrong finger's calibration refused."""
+
+import math
+
+import numpy as np
+import pytest
+
+from driver.rig import RigError
+from driver.wheel import WheelCalibration, WheelPolicy, WheelSlip, localize_with_wheel
+from localizer import WheelJaw, WheelReach, load_part, part_from_points
+from sim2d import SimRig
+from sim2d.wheel_rig import WheelRig
+
+
+def concave_starts(part, wheel, n, seed=0):
+    reach = WheelReach(part, wheel)
+    ok = reach.sure & (np.asarray(part.curvature_at_arc(reach.sigma)) < 0)
+    return np.random.default_rng(seed).choice(reach.sigma[ok], n, replace=False)
+
+
+def localize(part, wheel, start, **rig_options):
+    rig = WheelRig(part, wheel, **rig_options)
+    run = localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(start))
+    return run, float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))
+
+
+@pytest.mark.parametrize(
+    ("part_name", "radius"),
+    [("kidney", 3.0), ("kidney", 10.0), ("lobed", 3.0)],
+)
+def test_noise_free_rolls_from_concave_starts_localize_within_the_success_radius(part_name, radius):
+    if part_name == "kidney":
+        part = load_part("parts/kidney.csv")
+    else:  # a generated part, no symmetry, whose concave radius (4.3 mm at the least) exceeds the wheel's
+        a = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+        rho = 40 + 4 * np.cos(a) + 9 * np.cos(3 * a + 0.5) + 3 * np.cos(5 * a + 1.0)
+        part = part_from_points(np.c_[rho * np.cos(a), rho * np.sin(a)], name="lobed")
+        kappa = part.curvature_at_arc(np.linspace(0, part.perimeter, 5000))
+        assert -1 / radius < kappa.min() < -0.2
+    wheel = WheelJaw(radius)
+    for start in concave_starts(part, wheel, 3):
+        run, err = localize(part, wheel, start)
+        assert run.stopped == "confident"
+        assert abs(err) < 0.3
+        assert abs(run.slip) < 0.01
+
+
+def test_a_jump_over_a_pocket_is_undone_and_the_wheel_rolls_the_other_way():
+    part = load_part("bench/parts/tuning/star-04.json")
+    wheel = WheelJaw(5.0)
+    run, err = localize(part, wheel, 161.3)  # 5 mm before a pocket the 5 mm wheel cannot enter
+    assert run.jumps >= 1 and run.reversals >= 1
+    assert run.stopped == "confident" and abs(err) < 0.3
+    # every reading given to the filter was a rolling one: the true contact never jumped
+    true = np.asarray(run.true_arcs)
+    steps = np.abs(np.asarray(part.arc_offset(true[1:], true[:-1])))
+    assert steps.max() < 1.0
+
+
+def test_a_slipping_rim_stops_the_rolling_with_the_slip_named():
+    part = load_part("parts/kidney.csv")
+    wheel = WheelJaw(5.0)
+    with pytest.raises(WheelSlip, match=r"slipped [+-]\d"):
+        localize(part, wheel, 60.0, slip=0.05)
+
+
+def test_a_calibration_for_another_finger_and_a_rig_without_an_axle_encoder_are_refused():
+    part = load_part("parts/kidney.csv")
+    rig = WheelRig(part, WheelJaw(5.0))
+    with pytest.raises(RigError, match="calibration is for wheel:3"):
+        localize_with_wheel(
+            rig,
+            part,
+            WheelJaw(5.0),
+            approach_pose=rig.approach_pose(60.0),
+            calibration=WheelCalibration.nominal(WheelJaw(3.0)),
+        )
+    straight = SimRig(part)
+    with pytest.raises(RigError, match="no axle encoder"):
+        localize_with_wheel(straight, part, WheelJaw(5.0), approach_pose=(0.0, 0.0, 0.0))
+    with pytest.raises(RigError, match="step"):
+        WheelPolicy(step=-1.0)
+
+
+def test_a_mounting_rotation_is_taken_out_by_the_calibration():
+    part = load_part("parts/kidney.csv")
+    wheel = WheelJaw(5.0)
+    rig = WheelRig(part, wheel, direction_zero=math.radians(2.0))
+    cal = WheelCalibration(jaw="wheel:5", radius=5.0, direction_zero=math.radians(2.0))
+    run = localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(65.0), calibration=cal)
+    assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3

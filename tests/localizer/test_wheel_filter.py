@@ -1,0 +1,110 @@
+"""The wheel's sequential filter (issue 17): its likelihood against the full Gaussian density, its belief
+against the truth on noise-free rolls from concave starts, its reach and its refusals."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.stats import multivariate_normal
+
+from localizer import QueryError, WheelFilter, WheelJaw, load_part, part_from_points
+from localizer._wheel_filter import _free_runs
+
+from .test_wheel import peanut
+
+KIDNEY = "parts/kidney.csv"
+
+
+def theta(part, s):
+    s = np.asarray(s, dtype=float)
+    laps = np.floor(s / part.perimeter)
+    return part.tangent_angle(part.param_at_arc(s - laps * part.perimeter)) + 2 * np.pi * laps
+
+
+def test_the_grown_factor_gives_the_full_gaussian_density_of_the_residuals():
+    part = load_part(KIDNEY)
+    f = WheelFilter(part, WheelJaw(5.0), sd_length=0.0, sd_scale=0.0, thin=0.7)
+    rng = np.random.default_rng(3)
+    lengths = np.arange(0.5, 20.0, 0.5)
+    turns = rng.normal(0.0, 0.2, lengths.size).cumsum() * 0.01
+    for L, om in zip(lengths, turns):
+        f.update(L, om)
+    used = np.array(f.L_used)
+    cov = f._cov(used, used)  # the documented covariance, built in one piece
+    picks = (100, 3000, 7000)
+    full = []
+    for i in picks:
+        rho = np.interp(used, lengths, turns) - (theta(part, f.grid[i] + used) - theta(part, f.grid[i]))
+        full.append(multivariate_normal(np.zeros(used.size), cov).logpdf(rho))
+    # log N = -½ quad - ½ log det - k/2 log 2π; compare differences between starts
+    ours = -0.5 * f._quad[list(picks)] - 0.5 * f._logdet[list(picks)]
+    assert np.allclose(np.diff(ours), np.diff(full), rtol=1e-6, atol=1e-6)
+
+
+@pytest.mark.parametrize("radius", [3.0, 10.0])
+def test_noise_free_rolls_from_concave_starts_end_sure_at_the_truth(radius):
+    part = load_part(KIDNEY)
+    sigma = np.linspace(0, part.perimeter, 600, endpoint=False)
+    starts = sigma[part.curvature_at_arc(sigma) < 0][::8]
+    assert starts.size >= 5
+    for s in starts:
+        f = WheelFilter(part, WheelJaw(radius))
+        for L in np.arange(0.25, 60.0, 0.25):
+            f.update(L, float(theta(part, s + L) - theta(part, s)))
+            b = f.belief() if f.steps % 4 == 0 else None
+            if b is not None and b.mass >= 0.95:
+                break
+        assert b is not None and b.mass >= 0.95
+        assert abs(float(part.arc_offset(b.map_arc, s + L))) < 0.05
+
+
+def test_a_start_whose_roll_runs_over_what_the_wheel_cannot_touch_is_unlikely_not_ruled_out():
+    outline, _ = peanut()  # waists of 10 mm: a 12 mm wheel cannot touch them
+    dense = np.asarray(outline.point_at_arc(np.linspace(0, outline.perimeter, 400, endpoint=False)))
+    part = part_from_points(dense, name="peanut")
+    f = WheelFilter(part, WheelJaw(12.0))
+    assert 0 < f.prior.mean() < 1
+    blocked = np.flatnonzero(f.prior > 0)
+    for L in np.arange(1.0, 31.0, 1.0):
+        f.update(L, 0.0)
+    clear = f._clear()
+    assert not clear[blocked].all() and clear[blocked].any()
+    assert np.all(f._penalty[~clear & (f.prior > 0)] <= math.log(1e-3) + 1e-9)  # CONTRADICTION at a reading used
+    assert np.all(f._penalty[clear] == 0)
+
+
+def test_free_runs_count_the_arc_to_the_next_untouchable_point_both_ways():
+    touch = np.array([True, True, False, True, True, True, False, True])
+    ahead, behind = _free_runs(touch, 0.5)
+    assert ahead.tolist() == [0.5, 0.0, -1.0, 1.0, 0.5, 0.0, -1.0, 1.0]
+    assert behind.tolist() == [0.5, 1.0, -1.0, 0.0, 0.5, 1.0, -1.0, 0.0]
+    assert np.isinf(_free_runs(np.ones(5, bool), 1.0)[0]).all()
+
+
+def test_a_jump_makes_the_starts_that_could_have_rolled_on_unlikely():
+    outline, _ = peanut()
+    part = part_from_points(np.asarray(outline.point_at_arc(np.linspace(0, outline.perimeter, 400, endpoint=False))))
+    f = WheelFilter(part, WheelJaw(12.0))
+    f.jumped(+1)
+    here = np.rint(f.grid / f.h).astype(int) % f.grid.size
+    rolls_on = f._ahead[here] > 1.0
+    assert np.all(f._penalty[rolls_on] == pytest.approx(math.log(0.05)))
+    assert np.all(f._penalty[~rolls_on] == 0)
+    with pytest.raises(QueryError, match="direction"):
+        f.jumped(0)
+
+
+def test_bad_settings_and_drawings_are_refused():
+    part = load_part(KIDNEY)
+    with pytest.raises(QueryError, match="spacing"):
+        WheelFilter(part, WheelJaw(5.0), spacing=0.0)
+    with pytest.raises(QueryError, match="sd_turn"):
+        WheelFilter(part, WheelJaw(5.0), sd_turn=0.0)
+    with pytest.raises(QueryError, match="noise_scales"):
+        WheelFilter(part, WheelJaw(5.0), noise_scales=(0.5,))
+    outline, _ = peanut()
+    with pytest.raises(QueryError, match="spline parts only"):
+        WheelFilter(outline, WheelJaw(5.0))  # type: ignore[arg-type]
+    f = WheelFilter(part, WheelJaw(5.0))
+    with pytest.raises(QueryError, match="finite"):
+        f.update(math.nan, 0.0)
