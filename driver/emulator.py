@@ -160,6 +160,10 @@ class Emulator:
             return [encode_reply(seq, "OK", float(x), float(y), float(math.degrees(phi)))]
         if cmd == "STOP":
             return [encode_reply(seq, "OK")]
+        if cmd == "AXLE":
+            if not callable(getattr(self.rig, "axle", None)):
+                return [encode_reply(seq, "ERR", "UNSUPPORTED", "this hand has no wheel on an axle encoder")]
+            return [encode_reply(seq, "OK", float(math.degrees(self.rig.axle())))]
         if cmd == "SERVO":
             target, gain, guard, ms = args
             if not (target > 0 and gain >= 0 and guard in (0, 1) and 1 <= ms <= 10000):

@@ -366,6 +366,8 @@ class Calibration:
         Measured Δv2/Δv1 at each tap.
     target : float, V
         Δv1 held during the taps.
+    jaw : str
+        The finger calibrated (the paper's 100 mm jaw): refused for another.
 
     Examples
     --------
@@ -379,6 +381,7 @@ class Calibration:
     positions: tuple
     ratios: tuple
     target: float = 0.4
+    jaw: str = "straight:100"
     _r: np.ndarray = field(init=False, repr=False, compare=False)  # the ratios, ascending
     _d: np.ndarray = field(init=False, repr=False, compare=False)  # the positions in that order, mm
 
@@ -421,19 +424,18 @@ class Calibration:
 
     def save(self, path) -> None:
         """Write as JSON."""
-        Path(path).write_text(
-            json.dumps(
-                {"positions": list(self.positions), "ratios": list(self.ratios), "target": self.target}, indent=2
-            )
-            + "\n"
-        )
+        doc = {"jaw": self.jaw, "positions": list(self.positions), "ratios": list(self.ratios), "target": self.target}
+        Path(path).write_text(json.dumps(doc, indent=2) + "\n")
 
     @classmethod
     def load(cls, path) -> Calibration:
         """Read a calibration written by :meth:`save`."""
         try:
             data = json.loads(Path(path).read_text())
-            return cls(tuple(data["positions"]), tuple(data["ratios"]), float(data.get("target", 0.4)))
+            jaw = str(data.get("jaw", "straight:100"))  # files from before fingers were named: the paper's jaw
+            if not jaw.startswith("straight"):
+                raise ValueError(f"it is a calibration of a {jaw} finger, not of a straight jaw")
+            return cls(tuple(data["positions"]), tuple(data["ratios"]), float(data.get("target", 0.4)), jaw)
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise RigError(f"calibration file {path}: {exc}") from None
 

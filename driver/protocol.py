@@ -27,7 +27,7 @@ __all__ = [
 ]
 
 #: Commands of each device and their argument counts.
-ARM_COMMANDS = {"MOVE": 3, "POSE": 0, "STOP": 0, "STATUS": 0, "SERVO": 4}
+ARM_COMMANDS = {"MOVE": 3, "POSE": 0, "STOP": 0, "STATUS": 0, "SERVO": 4, "AXLE": 0}
 DAQ_COMMANDS = {"READ": 1, "STREAM": 1, "ZERO": 0, "STATUS": 0}
 #: Longest line either side sends, bytes (a longer one is garbage).
 MAX_LINE = 256

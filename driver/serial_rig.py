@@ -197,6 +197,14 @@ class SerialRig:
         x, y, phi_deg = self._transact("arm", "POSE").numbers(3)
         return Pose(x, y, math.radians(phi_deg))
 
+    def axle(self) -> float:
+        """AXLE: a wheel finger's axle encoder, the disc's angle relative to the hand (rad). An arm whose
+        hand has no wheel answers ``ERR UNSUPPORTED`` (:class:`ProtocolError`)."""
+        (psi_deg,) = self._transact("arm", "AXLE").numbers(1)
+        psi = math.radians(psi_deg)
+        self._emit({"event": "axle", "psi": psi})
+        return psi
+
     def read(self, n: int = 32) -> tuple:
         """READ n: averaged (v1, v2) in volts; stops the run above the overload limit."""
         v1, v2 = self._transact("daq", "READ", int(n)).numbers(2)

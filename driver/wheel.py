@@ -29,15 +29,17 @@ wheel too. Each rolling step:
 
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from localizer import Belief, Part, WheelFilter, WheelJaw, wheel_reach_for
 
-from .procedures import PRESS, Hand, PressSettings, delta_voltages, press, zero
+from .procedures import PRESS, Calibration, Hand, PressSettings, delta_voltages, press, zero
 from .reactive import CONFIDENCE, MAX_ROTATION
 from .rig import GroundTruth, Rig, RigError
 
@@ -47,6 +49,10 @@ __all__ = [
     "WheelPolicy",
     "WheelRun",
     "localize_with_wheel",
+    "calibrate_wheel",
+    "load_calibration",
+    "check_calibration",
+    "kappa_band",
     "JUMP_FLOOR",
     "JUMP_MISMATCH",
     "WheelSlip",
@@ -65,8 +71,8 @@ class WheelSlip(RigError):
 
 
 @runtime_checkable
-class AxleEncoder(Protocol):
-    """A rig with a wheel finger: it reads the disc's angle on its axle."""
+class AxleEncoder(Rig, Protocol):
+    """A rig with a wheel finger: it also reads the disc's angle on its axle."""
 
     def axle(self) -> float:
         """The axle encoder: the disc's angle relative to the hand, rad (counting, not wrapped)."""
@@ -85,11 +91,26 @@ class WheelCalibration:
         The wheel's effective rolling radius.
     direction_zero : float, rad
         The wrist channels' mounting rotation: subtracted from atan2(Δv2, Δv1).
+    depth : float, mm
+        The wrist's give at the target force, measured where it was calibrated (NaN: not measured).
+    residual : float, mm
+        RMS misfit of the axle path's steps to the rolling identity (NaN: not measured).
+    steps : int
+        Rolling steps the calibration used (0: the wheel's drawing).
     """
 
     jaw: str
     radius: float
     direction_zero: float = 0.0
+    depth: float = math.nan
+    residual: float = math.nan
+    steps: int = 0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.radius) and self.radius > 0):
+            raise RigError(f"wheel calibration radius={self.radius!r} mm must be a positive number")
+        if not math.isfinite(self.direction_zero):
+            raise RigError(f"wheel calibration direction_zero={self.direction_zero!r} rad must be finite")
 
     @classmethod
     def nominal(cls, wheel: WheelJaw) -> WheelCalibration:
@@ -100,6 +121,13 @@ class WheelCalibration:
         """Refuse this calibration for another finger."""
         if self.jaw != str(wheel):
             raise RigError(f"the calibration is for {self.jaw}, the finger is {wheel}: calibrate this finger first")
+
+    def as_dict(self) -> dict:
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in asdict(self).items()}
+
+    def save(self, path) -> None:
+        """Write as JSON (the finger named, so that it is refused for another)."""
+        Path(path).write_text(json.dumps(self.as_dict(), indent=2) + "\n")
 
 
 @dataclass(frozen=True)
@@ -197,8 +225,188 @@ class WheelRun:
         return self.belief.map_arc
 
 
-def _direction(dv1: float, dv2: float, cal: WheelCalibration) -> float:
-    return math.atan2(dv2, dv1) - cal.direction_zero
+class _Wheel:
+    """A wheel pressed on the part: the servo, the settled readings and one checked step (module notes)."""
+
+    def __init__(self, rig, cal: WheelCalibration, policy: WheelPolicy, pressing: PressSettings, kappa_band):
+        if not isinstance(rig, AxleEncoder):
+            raise RigError(f"{type(rig).__name__} has no axle encoder: a wheel finger needs one (docs/wheel.md)")
+        self.rig, self.cal, self.policy, self.pressing = rig, cal, policy, pressing
+        self.kappa_band = kappa_band
+
+    def begin(self, approach_pose) -> tuple[float, float, float, float, float]:
+        """Zero the wrist clear of the part, press from ``approach_pose``, measure the wrist's stiffness;
+        the first settled state (φ, α, ψ_e, x, y)."""
+        pol = self.policy
+        self.hand = Hand(self.rig, approach_pose)
+        self.baseline = zero(self.rig)
+        dv1, _ = press(self.rig, self.hand, self.baseline, target=pol.target, n=pol.n, pressing=self.pressing)
+        # the wrist's stiffness seen at the contact (V/mm): back off 0.2 mm and read again
+        self.hand.press_by(-0.2)
+        lighter, _ = self._read()
+        self.hand.press_by(0.2)
+        self.stiffness = max((dv1 - lighter) / 0.2, 1e-3)
+        self.depth = pol.target / self.stiffness
+        self.state = self._state()
+        return self.state
+
+    def _read(self) -> tuple[float, float]:
+        """(|Δv| V, α rad) from the wrist."""
+        dv1, dv2 = delta_voltages(self.rig, self.baseline, self.policy.n)
+        return math.hypot(dv1, dv2), math.atan2(dv2, dv1) - self.cal.direction_zero
+
+    def _settle(self) -> tuple[float, float]:
+        """Servo the hand to the contact normal and the force to the target (module notes, step 2)."""
+        pol = self.policy
+        f, a = self._read()
+        for _ in range(pol.servo_iterations):
+            if abs(a) <= pol.angle_tol and abs(f - pol.target) <= pol.force_tol:
+                break
+            x, y, phi = self.hand.pose
+            beta = phi + a
+            if f < 0.1 * pol.target:  # clear of the part: press back along the hand's axis
+                push = self.pressing.search_step
+            else:
+                push = float(np.clip((pol.target - f) / self.stiffness, -1.0, 1.0))
+            self.hand.go(x - push * math.sin(beta), y + push * math.cos(beta), beta)
+            f, a = self._read()
+        if f < 0.1 * pol.target:
+            raise RigError(f"the wheel lost the part (|Δv| = {f:.3g} V after the step): start again closer")
+        return f, a
+
+    def _state(self) -> tuple[float, float, float, float, float]:
+        """(φ, α, ψ_e, x, y) at a settled pose."""
+        _, a = self._settle()
+        x, y, _ = self.rig.pose()
+        phi = float(self.hand.measured_angle())
+        return phi, a, float(self.rig.axle()), float(x), float(y)
+
+    def step(self, direction: int) -> tuple[float, float, float] | None:
+        """Roll one step ``direction`` (+1: counter-clockwise); (ΔΩ rad, ΔL mm, the axle path's mismatch mm),
+        or None after a jump, which is undone (the hand back where the step started)."""
+        pol, r = self.policy, self.cal.radius
+        before, prev = self.hand.pose, self.state
+        x, y, phi = before
+        self.hand.go(x + direction * pol.step * math.cos(phi), y + direction * pol.step * math.sin(phi), phi)
+        now = self._state()
+        d_turn = (now[0] + now[1]) - (prev[0] + prev[1])
+        d_len = r * ((now[2] - prev[2]) - (now[1] - prev[1]))
+        path = math.hypot(now[3] - prev[3], now[4] - prev[4])
+        mismatch = path - abs(d_len + (r - self.depth) * d_turn)
+        lo, hi = sorted((self.kappa_band[0] * d_len, self.kappa_band[1] * d_len))
+        if not (lo - JUMP_FLOOR <= d_turn <= hi + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step:
+            self.hand.go(*before)
+            self.state = self._state()
+            return None
+        self.state = now
+        return d_turn, d_len, mismatch
+
+    def truth(self) -> float:
+        return float(self.rig.truth()["contact_arc"]) if isinstance(self.rig, GroundTruth) else math.nan
+
+
+def calibrate_wheel(
+    rig: Rig,
+    wheel: WheelJaw,
+    approach_pose,
+    *,
+    part: Part | None = None,
+    length: float = 40.0,
+    policy: WheelPolicy = WheelPolicy(),
+    pressing: PressSettings = PRESS,
+) -> WheelCalibration:
+    """Calibrate a wheel by rolling it ``length`` mm on anything smooth it fits (the part, a gauge block).
+
+    What replaces the straight jaw's taps (docs/wheel.md): under pure rolling the commanded axle, pressed
+    δ into the wrist, runs along the offset at r − δ, so each step's path (from the arm) is
+    r·(Δψ_e + Δφ) − δ·ΔΩ, whatever the surface. With δ measured at the press (the wrist's stiffness),
+    the least-squares r over the steps is the **effective radius**. The axle path's direction is the
+    surface's tangent, so its chords against the force's direction give the channels' **mounting
+    rotation** (the direction zero). The axle's place in the hand is taken from the drawing (the
+    simulated hand's pose is the axle; not calibrated here).
+
+    Parameters
+    ----------
+    rig : Rig with an axle encoder
+    wheel : WheelJaw
+        The finger, its nominal radius the first guess.
+    approach_pose : (x mm, y mm, φ rad)
+        Clear of a smooth surface the wheel fits along ``length`` mm counter-clockwise.
+    part : Part, optional
+        The surface's model, to tell a jump from rolling (default: any curvature from −1/2r up).
+    length : float, mm
+        Axle travel; the radius's error falls as 1/length.
+    """
+    if not (math.isfinite(length) and length > 0):
+        raise RigError(f"calibration length={length!r} mm must be a positive number")
+    band = kappa_band(part, wheel) if part is not None else (-0.5 / wheel.radius, math.inf)
+    disc = _Wheel(rig, WheelCalibration.nominal(wheel), policy, pressing, band)
+    states = [disc.begin(approach_pose)]
+    travelled = 0.0
+    while travelled < length:
+        if disc.step(+1) is None:
+            raise RigError(
+                f"the wheel jumped {travelled:.1f} mm into its calibration roll: calibrate on a smooth stretch "
+                f"the {wheel} fits for {length:g} mm counter-clockwise"
+            )
+        travelled += math.hypot(disc.state[3] - states[-1][3], disc.state[4] - states[-1][4])
+        states.append(disc.state)
+    disc.hand.press_by(-(disc.depth + 2.0))  # off the surface, 2 mm clear
+    st = np.asarray(states)
+    phi, alpha, psi, x, y = st.T
+    path = np.hypot(np.diff(x), np.diff(y))
+    a = np.diff(psi) + np.diff(phi)
+    b = np.diff(phi + alpha)
+    radius = float(a @ (path + disc.depth * b) / (a @ a))
+    residual = float(np.sqrt(np.mean((path - radius * a + disc.depth * b) ** 2)))
+    # chords of about 2 mm against the mean force direction at their ends
+    m = max(1, int(round(2.0 / policy.step)))
+    chord = np.arctan2(y[m:] - y[:-m], x[m:] - x[:-m])
+    beta = phi + alpha
+    mid = 0.5 * (beta[m:] + beta[:-m])
+    zero = float(np.angle(np.mean(np.exp(1j * (chord - mid)))))
+    return WheelCalibration(
+        jaw=str(wheel), radius=radius, direction_zero=zero, depth=disc.depth, residual=residual, steps=len(path)
+    )
+
+
+def load_calibration(path) -> Calibration | WheelCalibration:
+    """Read a calibration file of either finger (:meth:`Calibration.save`, :meth:`WheelCalibration.save`)."""
+    try:
+        data = json.loads(Path(path).read_text())
+        if not isinstance(data, dict):
+            raise TypeError("not a JSON object")
+        jaw = str(data.get("jaw", "straight:100"))
+        if jaw.startswith("wheel"):
+            nan = math.nan
+            return WheelCalibration(
+                jaw=jaw,
+                radius=float(data["radius"]),
+                direction_zero=float(data.get("direction_zero", 0.0)),
+                depth=float(data["depth"]) if data.get("depth") is not None else nan,
+                residual=float(data["residual"]) if data.get("residual") is not None else nan,
+                steps=int(data.get("steps", 0)),
+            )
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise RigError(f"calibration file {path}: {exc}") from None
+    return Calibration.load(path)
+
+
+def check_calibration(calibration: Calibration | WheelCalibration, finger) -> None:
+    """Refuse a calibration made for another finger than ``finger`` (a StraightJaw or WheelJaw)."""
+    jaw = calibration.jaw
+    if jaw != str(finger):
+        raise RigError(f"the calibration is for {jaw}, the finger is {finger}: calibrate this finger first")
+
+
+def kappa_band(part: Part, wheel: WheelJaw) -> tuple[float, float]:
+    """The curvatures (1/mm) a step of rolling on ``part`` may show: those of the stretches the wheel
+    reaches, widened half way to −1/r on the concave side (a disc jammed between two walls reads exactly
+    −1/r) and by half on the convex side (module notes, step 4)."""
+    reach = wheel_reach_for(part, wheel)
+    kappa = np.asarray(part.curvature_at_arc(reach.sigma[reach.reached]), dtype=float)
+    lo, hi = float(kappa.min()), float(kappa.max())
+    return lo - 0.5 * (lo + 1.0 / wheel.radius), hi + 0.5 * abs(hi)
 
 
 def localize_with_wheel(
@@ -233,148 +441,73 @@ def localize_with_wheel(
     observer : callable, optional
         Called with ``{"event": "belief", ...}`` at every check.
     """
-    if not isinstance(rig, AxleEncoder):
-        raise RigError(f"{type(rig).__name__} has no axle encoder: a wheel finger needs one (docs/wheel.md)")
     cal = calibration if calibration is not None else WheelCalibration.nominal(wheel)
     cal.check(wheel)
+    disc = _Wheel(rig, cal, policy, pressing, kappa_band(part, wheel))
     flt = filter if filter is not None else WheelFilter(part, wheel)
     flt.reset()
-    return _WheelRoller(rig, part, wheel, cal, flt, policy, pressing, observer).run(approach_pose)
-
-
-class _WheelRoller:
-    def __init__(self, rig, part, wheel, cal, flt, policy, pressing, observer):
-        self.rig, self.part, self.wheel, self.cal, self.flt = rig, part, wheel, cal, flt
-        self.policy, self.pressing, self.observer = policy, pressing, observer
-        reach = wheel_reach_for(part, wheel)
-        kappa = np.asarray(part.curvature_at_arc(reach.sigma[reach.reached]), dtype=float)
-        lo, hi = float(kappa.min()), float(kappa.max())
-        self.kappa_band = (lo - 0.5 * (lo + 1.0 / wheel.radius), hi + 0.5 * abs(hi))
-        self.max_arc = policy.max_arc if policy.max_arc is not None else float(part.perimeter)
-
-    # --------------------------------------------------------------- sensing
-    def _read(self) -> tuple[float, float]:
-        """(|Δv| V, α rad) from the wrist."""
-        dv1, dv2 = delta_voltages(self.rig, self.baseline, self.policy.n)
-        return math.hypot(dv1, dv2), _direction(dv1, dv2, self.cal)
-
-    def _settle(self) -> tuple[float, float]:
-        """Servo the hand to the contact normal and the force to the target (module notes, step 2)."""
-        pol = self.policy
-        f, a = self._read()
-        for _ in range(pol.servo_iterations):
-            if abs(a) <= pol.angle_tol and abs(f - pol.target) <= pol.force_tol:
+    pol = policy
+    max_arc = pol.max_arc if pol.max_arc is not None else float(part.perimeter)
+    start = disc.begin(approach_pose)
+    lengths, turns, truths, history = [0.0], [0.0], [disc.truth()], []
+    flt.update(0.0, 0.0)
+    direction, reversals, jumps, steps = 1, 0, 0, 0
+    rotation = arc = slip = 0.0
+    blocked_at: float | None = None
+    stopped = "max_rotation"
+    while True:
+        moved = disc.step(direction)
+        if moved is None:
+            flt.jumped(direction, margin=1.0 + pol.step)
+            jumps += 1
+            if blocked_at is not None and abs(lengths[-1] - blocked_at) < 2 * pol.step:
+                stopped = "blocked"
                 break
-            x, y, phi = self.hand.pose
-            beta = phi + a
-            if f < 0.1 * pol.target:  # clear of the part: press back along the hand's axis
-                push = self.pressing.search_step
-            else:
-                push = float(np.clip((pol.target - f) / self.stiffness, -1.0, 1.0))
-            self.hand.go(x - push * math.sin(beta), y + push * math.cos(beta), beta)
-            f, a = self._read()
-        if f < 0.1 * pol.target:
-            raise RigError(f"the wheel lost the part (|Δv| = {f:.3g} V after the step): start again closer")
-        return f, a
-
-    def _state(self) -> tuple[float, float, float, float, float]:
-        """(φ, α, ψ_e, x, y) at a settled pose."""
-        f, a = self._settle()
-        x, y, _ = self.rig.pose()
-        phi = float(self.hand.measured_angle())
-        return phi, a, float(self.rig.axle()), float(x), float(y)
-
-    def _truth(self) -> float:
-        return float(self.rig.truth()["contact_arc"]) if isinstance(self.rig, GroundTruth) else math.nan
-
-    # ------------------------------------------------------------------- run
-    def run(self, approach_pose) -> WheelRun:
-        pol, flt = self.policy, self.flt
-        self.baseline = zero(self.rig)
-        self.hand = Hand(self.rig, approach_pose)
-        dv1, _ = press(self.rig, self.hand, self.baseline, target=pol.target, n=pol.n, pressing=self.pressing)
-        # the wrist's stiffness seen at the contact (V/mm): back off 0.2 mm and read again
-        self.hand.press_by(-0.2)
-        lighter, _ = self._read()
-        self.hand.press_by(0.2)
-        self.stiffness = max((dv1 - lighter) / 0.2, 1e-3)
-        depth = pol.target / self.stiffness
-        r = self.cal.radius
-        start = self._state()
-        prev = start
-        lengths, turns, truths, history = [0.0], [0.0], [self._truth()], []
-        flt.update(0.0, 0.0)
-        direction, reversals, jumps, steps = 1, 0, 0, 0
-        rotation = arc = slip = 0.0
-        blocked_since = None
-        stopped = "max_rotation"
-        belief = flt.belief()
-        while True:
-            pose_before = self.hand.pose
-            x, y, phi = pose_before
-            self.hand.go(x + direction * pol.step * math.cos(phi), y + direction * pol.step * math.sin(phi), phi)
-            now = self._state()
-            d_turn = (now[0] + now[1]) - (prev[0] + prev[1])
-            d_len = r * ((now[2] - prev[2]) - (now[1] - prev[1]))
-            path = math.hypot(now[3] - prev[3], now[4] - prev[4])
-            mismatch = path - abs(d_len + (r - depth) * d_turn)
-            band = sorted((self.kappa_band[0] * d_len, self.kappa_band[1] * d_len))
-            if not (band[0] - JUMP_FLOOR <= d_turn <= band[1] + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step:
-                # a jump: back to where the step started, the other way
-                self.hand.go(*pose_before)
-                prev = self._state()
-                flt.jumped(direction, margin=1.0 + pol.step)
-                jumps += 1
-                if blocked_since is not None and abs(lengths[-1] - blocked_since) < 2 * pol.step:
-                    stopped = "blocked"
-                    break
-                blocked_since = lengths[-1]
-                direction, reversals = -direction, reversals + 1
-                continue
-            slip += mismatch
-            rotation += abs(d_turn)
-            arc += abs(d_len)
-            steps += 1
-            L = lengths[-1] + d_len
-            om = (now[0] + now[1]) - (start[0] + start[1])
-            lengths.append(L)
-            turns.append(om)
-            truths.append(self._truth())
-            flt.update(L, om)
-            prev = now
-            if abs(slip) > pol.max_slip:
-                raise WheelSlip(
-                    f"the wheel's rim slipped {slip:+.3f} mm over {arc:.1f} mm rolled (the axle's path against the "
-                    f"encoders, more than {pol.max_slip} mm): its readings are not the part's arc, so the rolling "
-                    "stopped with the wheel on the part. Clean the rim and the part, or press harder"
-                )
-            if steps % pol.check_every == 0:
-                belief = flt.belief()
-                history.append((rotation, belief.map_arc, belief.mass, truths[-1]))
-                if self.observer is not None:
-                    self.observer({"event": "belief", "rotation": rotation, "arc": arc, "belief": belief})
-                if belief.mass >= pol.confidence:
-                    stopped = "confident"
-                    break
-            if rotation >= pol.max_rotation:
-                stopped = "max_rotation"
+            blocked_at = lengths[-1]
+            direction, reversals = -direction, reversals + 1
+            continue
+        d_turn, d_len, mismatch = moved
+        slip += mismatch
+        rotation += abs(d_turn)
+        arc += abs(d_len)
+        steps += 1
+        now = disc.state
+        lengths.append(lengths[-1] + d_len)
+        turns.append((now[0] + now[1]) - (start[0] + start[1]))
+        truths.append(disc.truth())
+        flt.update(lengths[-1], turns[-1])
+        if abs(slip) > pol.max_slip:
+            raise WheelSlip(
+                f"the wheel's rim slipped {slip:+.3f} mm over {arc:.1f} mm rolled (the axle's path against the "
+                f"encoders, more than {pol.max_slip} mm): its readings are not the part's arc, so the rolling "
+                "stopped with the wheel on the part. Clean the rim and the part, or press harder"
+            )
+        if steps % pol.check_every == 0:
+            belief = flt.belief()
+            history.append((rotation, belief.map_arc, belief.mass, truths[-1]))
+            if observer is not None:
+                observer({"event": "belief", "rotation": rotation, "arc": arc, "belief": belief})
+            if belief.mass >= pol.confidence:
+                stopped = "confident"
                 break
-            if arc >= self.max_arc:
-                stopped = "max_arc"
-                break
-        belief = flt.belief()
-        return WheelRun(
-            belief=belief,
-            rotation=rotation,
-            arc=arc,
-            steps=steps,
-            stopped=stopped,
-            reversals=reversals,
-            jumps=jumps,
-            slip=slip,
-            depth=depth,
-            history=tuple(history),
-            lengths=tuple(lengths),
-            turns=tuple(turns),
-            true_arcs=tuple(truths),
-        )
+        if rotation >= pol.max_rotation:
+            stopped = "max_rotation"
+            break
+        if arc >= max_arc:
+            stopped = "max_arc"
+            break
+    return WheelRun(
+        belief=flt.belief(),
+        rotation=rotation,
+        arc=arc,
+        steps=steps,
+        stopped=stopped,
+        reversals=reversals,
+        jumps=jumps,
+        slip=slip,
+        depth=disc.depth,
+        history=tuple(history),
+        lengths=tuple(lengths),
+        turns=tuple(turns),
+        true_arcs=tuple(truths),
+    )

@@ -41,8 +41,10 @@ class WheelRig:
     stiffness : float, N/mm
     volts_per_newton : float, V/N
         Channel gain (the straight jaw's wrist: 0.4 V at 1 N).
+    true_radius : float, optional, mm
+        The real disc's radius (default the wheel's nominal): what the calibration finds.
     direction_zero : float, rad
-        The channels' mounting rotation about the axle: what the calibration finds.
+        The channels' mounting rotation about the axle: what the calibration finds too.
     slip : float
         Fraction of the rolled arc the rim loses (:class:`sim2d.wheel_world.WheelWorld`).
     linear_speed, angular_speed : float, mm/s and rad/s
@@ -58,6 +60,7 @@ class WheelRig:
         seed: int = 0,
         stiffness: float = 1.0,
         volts_per_newton: float = Wrist.volts_per_newton,
+        true_radius: float | None = None,
         direction_zero: float = 0.0,
         slip: float = 0.0,
         linear_speed: float = 20.0,
@@ -75,7 +78,8 @@ class WheelRig:
             if isinstance(part, Outline)
             else machined_part(part, self.noise, self.rng)
         )
-        self.world = WheelWorld(real, part, wheel.radius, stiffness=stiffness, slip=slip)
+        radius = wheel.radius if true_radius is None else float(true_radius)
+        self.world = WheelWorld(real, part, radius, stiffness=stiffness, slip=slip)
         self.volts_per_newton = float(volts_per_newton)
         self.direction_zero = float(direction_zero)
         self.linear_speed, self.angular_speed = float(linear_speed), float(angular_speed)

@@ -90,3 +90,59 @@ def test_a_mounting_rotation_is_taken_out_by_the_calibration():
     cal = WheelCalibration(jaw="wheel:5", radius=5.0, direction_zero=math.radians(2.0))
     run = localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(65.0), calibration=cal)
     assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3
+
+
+def test_the_same_wheel_localization_over_the_serial_protocol_and_a_straight_hand_refusing_the_axle():
+    from driver.emulator import Emulator
+    from driver.rig import ProtocolError
+    from driver.serial_rig import SerialRig
+
+    part = load_part("parts/kidney.csv")
+    wheel = WheelJaw(5.0)
+    start = 65.0
+    direct = WheelRig(part, wheel, noise="paper", seed=3)
+    pose = direct.approach_pose(start)
+    expected = localize_with_wheel(direct, part, wheel, approach_pose=pose)
+    emu = Emulator(WheelRig(part, wheel, noise="paper", seed=3))
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq) as rig:
+            run = localize_with_wheel(rig, part, wheel, approach_pose=pose)
+    finally:
+        emu.close()
+    assert run.estimate_arc == pytest.approx(expected.estimate_arc, abs=1e-9)
+    assert run.lengths == pytest.approx(expected.lengths, abs=1e-9)
+    assert np.isnan(run.true_arcs).all()  # a serial rig does not know the truth
+    emu = Emulator(SimRig(part))
+    arm, daq = emu.serve_tcp(0)
+    try:
+        with SerialRig(arm, daq) as rig, pytest.raises(ProtocolError, match="UNSUPPORTED"):
+            rig.axle()
+    finally:
+        emu.close()
+
+
+def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_the_part_itself(tmp_path):
+    from driver.procedures import Calibration
+    from driver.wheel import calibrate_wheel, load_calibration
+
+    part = load_part("parts/kidney.csv")
+    wheel = WheelJaw(5.0)
+    rig = WheelRig(part, wheel, noise="paper", seed=2, true_radius=5.03, direction_zero=math.radians(1.5))
+    cal = calibrate_wheel(rig, wheel, rig.approach_pose(20.0), part=part, length=40.0)
+    assert cal.radius == pytest.approx(5.03, abs=0.003)
+    # the channels' cross-talk (0.003 in `paper`) turns the direction they read by as much: the
+    # calibration finds the effective rotation
+    crosstalk = rig.noise.crosstalk
+    assert math.degrees(cal.direction_zero) == pytest.approx(1.5 - math.degrees(crosstalk), abs=0.03)
+    assert cal.depth == pytest.approx(1.0, rel=0.02) and cal.residual < 0.005  # mm a 0.25 mm step
+    cal.save(tmp_path / "cal.json")
+    back = load_calibration(tmp_path / "cal.json")
+    assert back == cal
+    with pytest.raises(RigError, match="not of a straight jaw"):
+        Calibration.load(tmp_path / "cal.json")
+    with pytest.raises(RigError, match="calibration is for wheel:5, the finger is wheel:3"):
+        back.check(WheelJaw(3.0))
+    # calibrated, the mis-sized wheel localizes
+    run = localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(65.0), calibration=cal)
+    assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3
