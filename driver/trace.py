@@ -24,7 +24,7 @@ from localizer import arc_from_jaw_positions, check_size
 from .procedures import Calibration, RollingRun
 from .rig import RigError
 
-__all__ = ["Trace", "COLUMNS", "FORMAT"]
+__all__ = ["Trace", "COLUMNS", "FORMAT", "read_archive", "trace_format"]
 
 COLUMNS = ("roll", "step", "time", "x", "y", "phi_command", "phi", "dv1", "dv2", "true_arc", "true_jaw_position")
 FORMAT = "rolltouch-trace/1"
@@ -32,6 +32,53 @@ FORMAT = "rolltouch-trace/1"
 #: 2000 readings is 200 kB; a crafted archive of 2 MB can unpack to gigabytes).
 MAX_TRACE_BYTES = 256 * 2**20
 MAX_TRACE_UNPACKED = 512 * 2**20
+
+
+def read_archive(path, names) -> tuple[dict, dict]:
+    """The metadata (a JSON object) and the named columns (equal-length 1-D numbers) of a trace archive,
+    read safely: its size checked before it is opened, never unpickled.
+
+    Raises
+    ------
+    RigError
+        Missing, unreadable, too large, damaged or crafted file; missing or malformed columns.
+    """
+    check_size(path, MAX_TRACE_BYTES, "trace", RigError)
+    try:
+        with zipfile.ZipFile(path) as z:
+            unpacked = sum(i.file_size for i in z.infolist())
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError):
+        raise RigError(f"trace {path}: not a rolltouch trace (not an .npz archive, or a damaged one)") from None
+    if unpacked > MAX_TRACE_UNPACKED:
+        raise RigError(
+            f"trace {path}: its columns unpack to {unpacked / 2**20:.0f} MB, more than the "
+            f"{MAX_TRACE_UNPACKED / 2**20:.0f} MB a trace may hold; not a rolltouch trace"
+        )
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["metadata"])) if "metadata" in data.files else None
+            missing = [name for name in ("metadata", *names) if name not in data.files]
+            if missing:
+                kind = f" ({meta['format']})" if isinstance(meta, dict) and "format" in meta else ""
+                raise RigError(f"trace {path}: not a rolltouch trace of this kind{kind} (no {', '.join(missing)})")
+            columns = {name: np.array(data[name]) for name in names}
+    except RigError:
+        raise
+    except (OSError, ValueError, KeyError, IndexError, TypeError, EOFError, zipfile.BadZipFile, MemoryError):
+        # numpy's own text may suggest allow_pickle=True: a trace never holds Python objects
+        raise RigError(f"trace {path}: not a rolltouch trace (a damaged or crafted .npz)") from None
+    if not isinstance(meta, dict):
+        raise RigError(f"trace {path}: its metadata is a {type(meta).__name__}, not a JSON object")
+    sizes = {a.shape for a in columns.values()}
+    if names and len(sizes) != 1 or any(a.ndim != 1 or a.dtype.kind not in "fiu" for a in columns.values()):
+        raise RigError(f"trace {path}: its columns are not equal-length numbers; not a rolltouch trace")
+    return meta, columns
+
+
+def trace_format(path) -> str:
+    """The ``format`` a trace archive's metadata names ("" when it names none)."""
+    meta, _ = read_archive(path, ())
+    return str(meta.get("format", ""))
 
 
 @dataclass(frozen=True)
@@ -90,6 +137,9 @@ class Trace:
 
         events = read_log(path)
         start = events[0]
+        jaw = str(start.get("jaw", "straight:100"))  # logs from before fingers were named: the paper's jaw
+        if not jaw.startswith("straight"):
+            raise RigError(f"run log {path}: a {jaw} finger's log, not a straight jaw's")
         for k, e in enumerate(events):
             need = {"roll": ("roll", "step", "offset"), "reading": ("roll", "step", "dv1", "dv2", "phi")}
             missing = [key for key in need.get(e.get("event"), ()) if key not in e]
@@ -136,35 +186,10 @@ class Trace:
         """
         if str(path).endswith(".jsonl"):
             return cls.from_log(path)
-        check_size(path, MAX_TRACE_BYTES, "trace", RigError)
-        try:
-            with zipfile.ZipFile(path) as z:
-                unpacked = sum(i.file_size for i in z.infolist())
-        except (zipfile.BadZipFile, OSError, EOFError, ValueError):
-            raise RigError(f"trace {path}: not a rolltouch trace (not an .npz archive, or a damaged one)") from None
-        if unpacked > MAX_TRACE_UNPACKED:
-            raise RigError(
-                f"trace {path}: its columns unpack to {unpacked / 2**20:.0f} MB, more than the "
-                f"{MAX_TRACE_UNPACKED / 2**20:.0f} MB a trace may hold; not a rolltouch trace"
-            )
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                missing = [name for name in ("metadata", *COLUMNS) if name not in data.files]
-                if missing:
-                    raise RigError(f"trace {path}: not a rolltouch trace (no {', '.join(missing)})")
-                meta = json.loads(str(data["metadata"]))
-                columns = {name: np.array(data[name]) for name in COLUMNS}
-        except RigError:
-            raise
-        except (OSError, ValueError, KeyError, IndexError, TypeError, EOFError, zipfile.BadZipFile, MemoryError):
-            # numpy's own text may suggest allow_pickle=True: a trace never holds Python objects
-            raise RigError(f"trace {path}: not a rolltouch trace (a damaged or crafted .npz)") from None
-        if not isinstance(meta, dict) or meta.get("format") != FORMAT:
-            shown = meta.get("format") if isinstance(meta, dict) else type(meta).__name__
-            raise RigError(f"trace {path}: format {shown!r}, expected {FORMAT!r}")
-        sizes = {a.shape for a in columns.values()}
-        if len(sizes) != 1 or any(a.ndim != 1 or a.dtype.kind not in "fiu" for a in columns.values()):
-            raise RigError(f"trace {path}: its columns are not equal-length numbers; not a rolltouch trace")
+        meta, columns = read_archive(path, COLUMNS)
+        if meta.get("format") != FORMAT:
+            jaw = f" (a {meta['jaw']} finger's)" if isinstance(meta.get("jaw"), str) else ""
+            raise RigError(f"trace {path}: format {meta.get('format')!r}{jaw}, expected {FORMAT!r}")
         for key in ("steps", "offsets", "calibration"):
             if key not in meta:
                 raise RigError(f"trace {path}: its metadata has no {key!r}; not a rolltouch trace")

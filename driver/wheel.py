@@ -439,7 +439,8 @@ def localize_with_wheel(
     pressing : PressSettings
         The first press.
     observer : callable, optional
-        Called with ``{"event": "belief", ...}`` at every check.
+        Called with ``{"event": "reading", "length": mm, "turn": rad}`` at every step (the start's
+        (0, 0) is implied) and ``{"event": "belief", ...}`` at every check.
     """
     cal = calibration if calibration is not None else WheelCalibration.nominal(wheel)
     cal.check(wheel)
@@ -476,6 +477,8 @@ def localize_with_wheel(
         turns.append((now[0] + now[1]) - (start[0] + start[1]))
         truths.append(disc.truth())
         flt.update(lengths[-1], turns[-1])
+        if observer is not None:
+            observer({"event": "reading", "length": lengths[-1], "turn": turns[-1]})
         if abs(slip) > pol.max_slip:
             raise WheelSlip(
                 f"the wheel's rim slipped {slip:+.3f} mm over {arc:.1f} mm rolled (the axle's path against the "

@@ -271,7 +271,13 @@ class WheelFilter:
         return out
 
     def belief(self, radius: float | None = None) -> Belief:
-        """The belief over the present contact; its mass the least over :attr:`noise_scales`."""
+        """The belief over the present contact; its mass the least over :attr:`noise_scales`.
+
+        Parameters
+        ----------
+        radius : float, optional, mm
+            The mass is taken within this of the most probable contact (default: the filter's).
+        """
         radius = self.radius if radius is None else float(radius)
         present = self.present()
         w = self.posterior()

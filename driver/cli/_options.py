@@ -8,7 +8,17 @@ import math
 import os
 from pathlib import Path
 
-from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part
+from localizer import (
+    DEFAULT_JAW,
+    ROLL_STEP,
+    SUCCESS_RADIUS,
+    Outline,
+    Part,
+    RolltouchError,
+    StraightJaw,
+    load_part,
+    parse_jaw,
+)
 
 from ..procedures import PRESS, STEP_RANGE_DEG, PressSettings, ServoSettings
 from ..reactive import CONFIDENCE, MAX_ROTATION
@@ -35,6 +45,8 @@ __all__ = [
     "servo_arguments",
     "reactive_arguments",
     "pressing",
+    "jaw_spec",
+    "jaw_argument",
 ]
 
 
@@ -220,3 +232,31 @@ def pressing(args) -> PressSettings:
             raise UsageError("--no-guard needs --servo-gain: without the servo there is nothing to guard")
         return PRESS
     return PressSettings(servo=ServoSettings(gain=args.servo_gain, guard=not args.no_guard))
+
+
+def jaw_spec(text: str):
+    """argparse type of ``--jaw``: a finger (:func:`localizer.parse_jaw`). The rig models the paper's 100 mm
+    straight jaw (its wrist and the calibration's ±50 mm taps) and wheels of any radius."""
+    try:
+        finger = parse_jaw(text)
+    except RolltouchError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    if isinstance(finger, StraightJaw) and finger != DEFAULT_JAW:
+        raise argparse.ArgumentTypeError(
+            f"{text}: the rig models the paper's {DEFAULT_JAW} jaw only (its wrist and the calibration's ±50 mm "
+            f"taps); use {DEFAULT_JAW} or a wheel, e.g. wheel:5"
+        )
+    return finger
+
+
+def jaw_argument(p, default=DEFAULT_JAW) -> None:
+    """--jaw: the finger, the paper's straight jaw or a wheel on an axle encoder (docs/wheel.md)."""
+    p.add_argument(
+        "--jaw",
+        type=jaw_spec,
+        default=default,
+        metavar="straight:100|wheel:MM",
+        help="the finger: the paper's 100 mm straight jaw"
+        + (" (default)" if default is not None else "")
+        + ", or a wheel of radius MM on an axle encoder (docs/wheel.md)",
+    )

@@ -9,10 +9,20 @@ import sys
 
 import numpy as np
 
-from localizer import DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
+from localizer import DEFAULT_JAW, DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
 
-from ._options import PLOT_SUFFIXES, add_command, check_before_moving, part_arguments, positive, read_part
+from ..rig import RigError
+from ._options import (
+    PLOT_SUFFIXES,
+    add_command,
+    check_before_moving,
+    jaw_argument,
+    part_arguments,
+    positive,
+    read_part,
+)
 from ._output import emit_run, no_fit_line, run_summary
+from ._wheel import locate_wheel
 
 __all__ = ["register", "localize_command", "locate_command"]
 
@@ -88,6 +98,7 @@ def register(sub) -> None:
     )
     lct.add_argument("trace", help="trace file (.npz) from 'rolltouch simulate'")
     lct.add_argument("--part", required=True, help="part file (the model the localizer is given; a point file)")
+    jaw_argument(lct, default=None)
     lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
     lct.add_argument("--json", action="store_true", help="print the result as JSON")
     lct.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
@@ -160,9 +171,19 @@ def localize_command(args) -> int:
 
 
 def locate_command(args) -> int:
-    from driver.trace import Trace
+    from driver.trace import Trace, trace_format
+    from driver.wheel_trace import WHEEL_FORMAT
 
     check_before_moving(args, {"plot": PLOT_SUFFIXES})
+    if str(args.trace).endswith(".jsonl"):
+        from driver.runlog import read_log
+
+        if str(read_log(args.trace)[0].get("jaw", "straight")).startswith("wheel"):
+            return locate_wheel(args, args.trace)
+    elif trace_format(args.trace) == WHEEL_FORMAT:
+        return locate_wheel(args, args.trace)
+    if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
+        raise RigError(f"trace {args.trace} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
     part = load_part(args.part)
     trace = Trace.load(args.trace)
     estimates = trace.estimates()

@@ -9,13 +9,14 @@ import json
 import math
 import sys
 
-from localizer import SUCCESS_RADIUS
+from localizer import SUCCESS_RADIUS, WheelJaw
 
 from ._options import (
     PLOT_SUFFIXES,
     STEP_DEG,
     add_command,
     check_before_moving,
+    jaw_argument,
     part_arguments,
     pressing,
     reactive_arguments,
@@ -26,6 +27,7 @@ from ._options import (
     step_degrees,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
+from ._wheel import calibrate_wheel_here, run_wheel
 
 __all__ = ["register", "calibrate_command", "run_command"]
 
@@ -41,6 +43,7 @@ def register(sub) -> None:
         "at 11 jaw positions from -50 to 50 mm and save the ratio spline.",
     )
     rig_arguments(cal)
+    jaw_argument(cal)
     cal.add_argument("--out", required=True, metavar="CAL.json", help="calibration file to write")
 
     run = add_command(
@@ -54,6 +57,7 @@ def register(sub) -> None:
     )
     part_arguments(run)
     rig_arguments(run)
+    jaw_argument(run)
     run.add_argument("--calibration", metavar="CAL.json", help="calibration from 'rolltouch calibrate'")
     run.add_argument(
         "--roll",
@@ -84,6 +88,16 @@ def calibrate_command(args) -> int:
 
     check_before_moving(args, {"out": (".json",)})
     args.interrupted = CONNECTING
+    if isinstance(args.jaw, WheelJaw):
+        with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
+            wheel_cal = calibrate_wheel_here(rig, args.jaw)
+        args.interrupted = RELEASED
+        wheel_cal.save(args.out)
+        print(
+            f"calibration of {wheel_cal.jaw} written to {args.out}: radius {wheel_cal.radius:.4f} mm, "
+            f"direction zero {math.degrees(wheel_cal.direction_zero):+.3f}°, {wheel_cal.steps} steps"
+        )
+        return 0
     with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
         calibration = calibrate(rig, rig.pose())
     args.interrupted = RELEASED
@@ -109,12 +123,20 @@ def run_command(args) -> int:
     from driver.runlog import RunLog
     from driver.serial_rig import SerialRig
     from driver.trace import Trace
+    from driver.wheel import check_calibration, load_calibration
 
     check_before_moving(args, {"plot": PLOT_SUFFIXES, "log": ()})
     part = read_part(args)
     rolls = args.roll or [20.0, 15.0]
-    calibration = Calibration.load(args.calibration) if args.calibration else None
+    loaded = load_calibration(args.calibration) if args.calibration else None
+    if loaded is not None:
+        check_calibration(loaded, args.jaw)
+    if isinstance(args.jaw, WheelJaw):
+        log = RunLog(args.log, _wheel_header(args, part, loaded)) if args.log else None
+        return run_wheel(args, part, args.jaw, loaded, log, lambda event: None)
+    calibration = loaded if isinstance(loaded, Calibration) else None
     header = {
+        "jaw": str(args.jaw),
         "part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
         "arm": args.arm,
         "daq": args.daq,
@@ -163,6 +185,18 @@ def run_command(args) -> int:
         log({"event": "result", **doc})
         log.close()
     return emit_run(args, doc, part, trace, run.localization)
+
+
+def _wheel_header(args, part, calibration) -> dict:
+    header = {
+        "jaw": str(args.jaw),
+        "part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        "arm": args.arm,
+        "daq": args.daq,
+    }
+    if calibration is not None:
+        header["calibration"] = calibration.as_dict()
+    return header
 
 
 @contextlib.contextmanager

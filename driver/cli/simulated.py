@@ -9,7 +9,7 @@ from dataclasses import asdict
 
 import numpy as np
 
-from localizer import Outline, QueryError
+from localizer import Outline, QueryError, WheelJaw
 
 from ..rig import RigError
 from ._options import (
@@ -19,6 +19,7 @@ from ._options import (
     add_command,
     check_before_moving,
     finite,
+    jaw_argument,
     part_arguments,
     pressing,
     reactive_arguments,
@@ -29,6 +30,7 @@ from ._options import (
     tcp_port,
 )
 from ._output import emit_run, print_reactive, run_reactive, run_summary
+from ._wheel import simulate_wheel, wheel_rig
 
 __all__ = ["register", "simulate_command", "emulate_command"]
 
@@ -44,6 +46,7 @@ def register(sub) -> None:
         "localize, and save the readings with their ground truth.",
     )
     part_arguments(sim)
+    jaw_argument(sim)
     sim.add_argument(
         "--start",
         type=finite,
@@ -92,6 +95,7 @@ def register(sub) -> None:
         "until killed.",
     )
     part_arguments(emu)
+    jaw_argument(emu)
     emu.add_argument("--tcp", type=tcp_port, metavar="PORT", help="serve on 127.0.0.1:PORT and PORT+1 (default: ptys)")
     emu.add_argument(
         "--start",
@@ -124,6 +128,8 @@ def simulate_command(args) -> int:
 
     check_before_moving(args, {"out": (".npz",), "plot": PLOT_SUFFIXES})
     part = read_part(args)
+    if isinstance(args.jaw, WheelJaw):
+        return simulate_wheel(args, part, args.jaw)
     if args.engine is None:
         args.engine = "kinematic" if isinstance(part, Outline) else "pymunk"
     noise = load_noise(args.noise)
@@ -149,7 +155,14 @@ def simulate_command(args) -> int:
             history=np.array(res.history, dtype=float).reshape(-1, 4),
             metadata=np.array(
                 json.dumps(
-                    {**doc, "noise": str(args.noise), "seed": args.seed, "engine": args.engine, "start_arc": args.start}
+                    {
+                        **doc,
+                        "jaw": str(args.jaw),
+                        "noise": str(args.noise),
+                        "seed": args.seed,
+                        "engine": args.engine,
+                        "start_arc": args.start,
+                    }
                 )
             ),
         )
@@ -184,6 +197,7 @@ def simulate_command(args) -> int:
         calibration,
         part={"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
         engine=args.engine,
+        jaw=str(args.jaw),
         noise_name=str(args.noise),
         noise=asdict(noise),
         seed=args.seed,
@@ -226,11 +240,15 @@ def emulate_command(args) -> int:
 
     part = read_part(args)
     faults = Faults.parse(args.fault)
-    rig = SimRig(part, noise=args.noise, seed=args.seed, engine=args.engine)
-    if args.start is None:
-        start_pose = rig.calibration_pose()
+    rig: object
+    if isinstance(args.jaw, WheelJaw):
+        rig, start_pose = wheel_rig(part, args.jaw, args)
     else:
-        start_pose = rig.approach_pose(float(args.start) % part.perimeter, jaw_position=0.0, standoff=1.0)
+        rig = SimRig(part, noise=args.noise, seed=args.seed, engine=args.engine)
+        if args.start is None:
+            start_pose = rig.calibration_pose()
+        else:
+            start_pose = rig.approach_pose(float(args.start) % part.perimeter, jaw_position=0.0, standoff=1.0)
     emulator = Emulator(rig, start_pose=start_pose, faults=faults, seed=args.seed)
     if args.tcp is not None:
         arm, daq = emulator.serve_tcp(args.tcp)

@@ -146,3 +146,52 @@ def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_t
     # calibrated, the mis-sized wheel localizes
     run = localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(65.0), calibration=cal)
     assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3
+
+
+def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_reading_back(tmp_path):
+    import json
+    import os
+    import subprocess
+    import sys
+
+    port = 49000 + os.getpid() % 1000
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    exe = [sys.executable, "-m", "driver.cli"]
+    kidney = "parts/kidney.csv"
+    rig = ["--arm", f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}"]
+    emu = subprocess.Popen(
+        exe + ["emulate", kidney, "--jaw", "wheel:5", "--tcp", str(port), "--start", "60", "--seed", "3"],
+        stdout=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+
+    def cli(*args):
+        return subprocess.run(exe + list(args), capture_output=True, text=True, timeout=120, env=env)
+
+    try:
+        assert emu.stdout.readline().startswith("arm socket://127.0.0.1:")
+        emu.stdout.readline()
+        cal = cli("calibrate", *rig, "--jaw", "wheel:5", "--out", str(tmp_path / "cal.json"))
+        assert cal.returncode == 0, cal.stderr
+        assert json.loads((tmp_path / "cal.json").read_text())["jaw"] == "wheel:5"
+        wrong = cli("run", kidney, *rig, "--calibration", str(tmp_path / "cal.json"), "--json")
+        run = cli(
+            "run", kidney, *rig, "--jaw", "wheel:5", "--reactive", "--calibration", str(tmp_path / "cal.json"),
+            "--json", "--log", str(tmp_path / "r.jsonl"),
+        )  # fmt: skip
+    finally:
+        emu.terminate()
+        emu.wait(10)
+    assert wrong.returncode == 2 and "calibration is for wheel:5, the finger is straight:100" in wrong.stderr
+    assert run.returncode == 0, run.stderr
+    doc = json.loads(run.stdout)
+    assert doc["jaw"] == "wheel:5" and doc["stopped"] == "confident" and doc["mass"] >= 0.95
+    header = json.loads((tmp_path / "r.jsonl").read_text().splitlines()[0])
+    assert header["jaw"] == "wheel:5" and header["calibration"]["jaw"] == "wheel:5"
+    # the log read back: the same belief from its readings; and refused for another finger
+    loc = cli("locate", str(tmp_path / "r.jsonl"), "--part", kidney, "--json")
+    assert loc.returncode == 0, loc.stderr
+    assert json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"], abs=1e-6)
+    other = cli("locate", str(tmp_path / "r.jsonl"), "--part", kidney, "--jaw", "wheel:3")
+    assert other.returncode == 2 and "not of wheel:3" in other.stderr

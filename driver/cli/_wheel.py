@@ -1,0 +1,274 @@
+"""The commands' work with a wheel finger (``--jaw wheel:MM``, docs/wheel.md): simulate, calibrate, run,
+emulate and locate, each the wheel's counterpart of the straight jaw's."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+import numpy as np
+
+from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_for
+
+from ..rig import GroundTruth, RigError
+from ._options import UsageError, pressing
+
+__all__ = [
+    "wheel_policy",
+    "wheel_doc",
+    "print_wheel",
+    "simulate_wheel",
+    "calibrate_wheel_here",
+    "run_wheel",
+    "wheel_rig",
+    "locate_wheel",
+    "wheel_start_arc",
+]
+
+
+def _spline_only(part, wheel: WheelJaw) -> Part:
+    if not isinstance(part, Part):
+        raise QueryError(
+            f"{part.name}: a {wheel} localizes on spline parts (JSON or CSV points) only; a drawing's corners "
+            "are not built for the wheel (docs/wheel.md)"
+        )
+    return part
+
+
+def wheel_policy(args):
+    """The wheel's rolling from the reactive options (``--confidence``, ``--max-rotation``)."""
+    from ..wheel import WheelPolicy
+
+    return WheelPolicy(confidence=args.confidence, max_rotation=math.radians(args.max_rotation))
+
+
+def wheel_start_arc(part: Part, wheel: WheelJaw) -> float:
+    """Where a simulated wheel is calibrated and, by default, served: the start of the longest stretch
+    the wheel surely reaches."""
+    reach = wheel_reach_for(part, wheel)
+    sure = np.asarray(reach.sure)
+    if sure.all():
+        return 0.0
+    if not sure.any():
+        raise RigError(f"a {wheel} surely touches {part.name} nowhere")
+    k = int(np.flatnonzero(~sure)[0])
+    rolled = np.roll(sure, -k)  # starts on a point it does not reach
+    edges = np.flatnonzero(np.diff(rolled.astype(int)))
+    starts, ends = edges[::2] + 1, edges[1::2] + 1
+    best = int(np.argmax(ends - starts))
+    return float(reach.sigma[(starts[best] + k) % sure.size])
+
+
+def wheel_doc(part, run, rig, calibration) -> dict:
+    """The JSON object of a wheel's run."""
+    b = run.belief
+    doc = {
+        "part": part.name,
+        "method": "reactive",
+        "jaw": calibration.jaw,
+        "estimate_arc": b.map_arc,
+        "mass": b.mass,
+        "ambiguous": b.ambiguous,
+        "informative": b.informative,
+        "stopped": run.stopped,
+        "rotation_deg": math.degrees(run.rotation),
+        "arc_mm": run.arc,
+        "steps": run.steps,
+        "reversals": run.reversals,
+        "jumps": run.jumps,
+        "slip_mm": run.slip,
+        "calibration": calibration.as_dict(),
+        "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+    }
+    if isinstance(rig, GroundTruth):
+        true_arc = rig.truth()["contact_arc"]
+        doc["true_arc"] = true_arc
+        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
+    return doc
+
+
+def print_wheel(doc) -> None:
+    verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
+    print(
+        f"{doc['jaw']}: rolled {doc['arc_mm']:.1f} mm, the hand turned {doc['rotation_deg']:.1f}°, in {doc['steps']} "
+        f"steps ({doc['stopped']}, {doc['jumps']} jumps undone, slip {doc['slip_mm']:+.3f} mm)"
+    )
+    print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within {SUCCESS_RADIUS} mm")
+    for m in doc["modes"][1:3]:
+        print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")
+    if doc.get("error_mm") is not None:
+        err = doc["error_mm"]
+        print(
+            f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
+            f"({'success' if err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
+        )
+
+
+def _emit(args, doc, part, run, out: str | None) -> int:
+    if out:
+        doc["trace"] = str(out)
+    if getattr(args, "plot", None):
+        from driver.plotting import plot_reactive
+
+        plot_reactive(part, run, args.plot)
+        doc["plot"] = str(args.plot)
+    if args.json:
+        print(json.dumps(doc, indent=2))
+    else:
+        print_wheel(doc)
+        if out:
+            print(f"readings written to {out}")
+    return 0
+
+
+def simulate_wheel(args, part, wheel: WheelJaw) -> int:
+    """'simulate --jaw wheel:MM --reactive': calibrate a simulated wheel, roll it from --start, save the trace."""
+    from sim2d import load_noise
+    from sim2d.wheel_rig import WheelRig
+
+    from ..wheel import calibrate_wheel, localize_with_wheel
+    from ..wheel_trace import WheelTrace
+
+    part = _spline_only(part, wheel)
+    if not args.reactive:
+        raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
+    if args.engine == "pymunk":
+        raise UsageError(f"--engine pymunk: the {wheel}'s world is kinematic only (the pymunk wheel is not built)")
+    args.engine = "kinematic"
+    if not 0 <= args.start < part.perimeter:
+        raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
+    if not bool(wheel_reach_for(part, wheel).touchable(args.start)):
+        raise RigError(f"--start {args.start} mm: a {wheel} laid there would touch the part elsewhere; pick another")
+    noise = load_noise(args.noise)
+    cal_rig = WheelRig(part, wheel, noise=noise, seed=args.seed + 1)
+    calibration = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_start_arc(part, wheel)), part=part)
+    rig = WheelRig(part, wheel, noise=noise, seed=args.seed)
+    run = localize_with_wheel(
+        rig,
+        part,
+        wheel,
+        approach_pose=rig.approach_pose(args.start),
+        calibration=calibration,
+        policy=wheel_policy(args),
+        pressing=pressing(args),
+    )
+    doc = wheel_doc(part, run, rig, calibration)
+    trace = WheelTrace.from_run(
+        run,
+        calibration,
+        part={"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        engine="kinematic",
+        noise=str(args.noise),
+        seed=args.seed,
+        start_arc=args.start,
+        result=doc,
+    )
+    trace.save(args.out)
+    return _emit(args, doc, part, run, args.out)
+
+
+def wheel_rig(part, wheel: WheelJaw, args):
+    """The simulated wheel rig 'emulate --jaw wheel:MM' serves, and its start pose (the wheel 1 mm off)."""
+    from sim2d.wheel_rig import WheelRig
+
+    part = _spline_only(part, wheel)
+    if args.engine == "pymunk":
+        raise UsageError(f"--engine pymunk: the {wheel}'s world is kinematic only (the pymunk wheel is not built)")
+    rig = WheelRig(part, wheel, noise=args.noise, seed=args.seed)
+    start = wheel_start_arc(part, wheel) if args.start is None else float(args.start) % part.perimeter
+    return rig, rig.approach_pose(start)
+
+
+def calibrate_wheel_here(rig, wheel: WheelJaw):
+    """'calibrate --jaw wheel:MM': roll 40 mm from the present pose (the hand's axis facing a smooth surface
+    the wheel fits, clear of it) and measure the radius and the channels' rotation."""
+    from ..wheel import calibrate_wheel
+
+    return calibrate_wheel(rig, wheel, tuple(rig.pose()))
+
+
+def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
+    """'run --jaw wheel:MM --reactive': from the present pose (the hand's axis facing the part, clear of it),
+    calibrate there unless a calibration is given, then roll until sure."""
+    from ..serial_rig import SerialRig
+    from ..wheel import WheelCalibration, calibrate_wheel, localize_with_wheel
+    from .rig import CONNECTING, RELEASED, _ending_progress_line
+
+    part = _spline_only(part, wheel)
+    if not args.reactive:
+        raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
+    if calibration is not None:
+        if not isinstance(calibration, WheelCalibration):
+            raise RigError(f"the calibration is for {calibration.jaw}, the finger is {wheel}: calibrate this finger")
+        calibration.check(wheel)
+
+    def progress(event):
+        if event.get("event") == "reading" and log is not None:
+            log(event)
+        if event.get("event") == "belief":
+            b = event["belief"]
+            if log is not None:
+                log({"event": "belief", "arc": event["arc"], "map_arc": b.map_arc, "mass": b.mass})
+            sys.stderr.write(f"\rrolled {event['arc']:7.1f} mm  best {b.map_arc:8.2f} mm  {b.mass:6.1%} ")
+            sys.stderr.flush()
+
+    args.interrupted = CONNECTING
+    with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+        here = tuple(rig.pose())
+        if calibration is None:
+            calibration = calibrate_wheel(rig, wheel, here, part=part)
+            if log is not None:
+                log({"event": "calibration", **calibration.as_dict()})
+        run = localize_with_wheel(
+            rig,
+            part,
+            wheel,
+            approach_pose=here,
+            calibration=calibration,
+            policy=wheel_policy(args),
+            pressing=pressing(args),
+            observer=progress,
+        )
+    args.interrupted = RELEASED
+    doc = wheel_doc(part, run, rig, calibration)
+    if log is not None:
+        log({"event": "result", **doc})
+        log.close()
+    return _emit(args, doc, part, run, None)
+
+
+def locate_wheel(args, path) -> int:
+    """'locate TRACE --part PART' of a wheel's trace: its readings replayed into the filter for its finger."""
+    from localizer import load_part
+
+    from ..wheel_trace import WheelTrace
+
+    trace = WheelTrace.load(path)
+    if args.jaw is not None and str(args.jaw) != trace.metadata["jaw"]:
+        raise RigError(f"trace {path} is of a {trace.metadata['jaw']} finger, not of {args.jaw}")
+    part = _spline_only(load_part(args.part), trace.wheel)
+    b = trace.relocalize(part)
+    true = trace.true_arc
+    doc = {
+        "part": part.name,
+        "jaw": trace.metadata["jaw"],
+        "estimate_arc": b.map_arc,
+        "mass": b.mass,
+        "ambiguous": b.ambiguous,
+        "readings": int(trace.columns["length"].size),
+        "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+    }
+    if math.isfinite(true):
+        doc["true_arc"] = true
+        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true)))
+    if args.json:
+        print(json.dumps(doc, indent=2))
+    else:
+        print(
+            f"{doc['jaw']} trace, {doc['readings']} readings: contact now at arc {b.map_arc:.3f} mm, "
+            f"{b.mass:.1%} within {SUCCESS_RADIUS} mm{' (AMBIGUOUS)' if b.ambiguous else ''}"
+        )
+        if "error_mm" in doc:
+            print(f"truth: {true:.3f} mm, error {doc['error_mm']:.3f} mm")
+    return 0
