@@ -285,6 +285,23 @@ def reactive_stop(run) -> str:
     return "ambiguous" if run.belief.ambiguous else "budget"
 
 
+def rotation_curve(part, history, rotation_deg: float, final: float, budget_deg: float) -> list:
+    """(mark deg, error mm) at every 5° of a rolling's rotation up to ``budget_deg``: the belief's error at
+    the last check before the mark (``history``: (rotation rad, map_arc, mass, true_arc) per check), the
+    final error once the rolling stopped."""
+    curve = []
+    mark = MARK_DEG
+    while mark <= budget_deg + 1e-9:
+        if rotation_deg <= mark + 1e-9:
+            e = final  # stopped (sure, or out of budget) before this mark
+        else:
+            before = [h for h in history if math.degrees(h[0]) <= mark + 1e-9]
+            e = _err(part, before[-1][1], before[-1][3]) if before else math.inf
+        curve.append((mark, e))
+        mark += MARK_DEG
+    return curve
+
+
 def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None) -> dict:
     """The reactive filter from the same start on a rig with the same seed."""
     from driver.reactive import localize_reactively
@@ -303,22 +320,11 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
     truth = rig.truth()["contact_arc"]
     final = _err(part, res.estimate_arc, truth)
     rot = math.degrees(res.rotation)
-    curve = []
-    mark = MARK_DEG
-    hist = res.history
-    while mark <= o.max_rotation_deg + 1e-9:
-        if rot <= mark + 1e-9:
-            e = final  # stopped (sure, or out of budget) before this mark
-        else:
-            before = [h for h in hist if math.degrees(h[0]) <= mark + 1e-9]
-            e = _err(part, before[-1][1], before[-1][3]) if before else math.inf
-        curve.append((mark, e))
-        mark += MARK_DEG
     return {
         "estimate_arc": res.estimate_arc,
         "error_mm": final,
         "rotation_deg": rot,
-        "curve": curve,
+        "curve": rotation_curve(part, res.history, rot, final, o.max_rotation_deg),
         "stopped": reactive_stop(res),
         "mass": res.belief.mass,
         "bridges": res.bridges,

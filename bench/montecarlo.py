@@ -316,6 +316,16 @@ def summarize(study: Study, rows) -> dict:
         )
         if study.methods:
             levels[-1]["methods"] = {m: method_detail(study, m, sel) for m in study.methods}
+        if study.fingers and n:
+            arcs = np.array([_number(r.get("arc_mm", "")) for r in sel], dtype=float)
+            levels[-1].update(
+                {
+                    "jaw": study.level_jaw(level),
+                    "reachable": float(np.mean([float(r["reachable"]) for r in sel])),
+                    "mean_redraws": float(np.mean([float(r["redraws"]) for r in sel])),
+                    "mean_arc_mm": float(np.nanmean(arcs)) if np.isfinite(arcs).any() else None,
+                }
+            )
     out = {
         "study": study.name,
         "method": study.method,

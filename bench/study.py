@@ -20,6 +20,11 @@ A study file::
     # parameter = "noise"
     # values = ["noise/paper-x0.5.toml", "paper", "noise/paper-x2.toml"]
 
+    jaw = "straight:100"                 # optional: the finger (or "wheel:5", docs/wheel.md)
+    [sweep]                              # or the finger over levels: the same trials' seeds, each
+    parameter = "jaw"                    #   finger from a start drawn uniformly over the whole
+    values = ["straight:100", "wheel:5"] #   boundary and redrawn where it cannot start ("redraws")
+
     [likelihood]                         # optional: the standard deviations told to the
     sd_length = 0.3                      # likelihood rule (mm, degrees)
     sd_turn_deg = 0.03
@@ -123,6 +128,7 @@ _KEYS = {
     "likelihood",
     "reactive",
     "particle",
+    "jaw",
 }
 METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
@@ -140,6 +146,10 @@ METHOD_COLUMNS = (
     "failure",
     "bridges",
 )
+#: Columns of a study that names its finger: the finger, how many uniform draws over the boundary were
+#: redrawn before one the finger can start from, the fraction of the boundary it can start from, and
+#: the arc a wheel rolled (mm; empty for the straight jaw).
+FINGER_COLUMNS = ("jaw", "redraws", "reachable", "arc_mm")
 
 
 @dataclass(frozen=True)
@@ -212,12 +222,23 @@ class Study:
     methods: tuple = ()
     reactive: ReactiveOptions = ReactiveOptions()
     particle: ParticleOptions = ParticleOptions()
+    jaw: str = "straight:100"
+
+    @property
+    def fingers(self) -> bool:
+        """Whether the study names its finger (a wheel, or a sweep over fingers): its table has
+        :data:`FINGER_COLUMNS` too."""
+        return self.parameter == "jaw" or self.jaw != "straight:100"
 
     @property
     def columns(self) -> tuple:
         """The columns of this study's trials.csv."""
         extra = tuple(f"{m}_{c}" for m in self.methods for c in METHOD_COLUMNS) if self.methods else ()
-        return TRIAL_COLUMNS + extra
+        return TRIAL_COLUMNS + extra + (FINGER_COLUMNS if self.fingers else ())
+
+    def level_jaw(self, level: int) -> str:
+        """The finger of ``level`` (a spec, :func:`localizer.parse_jaw`)."""
+        return str(self.values[level]) if self.parameter == "jaw" else self.jaw
 
     @property
     def levels(self) -> int:
@@ -239,7 +260,7 @@ class Study:
         if self.parameter == "noise":
             return load_noise(self.values[level])
         noise = load_noise(self.noise)
-        if self.parameter is not None:
+        if self.parameter not in (None, "jaw"):
             noise = replace(noise, **{self.parameter: self.values[level]})
         return noise
 
@@ -357,7 +378,11 @@ def load_study(path) -> Study:
             raise StudyError(f"study {path}: [sweep] takes 'parameter' and 'values'")
         parameter = sweep.get("parameter")
         given = sweep.get("values")
-        if parameter == "noise":
+        if parameter == "jaw":
+            if not isinstance(given, list) or not given or not all(isinstance(v, str) for v in given):
+                raise StudyError(f"study {path}: a jaw sweep's values must be a non-empty list of fingers")
+            values = tuple(_finger(path, v) for v in given)
+        elif parameter == "noise":
             if not isinstance(given, list) or not given or not all(isinstance(v, str) for v in given):
                 raise StudyError(f"study {path}: a noise sweep's values must be a non-empty list of presets or files")
             for v in given:
@@ -380,6 +405,14 @@ def load_study(path) -> Study:
                 except (SimError, TypeError) as exc:
                     raise StudyError(f"study {path}: sweep value {v!r} of {parameter}: {exc}") from None
             values = tuple(float(v) for v in given)
+    jaw = _finger(path, data.get("jaw", "straight:100"))
+    fingers = values if parameter == "jaw" else (jaw,)
+    if any(f.startswith("wheel") for f in fingers):
+        if methods != ["reactive"]:
+            raise StudyError(f'study {path}: a wheel localizes reactively: give methods = ["reactive"]')
+        for p in parts:
+            if not isinstance(load_part(p), Part):
+                raise StudyError(f"study {path}: part {p} is a drawing; a wheel rolls on spline parts only")
     lk = data.get("likelihood", {})
     if not isinstance(lk, dict) or set(lk) - {"sd_length", "sd_turn_deg"}:
         raise StudyError(f"study {path}: [likelihood] takes 'sd_length' and 'sd_turn_deg'")
@@ -402,7 +435,21 @@ def load_study(path) -> Study:
         methods=tuple(methods),
         reactive=reactive,
         particle=particle,
+        jaw=jaw,
     )
+
+
+def _finger(path, spec) -> str:
+    """A study's finger spec, checked and written as :func:`localizer.parse_jaw` names it."""
+    from localizer import DEFAULT_JAW, StraightJaw, parse_jaw
+
+    try:
+        finger = parse_jaw(spec)
+    except RolltouchError as exc:
+        raise StudyError(f"study {path}: {exc}") from None
+    if isinstance(finger, StraightJaw) and finger != DEFAULT_JAW:
+        raise StudyError(f"study {path}: jaw {spec!r}: the rig models the paper's {DEFAULT_JAW} jaw only")
+    return str(finger)
 
 
 def _options(path, table, cls, name):
@@ -479,6 +526,36 @@ def start_sampler(part, rolls, jaw_start: float):
 
 def run_trial(spec: TrialSpec) -> dict:
     """One simulated localization: calibrate, pick a start, roll, localize, score. Never raises.
+
+    With a wheel (:mod:`bench.wheel_trial`) the start is drawn over the whole boundary instead; a study
+    that names its finger gets the :data:`FINGER_COLUMNS` too, for the straight jaw from a stream of
+    its own, so that its trials are the same as in any other study.
+    """
+    s = spec.study
+    jaw = s.level_jaw(spec.level)
+    if jaw.startswith("wheel"):
+        from .wheel_trial import run_wheel_trial
+
+        return run_wheel_trial(spec)
+    row = _run_straight_trial(spec)
+    if s.fingers:
+        rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial, 1]))
+        part = _part(str(next(p for p in s.parts if Path(p).name == row["part"])))
+        rolls = [math.radians(r) for r in s.rolls_deg]
+        from .methods import JAW_START
+
+        candidates, tracks = start_sampler(part, rolls, -JAW_START if rolls[0] > 0 else JAW_START)
+        ok = np.zeros(tracks.sigma.size, dtype=bool)
+        ok[candidates] = True
+        redraws = 0
+        while redraws < 1000 and not ok[int(rng.uniform(0, part.perimeter) / tracks.h) % ok.size]:
+            redraws += 1
+        row.update({"jaw": jaw, "redraws": redraws, "reachable": float(ok.mean()), "arc_mm": ""})
+    return row
+
+
+def _run_straight_trial(spec: TrialSpec) -> dict:
+    """:func:`run_trial` with the paper's straight jaw.
 
     The start is drawn uniformly over the boundary points from which the fixed rolls can run
     (module notes); a start where the simulated rig still refuses to roll (a bridge, or the jaw

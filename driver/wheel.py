@@ -53,6 +53,7 @@ __all__ = [
     "load_calibration",
     "check_calibration",
     "kappa_band",
+    "wheel_calibration_arc",
     "JUMP_FLOOR",
     "JUMP_MISMATCH",
     "WheelSlip",
@@ -397,6 +398,23 @@ def check_calibration(calibration: Calibration | WheelCalibration, finger) -> No
     jaw = calibration.jaw
     if jaw != str(finger):
         raise RigError(f"the calibration is for {jaw}, the finger is {finger}: calibrate this finger first")
+
+
+def wheel_calibration_arc(part: Part, wheel: WheelJaw) -> float:
+    """Where to calibrate a wheel on the part itself (mm): the start of the longest stretch the wheel
+    surely reaches, which :func:`calibrate_wheel` rolls along counter-clockwise."""
+    reach = wheel_reach_for(part, wheel)
+    sure = np.asarray(reach.sure)
+    if sure.all():
+        return 0.0
+    if not sure.any():
+        raise RigError(f"a {wheel} surely touches {part.name} nowhere")
+    k = int(np.flatnonzero(~sure)[0])
+    rolled = np.roll(sure, -k)  # starts on a point it does not reach
+    edges = np.flatnonzero(np.diff(rolled.astype(int)))
+    starts, ends = edges[::2] + 1, edges[1::2] + 1
+    best = int(np.argmax(ends - starts))
+    return float(reach.sigma[(starts[best] + k) % sure.size])
 
 
 def kappa_band(part: Part, wheel: WheelJaw) -> tuple[float, float]:

@@ -7,11 +7,10 @@ import json
 import math
 import sys
 
-import numpy as np
-
 from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_for
 
 from ..rig import GroundTruth, RigError
+from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
 
 __all__ = [
@@ -23,7 +22,6 @@ __all__ = [
     "run_wheel",
     "wheel_rig",
     "locate_wheel",
-    "wheel_start_arc",
 ]
 
 
@@ -41,23 +39,6 @@ def wheel_policy(args):
     from ..wheel import WheelPolicy
 
     return WheelPolicy(confidence=args.confidence, max_rotation=math.radians(args.max_rotation))
-
-
-def wheel_start_arc(part: Part, wheel: WheelJaw) -> float:
-    """Where a simulated wheel is calibrated and, by default, served: the start of the longest stretch
-    the wheel surely reaches."""
-    reach = wheel_reach_for(part, wheel)
-    sure = np.asarray(reach.sure)
-    if sure.all():
-        return 0.0
-    if not sure.any():
-        raise RigError(f"a {wheel} surely touches {part.name} nowhere")
-    k = int(np.flatnonzero(~sure)[0])
-    rolled = np.roll(sure, -k)  # starts on a point it does not reach
-    edges = np.flatnonzero(np.diff(rolled.astype(int)))
-    starts, ends = edges[::2] + 1, edges[1::2] + 1
-    best = int(np.argmax(ends - starts))
-    return float(reach.sigma[(starts[best] + k) % sure.size])
 
 
 def wheel_doc(part, run, rig, calibration) -> dict:
@@ -142,7 +123,7 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
         raise RigError(f"--start {args.start} mm: a {wheel} laid there would touch the part elsewhere; pick another")
     noise = load_noise(args.noise)
     cal_rig = WheelRig(part, wheel, noise=noise, seed=args.seed + 1)
-    calibration = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_start_arc(part, wheel)), part=part)
+    calibration = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
     rig = WheelRig(part, wheel, noise=noise, seed=args.seed)
     run = localize_with_wheel(
         rig,
@@ -176,7 +157,7 @@ def wheel_rig(part, wheel: WheelJaw, args):
     if args.engine == "pymunk":
         raise UsageError(f"--engine pymunk: the {wheel}'s world is kinematic only (the pymunk wheel is not built)")
     rig = WheelRig(part, wheel, noise=args.noise, seed=args.seed)
-    start = wheel_start_arc(part, wheel) if args.start is None else float(args.start) % part.perimeter
+    start = wheel_calibration_arc(part, wheel) if args.start is None else float(args.start) % part.perimeter
     return rig, rig.approach_pose(start)
 
 

@@ -1,0 +1,136 @@
+"""One Monte Carlo trial with a wheel finger (a study's ``jaw = "wheel:R"`` or a sweep over fingers).
+
+Reproducible from (seed, level, trial) as the straight jaw's trials: the part is drawn first, then the
+wheel's true radius (its nominal one within a ground wheel's tolerance, :data:`RADIUS_SD`), then the
+start: uniformly over the whole boundary, redrawn until the wheel surely reaches it
+(:class:`localizer.WheelReach`; the redraws are counted). The wheel is calibrated on the part itself
+(:func:`driver.wheel.calibrate_wheel` on a rig of its own: the same wheel, another machined part and
+noise), then :func:`driver.wheel.localize_with_wheel` rolls from the start with the study's
+``[reactive]`` confidence and rotation budget. The row has the straight jaw's columns, the
+``reactive_*`` method columns, and :data:`bench.study.FINGER_COLUMNS`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["run_wheel_trial", "RADIUS_SD", "MAX_REDRAWS"]
+
+#: The real wheel's radius about its nominal one, mm (a ground wheel: IT6 on a 10 mm diameter is ±9 µm).
+RADIUS_SD = 0.01
+#: Uniform draws over the boundary before a trial gives up finding a start the wheel reaches.
+MAX_REDRAWS = 1000
+
+
+def run_wheel_trial(spec) -> dict:
+    """One wheel trial (module notes). Never raises: a failure is the row's ``failure``."""
+    from driver.wheel import WheelPolicy, calibrate_wheel, localize_with_wheel, wheel_calibration_arc
+    from localizer import Part, WheelJaw, parse_jaw, wheel_reach_for
+    from sim2d.wheel_rig import WheelRig
+
+    from .methods import _curve, _err, reactive_stop, rotation_curve
+    from .study import _part
+
+    s = spec.study
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
+    part_file = s.parts[int(rng.integers(len(s.parts)))]
+    part = _part(part_file)
+    if not isinstance(part, Part):  # load_study refuses drawings with a wheel
+        raise TypeError(f"{part_file}: a wheel rolls on spline parts only")
+    noise = s.level_noise(spec.level)
+    jaw = s.level_jaw(spec.level)
+    wheel = parse_jaw(jaw)
+    assert isinstance(wheel, WheelJaw)
+    true_radius = wheel.radius + float(rng.normal(0.0, RADIUS_SD))
+    reach = wheel_reach_for(part, wheel)
+    sure = np.asarray(reach.sure)
+    redraws, start = 0, math.nan
+    while redraws < MAX_REDRAWS:
+        u = float(rng.uniform(0.0, part.perimeter))
+        if sure[int(u / reach.h) % sure.size]:
+            start = u
+            break
+        redraws += 1
+    row = {
+        "level": spec.level,
+        "trial": spec.trial,
+        "parameter": s.parameter or "",
+        "value": s.level_label(spec.level),
+        "part": Path(part_file).name,
+        "start_arc": start,
+        "lengths": "",
+        "turns": "",
+        "restarts": 0,
+        "candidates": "",
+        "jaw": jaw,
+        "redraws": redraws,
+        "reachable": float(sure.mean()),
+    }
+    cal_seed, rig_seed = int(rng.integers(1 << 31)), int(rng.integers(1 << 31))
+    try:
+        if not math.isfinite(start):
+            raise RuntimeError(f"no start the {wheel} reaches in {MAX_REDRAWS} draws on {part.name}")
+        cal_rig = WheelRig(part, wheel, noise=noise, seed=cal_seed, true_radius=true_radius)
+        cal = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
+        rig = WheelRig(part, wheel, noise=noise, seed=rig_seed, true_radius=true_radius)
+        policy = WheelPolicy(confidence=s.reactive.confidence, max_rotation=math.radians(s.reactive.max_rotation_deg))
+        run = localize_with_wheel(
+            rig, part, wheel, approach_pose=rig.approach_pose(start), calibration=cal, policy=policy
+        )
+    except Exception as exc:  # noqa: BLE001 - the trial's failure is its result
+        text = f"{type(exc).__name__}: {exc}"[:200]
+        row.update(
+            {
+                "true_arc": math.nan,
+                "estimate_arc": math.nan,
+                "error_mm": math.inf,
+                "success": 0,
+                "probability": 0.0,
+                "ambiguous": 0,
+                "failure": text,
+                "arc_mm": math.nan,
+                "reactive_success": 0,
+                "reactive_error_mm": math.inf,
+                "reactive_estimate_arc": math.nan,
+                "reactive_rotation_deg": math.nan,
+                "reactive_curve": "",
+                "reactive_stopped": "error",
+                "reactive_mass": "",
+                "reactive_failure": text,
+                "reactive_bridges": "",
+                "time_s": time.perf_counter() - t0,
+            }
+        )
+        return row
+    truth = rig.truth()["contact_arc"]
+    err = _err(part, run.estimate_arc, truth)
+    rot = math.degrees(run.rotation)
+    ok = int(err < s.success_radius)
+    row.update(
+        {
+            "true_arc": truth,
+            "estimate_arc": run.estimate_arc,
+            "error_mm": err,
+            "success": ok,
+            "probability": run.belief.mass,
+            "ambiguous": int(run.belief.ambiguous),
+            "failure": "",
+            "arc_mm": run.arc,
+            "reactive_success": ok,
+            "reactive_error_mm": err,
+            "reactive_estimate_arc": run.estimate_arc,
+            "reactive_rotation_deg": rot,
+            "reactive_curve": _curve(rotation_curve(part, run.history, rot, err, s.reactive.max_rotation_deg)),
+            "reactive_stopped": reactive_stop(run),
+            "reactive_mass": run.belief.mass,
+            "reactive_failure": "",
+            "reactive_bridges": run.jumps,
+            "time_s": time.perf_counter() - t0,
+        }
+    )
+    return row
