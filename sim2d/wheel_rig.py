@@ -19,6 +19,7 @@ from localizer import Outline, Part, WheelJaw
 from ._errors import SimError
 from .machining import machined_outline, machined_part
 from .noise import NoiseModel, load_noise
+from .pymunk_wheel import PymunkWheelWorld
 from .wheel_world import WheelWorld
 from .wrist import Wrist, encoder_angle
 
@@ -46,7 +47,11 @@ class WheelRig:
     direction_zero : float, rad
         The channels' mounting rotation about the axle: what the calibration finds too.
     slip : float
-        Fraction of the rolled arc the rim loses (:class:`sim2d.wheel_world.WheelWorld`).
+        Fraction of the rolled arc the rim loses (:class:`sim2d.wheel_world.WheelWorld`; the kinematic
+        world only).
+    engine : {"kinematic", "pymunk"}
+        The kinematic world (:class:`sim2d.wheel_world.WheelWorld`) or the rigid bodies of
+        :class:`sim2d.pymunk_wheel.PymunkWheelWorld` (a disc rolling by friction on a bearing).
     linear_speed, angular_speed : float, mm/s and rad/s
     sample_period : float, s
     """
@@ -63,6 +68,7 @@ class WheelRig:
         true_radius: float | None = None,
         direction_zero: float = 0.0,
         slip: float = 0.0,
+        engine: str = "kinematic",
         linear_speed: float = 20.0,
         angular_speed: float = math.radians(30.0),
         sample_period: float = 1e-3,
@@ -79,7 +85,17 @@ class WheelRig:
             else machined_part(part, self.noise, self.rng)
         )
         radius = wheel.radius if true_radius is None else float(true_radius)
-        self.world = WheelWorld(real, part, radius, stiffness=stiffness, slip=slip)
+        self.world: WheelWorld | PymunkWheelWorld
+        if engine == "pymunk":
+            if slip:
+                raise SimError("slip is the kinematic world's: in pymunk the rim slips by its friction alone")
+            self.world = PymunkWheelWorld(
+                real, part, radius, stiffness=stiffness, linear_speed=linear_speed, angular_speed=angular_speed
+            )
+        elif engine == "kinematic":
+            self.world = WheelWorld(real, part, radius, stiffness=stiffness, slip=slip)
+        else:
+            raise SimError(f"unknown engine {engine!r}; use kinematic or pymunk")
         self.volts_per_newton = float(volts_per_newton)
         self.direction_zero = float(direction_zero)
         self.linear_speed, self.angular_speed = float(linear_speed), float(angular_speed)

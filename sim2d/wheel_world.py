@@ -107,7 +107,7 @@ class WheelWorld:
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None  # (arc, point, axle) of the last contact
 
     # ----------------------------------------------------------- geometry
-    def _nearest(self, c: np.ndarray) -> tuple[float, np.ndarray, float]:
+    def nearest(self, c: np.ndarray) -> tuple[float, np.ndarray, float]:
         """(model arc mm, point, distance mm) of the boundary point nearest to ``c``."""
         _, k = self._tree.query(c)
         n = self._xy.shape[0]
@@ -154,7 +154,7 @@ class WheelWorld:
         the disc's centre, depth mm). The wrist gives so that no point of the part comes nearer to the
         disc's centre than r: the centre is pushed out from the nearest point, again until nothing is
         nearer (in a pocket too narrow for the disc it settles touching both walls). Depth ≤ 0: clear."""
-        arc, p, d = self._nearest(c)
+        arc, p, d = self.nearest(c)
         if d >= self.radius:
             return arc, p, c, self.radius - d
         if d < 1e-9:
@@ -162,7 +162,7 @@ class WheelWorld:
         centre = c
         for _ in range(200):
             centre = p + (centre - p) * (self.radius / d)
-            arc, p, d = self._nearest(centre)
+            arc, p, d = self.nearest(centre)
             if d >= self.radius - 1e-9:
                 break
         return arc, p, centre, float(np.hypot(*(centre - c)))

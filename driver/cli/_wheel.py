@@ -114,17 +114,15 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     part = _spline_only(part, wheel)
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
-    if args.engine == "pymunk":
-        raise UsageError(f"--engine pymunk: the {wheel}'s world is kinematic only (the pymunk wheel is not built)")
-    args.engine = "kinematic"
+    args.engine = args.engine or "pymunk"
     if not 0 <= args.start < part.perimeter:
         raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
     if not bool(wheel_reach_for(part, wheel).touchable(args.start)):
         raise RigError(f"--start {args.start} mm: a {wheel} laid there would touch the part elsewhere; pick another")
     noise = load_noise(args.noise)
-    cal_rig = WheelRig(part, wheel, noise=noise, seed=args.seed + 1)
+    cal_rig = WheelRig(part, wheel, noise=noise, seed=args.seed + 1, engine=args.engine)
     calibration = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
-    rig = WheelRig(part, wheel, noise=noise, seed=args.seed)
+    rig = WheelRig(part, wheel, noise=noise, seed=args.seed, engine=args.engine)
     run = localize_with_wheel(
         rig,
         part,
@@ -139,7 +137,7 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
         run,
         calibration,
         part={"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
-        engine="kinematic",
+        engine=args.engine,
         noise=str(args.noise),
         seed=args.seed,
         start_arc=args.start,
@@ -154,9 +152,7 @@ def wheel_rig(part, wheel: WheelJaw, args):
     from sim2d.wheel_rig import WheelRig
 
     part = _spline_only(part, wheel)
-    if args.engine == "pymunk":
-        raise UsageError(f"--engine pymunk: the {wheel}'s world is kinematic only (the pymunk wheel is not built)")
-    rig = WheelRig(part, wheel, noise=args.noise, seed=args.seed)
+    rig = WheelRig(part, wheel, noise=args.noise, seed=args.seed, engine=args.engine)
     start = wheel_calibration_arc(part, wheel) if args.start is None else float(args.start) % part.perimeter
     return rig, rig.approach_pose(start)
 

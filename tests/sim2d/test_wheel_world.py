@@ -99,3 +99,27 @@ def test_the_axle_encoder_is_quantized_and_a_bad_wheel_is_refused():
         WheelRig(part, "wheel:5")  # type: ignore[arg-type]
     with pytest.raises(SimError, match="slip"):
         WheelWorld(part, part, 5.0, slip=1.5)
+
+
+def test_the_pymunk_disc_rolls_as_the_kinematic_one():
+    """The same commanded axle path on both worlds: contacts, force directions and the encoder agree."""
+    part = load_part(KIDNEY)
+    wheel = WheelJaw(5.0)
+    kin = WheelRig(part, wheel, noise="none")
+    dyn = WheelRig(part, wheel, noise="none", engine="pymunk")
+    sigma = np.linspace(0, part.perimeter, 4000, endpoint=False)
+    concave = sigma[part.curvature_at_arc(sigma) < 0]
+    dyn.move(*kin.approach_pose(concave[0] - 5.0, standoff=1.0))  # the arm starts clear of the part
+    turned = []
+    for s in np.linspace(concave[0] - 5.0, concave[0] + 15.0, 81):  # through a concave stretch
+        pose = kin.approach_pose(s, standoff=-1.0)  # 1 mm pressed
+        for rig in (kin, dyn):
+            rig.move(*pose)
+        a, b = kin.world.contact(), dyn.world.contact()
+        assert b.arc == pytest.approx(a.arc, abs=0.02)
+        assert b.normal == pytest.approx(a.normal, abs=2e-3)
+        assert b.force == pytest.approx(a.force, rel=0.05)
+        turned.append(dyn.axle() - kin.axle())
+    assert turned[-1] - turned[0] == pytest.approx(0.0, abs=2e-3)  # rad, after a 20 mm roll of 4 rad
+    with pytest.raises(SimError, match="slip is the kinematic"):
+        WheelRig(part, wheel, engine="pymunk", slip=0.1)
