@@ -424,8 +424,12 @@ def plot_study(study: Study, rows, out: Path) -> None:
     if study.methods and rows:
         _plot_methods(study, full, out)
         _plot_reliability(study, rows, out)
+    if study.parameter == "jaw" and rows:
+        _plot_fingers(study, rows, summ, out)
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     x = [lv["value"] if isinstance(lv["value"], (int, float)) else k for k, lv in enumerate(summ)]
+    if not all(isinstance(lv["value"], (int, float)) for lv in summ):
+        ax.set_xticks(range(len(summ)), [str(lv["value"]) for lv in summ], fontsize=8)
     rate = np.array([lv["success_rate"] if lv["success_rate"] is not None else np.nan for lv in summ])
     lo = np.array([lv["ci95"][0] for lv in summ])
     hi = np.array([lv["ci95"][1] for lv in summ])
@@ -480,6 +484,51 @@ def plot_study(study: Study, rows, out: Path) -> None:
         fig.tight_layout()
         fig.savefig(out / "failures.png", dpi=110)
         plt.close(fig)
+
+
+def _plot_fingers(study: Study, rows, levels: list, out: Path) -> None:
+    """fingers.png for a sweep over fingers: success against the rotation used, per finger (left), and
+    where each can start and how far it rolled (right)."""
+    import matplotlib.pyplot as plt
+
+    from .methods import MARK_DEG, parse_curve
+
+    m = study.methods[0]
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})
+    for lv in levels:
+        sel = [r for r in rows if int(r["level"]) == lv["level"]]
+        marks = np.arange(MARK_DEG, study.reactive.max_rotation_deg + 1e-9, MARK_DEG)
+        hit = np.zeros(marks.size)
+        for r in sel:
+            pairs = dict((round(k, 6), e) for k, e in parse_curve(r[f"{m}_curve"]))
+            hit += [pairs.get(round(k, 6), math.inf) < study.success_radius for k in marks]
+        d = lv["methods"][m]
+        ax.plot(
+            marks,
+            hit / max(len(sel), 1),
+            "o-",
+            ms=2.5,
+            label=f"{lv['value']}: {d['success']}/{d['trials']}, median {d['median_rotation_deg']:.0f}°",
+        )
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel("rotation used (degrees; a wheel: the hand's turning)")
+    ax.set_ylabel(f"success rate (error < {study.success_radius} mm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
+    names = [str(lv["value"]) for lv in levels]
+    reach = [lv.get("reachable", math.nan) for lv in levels]
+    bx.bar(names, reach, color="tab:blue", alpha=0.7, label="boundary a start can be drawn from")
+    for k, lv in enumerate(levels):
+        bx.text(k, reach[k] + 0.02, f"{lv.get('mean_redraws', 0):.1f} redraws", ha="center", fontsize=7)
+    bx.set_ylim(0, 1.15)
+    bx.set_ylabel("fraction of the boundary")
+    bx.legend(fontsize=7, loc="lower right")
+    bx.grid(alpha=0.3, axis="y")
+    bx.tick_params(axis="x", labelsize=8)
+    fig.suptitle(f"{study.name}: fingers on the same trial seeds, noise {Path(str(study.noise)).stem}", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out / "fingers.png", dpi=110)
+    plt.close(fig)
 
 
 def _plot_methods(study: Study, summary: dict, out: Path) -> None:
