@@ -56,6 +56,7 @@ __all__ = [
     "check_calibration",
     "kappa_band",
     "wheel_calibration_arc",
+    "CALIBRATION_LENGTH",
     "JUMP_FLOOR",
     "JUMP_MISMATCH",
     "WheelSlip",
@@ -64,6 +65,8 @@ __all__ = [
 #: A step's change of turn outside the part's turning over the rolled arc by this (rad) is a jump: 0.5°,
 #: twenty times the wrist's residual direction.
 JUMP_FLOOR = math.radians(0.5)
+#: Axle travel of a wheel's calibration (mm): the radius's error falls as its inverse.
+CALIBRATION_LENGTH = 40.0
 #: A step whose axle path and encoders disagree by more than this fraction of the step is a jump (slip
 #: is gradual: a rim that loses this much in one step has lost the contact).
 JUMP_MISMATCH = 0.25
@@ -322,7 +325,7 @@ def calibrate_wheel(
     approach_pose,
     *,
     part: Part | None = None,
-    length: float = 40.0,
+    length: float = CALIBRATION_LENGTH,
     policy: WheelPolicy = WheelPolicy(),
     pressing: PressSettings = PRESS,
 ) -> WheelCalibration:
@@ -413,9 +416,16 @@ def check_calibration(calibration: Calibration | WheelCalibration, finger) -> No
         raise RigError(f"the calibration is for {jaw}, the finger is {finger}: calibrate this finger first")
 
 
-def wheel_calibration_arc(part: Part, wheel: WheelJaw) -> float:
-    """Where to calibrate a wheel on the part itself (mm): the start of the longest stretch the wheel
-    surely reaches, which :func:`calibrate_wheel` rolls along counter-clockwise."""
+def wheel_calibration_arc(part: Part, wheel: WheelJaw, length: float = CALIBRATION_LENGTH) -> float:
+    """Where to calibrate a wheel on the part itself (mm): within the longest stretch the wheel surely
+    reaches, ``length`` mm of it centred (at least 2 mm from its ends), which :func:`calibrate_wheel`
+    rolls along counter-clockwise.
+
+    Raises
+    ------
+    RigError
+        No stretch the wheel surely reaches is ``length`` + 4 mm long: calibrate on a gauge block.
+    """
     reach = wheel_reach_for(part, wheel)
     sure = np.asarray(reach.sure)
     if sure.all():
@@ -423,11 +433,19 @@ def wheel_calibration_arc(part: Part, wheel: WheelJaw) -> float:
     if not sure.any():
         raise RigError(f"a {wheel} surely touches {part.name} nowhere")
     k = int(np.flatnonzero(~sure)[0])
-    rolled = np.roll(sure, -k)  # starts on a point it does not reach
-    edges = np.flatnonzero(np.diff(rolled.astype(int)))
-    starts, ends = edges[::2] + 1, edges[1::2] + 1
+    rolled = np.roll(sure, -k)  # starts on a point it does not reach, so no run wraps
+    starts = np.flatnonzero(~rolled[:-1] & rolled[1:]) + 1
+    ends = np.flatnonzero(rolled[:-1] & ~rolled[1:]) + 1
+    if rolled[-1]:
+        ends = np.append(ends, rolled.size)
     best = int(np.argmax(ends - starts))
-    return float(reach.sigma[(starts[best] + k) % sure.size])
+    run = (ends[best] - starts[best]) * reach.h
+    if run < length + 4.0:
+        raise RigError(
+            f"the longest stretch of {part.name} a {wheel} surely reaches is {run:.1f} mm, less than the "
+            f"calibration's {length:g} mm and 2 mm each side: calibrate on a gauge block"
+        )
+    return float(part.wrap_arc(reach.sigma[(starts[best] + k) % sure.size] + 0.5 * (run - length)))
 
 
 def _along(a, b, zero: float = 0.0):

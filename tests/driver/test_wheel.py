@@ -201,3 +201,26 @@ def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_reading
     assert json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"], abs=1e-6)
     other = cli("locate", str(tmp_path / "r.jsonl"), "--part", kidney, "--jaw", "wheel:3")
     assert other.returncode == 2 and "not of wheel:3" in other.stderr
+
+
+def test_the_calibration_stretch_lies_within_the_longest_the_wheel_surely_reaches():
+    from driver.wheel import CALIBRATION_LENGTH, wheel_calibration_arc
+
+    for name in ("glyph-06", "star-04"):
+        part = load_part(f"bench/parts/tuning/{name}.json")
+        wheel = WheelJaw(5.0)
+        reach = WheelReach(part, wheel)
+        start = wheel_calibration_arc(part, wheel)
+        # brute force: the runs of sure points, walked from a point it does not reach
+        first = int(np.argmin(reach.sure))
+        runs, count = [], 0
+        for j in range(reach.sigma.size):
+            i = (first + j) % reach.sigma.size
+            count = count + 1 if reach.sure[i] else 0
+            runs.append((count, i))
+        longest, end = max(runs)
+        run_start = reach.sigma[(end - longest + 1) % reach.sigma.size]
+        offset = float(part.arc_offset(start, run_start))
+        assert offset >= 2.0 and offset + CALIBRATION_LENGTH <= longest * reach.h - 2.0 + reach.h
+    with pytest.raises(RigError, match="gauge block"):
+        wheel_calibration_arc(part, wheel, length=1000.0)
