@@ -68,7 +68,6 @@ method's failure (``<method>_stopped = "error"``, ``<method>_failure``), never t
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 import tomllib
@@ -80,6 +79,8 @@ import numpy as np
 from driver.procedures import STEP_RANGE_DEG
 from driver.reactive import CONFIDENCE, MAX_ROTATION
 from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, check_size, load_part
+
+from .part_cache import cached_part
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -504,12 +505,6 @@ class TrialSpec:
     extra: dict = field(default_factory=dict)
 
 
-@functools.cache
-def _part(path: str) -> Part | Outline:
-    """The part file at ``path``, read once per worker process (its tables are kept with it)."""
-    return load_part(path)
-
-
 def start_sampler(part, rolls, jaw_start: float):
     """Boundary points (grid indices) and grid step of the filter's tracks from which the jaw, laid with
     the contact at ``jaw_start`` mm on it, rolls through ``rolls`` (rad, one sign) without bridging,
@@ -540,7 +535,7 @@ def run_trial(spec: TrialSpec) -> dict:
     row = _run_straight_trial(spec)
     if s.fingers:
         rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial, 1]))
-        part = _part(str(next(p for p in s.parts if Path(p).name == row["part"])))
+        part = cached_part(str(next(p for p in s.parts if Path(p).name == row["part"])))
         rolls = [math.radians(r) for r in s.rolls_deg]
         from .methods import JAW_START
 
@@ -572,7 +567,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
     t0 = time.perf_counter()
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
     part_file = s.parts[int(rng.integers(len(s.parts)))]
-    part = _part(part_file)
+    part = cached_part(part_file)
     noise = s.level_noise(spec.level)
     row = {
         "level": spec.level,

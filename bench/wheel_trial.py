@@ -30,16 +30,16 @@ def run_wheel_trial(spec) -> dict:
     """One wheel trial (module notes). Never raises: a failure is the row's ``failure``."""
     from driver.wheel import WheelPolicy, calibrate_wheel, localize_with_wheel, wheel_calibration_arc
     from localizer import Part, WheelJaw, parse_jaw, wheel_reach_for
-    from sim2d.wheel_rig import WheelRig
+    from sim2d import WheelRig
 
     from .methods import _curve, _err, reactive_stop, rotation_curve
-    from .study import _part
+    from .part_cache import cached_part
 
     s = spec.study
     t0 = time.perf_counter()
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
     part_file = s.parts[int(rng.integers(len(s.parts)))]
-    part = _part(part_file)
+    part = cached_part(part_file)
     if not isinstance(part, Part):  # load_study refuses drawings with a wheel
         raise TypeError(f"{part_file}: a wheel rolls on spline parts only")
     noise = s.level_noise(spec.level)

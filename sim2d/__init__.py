@@ -4,6 +4,8 @@ from ._errors import SimError
 from .machining import machined_part, machining_slope
 from .noise import PRESETS, NoiseModel, load_noise
 from .rig import SimRig
+from .wheel_rig import WheelRig
+from .wheel_world import WheelContact, WheelWorld
 from .world import Contact, World
 from .wrist import Wrist, encoder_angle
 
@@ -13,6 +15,9 @@ __all__ = [
     "PRESETS",
     "load_noise",
     "SimRig",
+    "WheelRig",
+    "WheelWorld",
+    "WheelContact",
     "Wrist",
     "encoder_angle",
     "machined_part",

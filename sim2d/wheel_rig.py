@@ -11,6 +11,7 @@ Every reading is logged with the ground truth beside it.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,9 +20,11 @@ from localizer import Outline, Part, WheelJaw
 from ._errors import SimError
 from .machining import machined_outline, machined_part
 from .noise import NoiseModel, load_noise
-from .pymunk_wheel import PymunkWheelWorld
 from .wheel_world import WheelWorld
 from .wrist import Wrist, encoder_angle
+
+if TYPE_CHECKING:
+    from .pymunk_wheel import PymunkWheelWorld
 
 __all__ = ["WheelRig"]
 
@@ -87,6 +90,8 @@ class WheelRig:
         radius = wheel.radius if true_radius is None else float(true_radius)
         self.world: WheelWorld | PymunkWheelWorld
         if engine == "pymunk":
+            from .pymunk_wheel import PymunkWheelWorld
+
             if slip:
                 raise SimError("slip is the kinematic world's: in pymunk the rim slips by its friction alone")
             self.world = PymunkWheelWorld(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import sys
@@ -11,7 +12,38 @@ from localizer import FIT_ALPHA, SUCCESS_RADIUS, ContactFilter
 from ..rig import GroundTruth
 from ._options import pressing
 
-__all__ = ["run_reactive", "print_reactive", "run_summary", "emit_run", "print_run", "no_fit_line"]
+__all__ = [
+    "CONNECTING",
+    "RELEASED",
+    "ending_progress_line",
+    "run_reactive",
+    "print_reactive",
+    "run_summary",
+    "emit_run",
+    "print_run",
+    "no_fit_line",
+]
+
+
+#: What an interrupted rig command had done, before it had the arm and after it let it go (inside,
+#: the serial rig's safe stop says what it did).
+CONNECTING = "no motion had been sent to the arm (it was being connected)"
+RELEASED = "the arm's part of the run had ended: nothing was moving"
+
+
+@contextlib.contextmanager
+def ending_progress_line(log):
+    """End the progress line on stderr; on any failure log it and close the run log, then re-raise."""
+    try:
+        yield
+        sys.stderr.write("\n")
+    except BaseException as exc:
+        sys.stderr.write("\n")
+        if log is not None:
+            notes = "; ".join(getattr(exc, "__notes__", []))
+            log({"event": "error", "message": str(exc) or type(exc).__name__, "host": notes})
+            log.close()
+        raise
 
 
 def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:

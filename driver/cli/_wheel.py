@@ -12,6 +12,7 @@ from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_fo
 from ..rig import GroundTruth, RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
+from ._output import CONNECTING, RELEASED, ending_progress_line
 
 __all__ = [
     "wheel_policy",
@@ -105,8 +106,7 @@ def _emit(args, doc, part, run, out: str | None) -> int:
 
 def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     """'simulate --jaw wheel:MM --reactive': calibrate a simulated wheel, roll it from --start, save the trace."""
-    from sim2d import load_noise
-    from sim2d.wheel_rig import WheelRig
+    from sim2d import WheelRig, load_noise
 
     from ..wheel import calibrate_wheel, localize_with_wheel
     from ..wheel_trace import WheelTrace
@@ -149,7 +149,7 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
 
 def wheel_rig(part, wheel: WheelJaw, args):
     """The simulated wheel rig 'emulate --jaw wheel:MM' serves, and its start pose (the wheel 1 mm off)."""
-    from sim2d.wheel_rig import WheelRig
+    from sim2d import WheelRig
 
     part = _spline_only(part, wheel)
     rig = WheelRig(part, wheel, noise=args.noise, seed=args.seed, engine=args.engine)
@@ -170,7 +170,6 @@ def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
     calibrate there unless a calibration is given, then roll until sure."""
     from ..serial_rig import SerialRig
     from ..wheel import WheelCalibration, calibrate_wheel, localize_with_wheel
-    from .rig import CONNECTING, RELEASED, _ending_progress_line
 
     part = _spline_only(part, wheel)
     if not args.reactive:
@@ -191,7 +190,7 @@ def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
             sys.stderr.flush()
 
     args.interrupted = CONNECTING
-    with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+    with ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         here = tuple(rig.pose())
         if calibration is None:
             calibration = calibrate_wheel(rig, wheel, here, part=part)

@@ -4,7 +4,6 @@ by :class:`driver.serial_rig.SerialRig` on leaving."""
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import sys
@@ -26,7 +25,7 @@ from ._options import (
     servo_arguments,
     step_degrees,
 )
-from ._output import emit_run, print_reactive, run_reactive, run_summary
+from ._output import CONNECTING, RELEASED, emit_run, ending_progress_line, print_reactive, run_reactive, run_summary
 from ._wheel import calibrate_wheel_here, run_wheel
 
 __all__ = ["register", "calibrate_command", "run_command"]
@@ -74,12 +73,6 @@ def register(sub) -> None:
     run.add_argument("--log", metavar="FILE.jsonl", help="run log, JSON Lines, flushed per sample")
     run.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses and the estimate")
     run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
-
-
-#: What an interrupted rig command had done, before it had the arm and after it let it go (inside,
-#: the serial rig's safe stop says what it did).
-CONNECTING = "no motion had been sent to the arm (it was being connected)"
-RELEASED = "the arm's part of the run had ended: nothing was moving"
 
 
 def calibrate_command(args) -> int:
@@ -159,7 +152,7 @@ def run_command(args) -> int:
     if args.reactive:
         return _run_reactively(args, part, calibration, log, observer)
     args.interrupted = CONNECTING
-    with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+    with ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         run, calibration = run_from_here(
             rig,
             part,
@@ -199,21 +192,6 @@ def _wheel_header(args, part, calibration) -> dict:
     return header
 
 
-@contextlib.contextmanager
-def _ending_progress_line(log):
-    """End the progress line on stderr; on any failure log it and close the run log, then re-raise."""
-    try:
-        yield
-        sys.stderr.write("\n")
-    except BaseException as exc:
-        sys.stderr.write("\n")
-        if log is not None:
-            notes = "; ".join(getattr(exc, "__notes__", []))
-            log({"event": "error", "message": str(exc) or type(exc).__name__, "host": notes})
-            log.close()
-        raise
-
-
 def _run_reactively(args, part, calibration, log, observer) -> int:
     """'run --reactive': from the present pose, calibrate if needed, slide 40 mm, roll until sure."""
     from driver.procedures import Hand, calibrate
@@ -229,7 +207,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
             sys.stderr.flush()
 
     args.interrupted = CONNECTING
-    with _ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+    with ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
         here = tuple(rig.pose())
         if calibration is None:
             calibration = calibrate(rig, here)

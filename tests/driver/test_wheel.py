@@ -9,8 +9,7 @@ import pytest
 from driver.rig import RigError
 from driver.wheel import WheelCalibration, WheelPolicy, WheelSlip, localize_with_wheel
 from localizer import WheelJaw, WheelReach, load_part, part_from_points
-from sim2d import SimRig
-from sim2d.wheel_rig import WheelRig
+from sim2d import SimRig, WheelRig
 
 
 def concave_starts(part, wheel, n, seed=0):

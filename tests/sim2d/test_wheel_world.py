@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from localizer import WheelJaw, load_part, part_from_points
-from sim2d import SimError
-from sim2d.wheel_rig import WheelRig
+from sim2d import SimError, WheelRig
 from sim2d.wheel_world import WheelWorld
 
 KIDNEY = "parts/kidney.csv"
