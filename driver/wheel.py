@@ -26,7 +26,9 @@ wheel too. Each rolling step:
    :class:`WheelSlip`, as the L readings are no longer the part's arc).
 
 :func:`localize_with_wheel` rolls one way, turning round at a jump, and gives the readings to a
-:class:`localizer.WheelFilter` until it is sure (or the budget is spent).
+:class:`localizer.WheelFilter` until it is sure (or the budget is spent). When nothing on the part fits
+what was read (a jam that reads as rolling in a concave arc of the wheel's own radius), it retraces
+its poses back to where that segment of rolling started and starts afresh there, the other way.
 """
 
 from __future__ import annotations
@@ -57,6 +59,7 @@ __all__ = [
     "kappa_band",
     "wheel_calibration_arc",
     "CALIBRATION_LENGTH",
+    "MAX_RESTARTS",
     "JUMP_FLOOR",
     "JUMP_MISMATCH",
     "WheelSlip",
@@ -65,6 +68,8 @@ __all__ = [
 #: A step's change of turn outside the part's turning over the rolled arc by this (rad) is a jump: 0.5°,
 #: twenty times the wrist's residual direction.
 JUMP_FLOOR = math.radians(0.5)
+#: Times the rolling may start afresh after nothing fit its readings, before it stops "blocked".
+MAX_RESTARTS = 2
 #: Axle travel of a wheel's calibration (mm): the radius's error falls as its inverse.
 CALIBRATION_LENGTH = 40.0
 #: A step whose axle path and encoders disagree by more than this fraction of the step is a jump (slip
@@ -208,7 +213,8 @@ class WheelRun:
         Arc rolled, both ways counted.
     steps : int
     stopped : str
-        "confident", "max_rotation", "max_arc" or "blocked" (jumps both ways); slip beyond the
+        "confident", "max_rotation", "max_arc" or "blocked" (jumps both ways, or nothing fitting
+        after :data:`MAX_RESTARTS` fresh starts); slip beyond the
         policy's limit raises :class:`WheelSlip` instead.
     reversals, jumps : int
     slip : float, mm
@@ -217,7 +223,12 @@ class WheelRun:
         The wrist's give at the target force (measured at the first press).
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
     lengths, turns, true_arcs : tuple of float
-        Every reading's L (mm) and Ω (rad) since the start, and the true contact (NaN on a real rig).
+        Every reading's L (mm) and Ω (rad) since its segment's start, and the true contact (NaN on a
+        real rig).
+    segments : tuple of int
+        Each reading's segment: the rolling retraces the last segment and starts afresh (a new
+        segment, from (0, 0)) when nothing on the part fits its readings
+        (:attr:`localizer.Belief.consistent`).
     """
 
     belief: Belief
@@ -233,6 +244,12 @@ class WheelRun:
     lengths: tuple = field(repr=False, default=())
     turns: tuple = field(repr=False, default=())
     true_arcs: tuple = field(repr=False, default=())
+    segments: tuple = field(repr=False, default=())
+
+    @property
+    def restarts(self) -> int:
+        """Times the rolling started afresh (module notes)."""
+        return int(self.segments[-1]) if self.segments else 0
 
     @property
     def estimate_arc(self) -> float:
@@ -287,6 +304,10 @@ class _Wheel:
         if f < 0.1 * pol.target:
             raise RigError(f"the wheel lost the part (|Δv| = {f:.3g} V after the step): start again closer")
         return f, a
+
+    def settled(self) -> tuple[float, float, float, float, float]:
+        """The state (φ, α, ψ_e, x, y) after servoing where the hand is now."""
+        return self._state()
 
     def _state(self) -> tuple[float, float, float, float, float]:
         """(φ, α, ψ_e, x, y) at a settled pose."""
@@ -507,9 +528,10 @@ def localize_with_wheel(
     pol = policy
     max_arc = pol.max_arc if pol.max_arc is not None else float(part.perimeter)
     start = disc.begin(approach_pose)
-    lengths, turns, truths, history = [0.0], [0.0], [disc.truth()], []
+    lengths, turns, truths, segments, history = [0.0], [0.0], [disc.truth()], [0], []
     flt.update(0.0, 0.0)
-    direction, reversals, jumps, steps = 1, 0, 0, 0
+    direction, reversals, jumps, steps, segment = 1, 0, 0, 0, 0
+    poses, segment_rotation = [disc.hand.pose], 0.0  # the settled poses of this segment, to retrace
     rotation = arc = slip = 0.0
     blocked_at: float | None = None
     stopped = "max_rotation"
@@ -527,15 +549,18 @@ def localize_with_wheel(
         d_turn, d_len, mismatch = moved
         slip += mismatch
         rotation += abs(d_turn)
+        segment_rotation += abs(d_turn)
         arc += abs(d_len)
         steps += 1
+        poses.append(disc.hand.pose)
         now = disc.state
         lengths.append(lengths[-1] + d_len)
         turns.append((now[0] + now[1]) - (start[0] + start[1]))
         truths.append(disc.truth())
+        segments.append(segment)
         flt.update(lengths[-1], turns[-1])
         if observer is not None:
-            observer({"event": "reading", "length": lengths[-1], "turn": turns[-1]})
+            observer({"event": "reading", "length": lengths[-1], "turn": turns[-1], "segment": segment})
         if abs(slip) > pol.max_slip + pol.max_slip_fraction * arc:
             raise WheelSlip(
                 f"the wheel's rim slipped {slip:+.3f} mm over {arc:.1f} mm rolled (the axle's path against the "
@@ -551,6 +576,27 @@ def localize_with_wheel(
             if belief.mass >= pol.confidence:
                 stopped = "confident"
                 break
+            if not belief.consistent:
+                # nothing fits what was read since the segment's start: the wheel jammed where it read
+                # as rolling. Retrace the segment's poses back to its start (the jam unwinds as it
+                # was wound), and start afresh there, the other way; twice at the most
+                if segment >= MAX_RESTARTS:
+                    stopped = "blocked"
+                    break
+                for pose in reversed(poses[:-1]):
+                    disc.hand.go(*pose)
+                disc.state = disc.settled()
+                rotation += segment_rotation
+                poses, segment_rotation = [disc.hand.pose], 0.0
+                start, segment = disc.state, segment + 1
+                flt.reset()
+                flt.update(0.0, 0.0)
+                lengths.append(0.0)
+                turns.append(0.0)
+                truths.append(disc.truth())
+                segments.append(segment)
+                direction, reversals = -direction, reversals + 1
+                blocked_at = None
         if rotation >= pol.max_rotation:
             stopped = "max_rotation"
             break
@@ -571,4 +617,5 @@ def localize_with_wheel(
         lengths=tuple(lengths),
         turns=tuple(turns),
         true_arcs=tuple(truths),
+        segments=tuple(segments),
     )

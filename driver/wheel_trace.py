@@ -1,7 +1,8 @@
 """A wheel finger's trace: what a wheel's rolling read, saved as ``.npz`` arrays plus JSON metadata.
 
-One row per reading given to the filter: the arc rolled since the start L (mm, from the axle encoder),
-the hand's net turn Ω (rad), and on a simulated rig the true contact (mm). The metadata names the
+One row per reading given to the filter: its segment (the rolling starts afresh when nothing fits),
+the arc rolled since the segment's start L (mm, from the axle encoder), the hand's net turn Ω (rad),
+and on a simulated rig the true contact (mm). The metadata names the
 finger (``jaw``) and holds its calibration, how the run was made and how it ended; a trace is read
 back only as a wheel's (:meth:`WheelTrace.load` refuses a straight jaw's trace, and
 :meth:`driver.trace.Trace.load` a wheel's), and relocalized from its readings with the finger it names.
@@ -23,7 +24,7 @@ from .wheel import WheelCalibration, WheelRun
 
 __all__ = ["WheelTrace", "WHEEL_COLUMNS", "WHEEL_FORMAT"]
 
-WHEEL_COLUMNS = ("length", "turn", "true_arc")
+WHEEL_COLUMNS = ("segment", "length", "turn", "true_arc")
 WHEEL_FORMAT = "rolltouch-wheel-trace/1"
 
 
@@ -46,6 +47,7 @@ class WheelTrace:
     def from_run(cls, run: WheelRun, calibration: WheelCalibration, **metadata) -> WheelTrace:
         """The readings of a :class:`driver.wheel.WheelRun` with ``metadata`` about how it was made."""
         columns = {
+            "segment": np.asarray(run.segments, dtype=np.int64),
             "length": np.asarray(run.lengths, dtype=float),
             "turn": np.asarray(run.turns, dtype=float),
             "true_arc": np.asarray(run.true_arcs, dtype=float),
@@ -84,6 +86,7 @@ class WheelTrace:
         if cal is None:
             raise RigError(f"run log {path}: it logged no calibration")
         columns = {
+            "segment": np.array([int(e.get("segment", 0)) for e in rows], dtype=np.int64),
             "length": np.array([e["length"] for e in rows], dtype=float),
             "turn": np.array([e["turn"] for e in rows], dtype=float),
             "true_arc": np.full(len(rows), math.nan),
@@ -133,8 +136,10 @@ class WheelTrace:
     def relocalize(self, part: Part, **filter_options) -> Belief:
         """The belief from the trace's readings, replayed into a :class:`localizer.WheelFilter` for its finger."""
         flt = WheelFilter(part, self.wheel, **filter_options)
-        for L, om in zip(self.columns["length"], self.columns["turn"]):
-            flt.update(float(L), float(om))
+        last = self.columns["segment"][-1] if self.columns["segment"].size else 0
+        for seg, L, om in zip(self.columns["segment"], self.columns["length"], self.columns["turn"]):
+            if seg == last:  # the belief is the last segment's: the rolling started afresh there
+                flt.update(float(L), float(om))
         return flt.belief()
 
     @property

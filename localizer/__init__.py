@@ -22,7 +22,14 @@ from ._segment import DIRECTIONS, Segment
 from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
 from ._tracks import BRIDGE_EXCESS, PIVOT_KAPPA, ModeTracks, tracks_for
 from ._wheel import Finger, WheelJaw, WheelReach, parse_jaw, wheel_reach_for
-from ._wheel_filter import WHEEL_NOISE_SCALES, WHEEL_SD_SLOPE, WHEEL_SD_TURN, WHEEL_SLOPE_LENGTH, WheelFilter
+from ._wheel_filter import (
+    WHEEL_FIT_SCALE,
+    WHEEL_NOISE_SCALES,
+    WHEEL_SD_SLOPE,
+    WHEEL_SD_TURN,
+    WHEEL_SLOPE_LENGTH,
+    WheelFilter,
+)
 
 __all__ = [
     "Boundary",
@@ -67,6 +74,7 @@ __all__ = [
     "WHEEL_SD_SLOPE",
     "WHEEL_SLOPE_LENGTH",
     "WHEEL_NOISE_SCALES",
+    "WHEEL_FIT_SCALE",
     "parse_jaw",
     "Finger",
     "DEFAULT_JAW",

@@ -51,6 +51,9 @@ class Belief:
         False when the posterior is as flat as the prior (e.g. on a circle).
     steps : int
         Updates so far.
+    consistent : bool
+        False when no hypothesis fits the readings even under a generous error model (the wheel's
+        filter: a contact that jammed, a model that is not the part); ``mass`` is then 0.
     """
 
     map_arc: float
@@ -60,6 +63,7 @@ class Belief:
     ambiguous: bool
     informative: bool
     steps: int
+    consistent: bool = True
 
 
 def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray, radius: float) -> list[Mode]:

@@ -34,7 +34,12 @@ the reach does not rule out the truth.
 Trust, as the straight jaw's filter (its notes, "Trust"): the readings' likelihood is raised to the
 power :data:`~localizer.TEMPER`, and a stated probability is the least over ``noise_scales`` (the
 covariance times each factor squared), so that readings noisier than the filter was told lower it
-instead of making it confidently wrong.
+instead of making it confidently wrong. And a belief is only stated when some start fits at all: when
+the best start's residuals are beyond the χ² test at :data:`~localizer.FIT_ALPHA` even under
+:data:`WHEEL_FIT_SCALE` times the error model, nothing fits (the held-out family's star held a 5 mm
+wheel jammed between two walls, which reads exactly as rolling in a concave arc of the wheel's own
+radius; the filter, normalising, stated 0.999 at a start that fitted as badly as the truth), and the
+belief's mass is 0, ``consistent`` False.
 
 Outlines with corners are refused: at a corner the wheel pivots, Ω changing while L does not, so Ω is
 not a function of L there (not built).
@@ -45,16 +50,24 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.stats import chi2
 
 from ._belief import Belief, find_modes
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
-from ._defaults import SUCCESS_RADIUS
+from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
 from ._types import BoolArray, FloatArray
 from ._wheel import WheelJaw, wheel_reach_for
 
-__all__ = ["WheelFilter", "WHEEL_SD_TURN", "WHEEL_SD_SLOPE", "WHEEL_SLOPE_LENGTH", "WHEEL_NOISE_SCALES"]
+__all__ = [
+    "WheelFilter",
+    "WHEEL_SD_TURN",
+    "WHEEL_SD_SLOPE",
+    "WHEEL_SLOPE_LENGTH",
+    "WHEEL_NOISE_SCALES",
+    "WHEEL_FIT_SCALE",
+]
 
 #: One reading's independent angle error (rad): the arm encoder's 0.03° step (0.009° rms) and the wrist's
 #: residual direction after the servo (0.02°, docs/wheel.md), rounded up.
@@ -65,6 +78,9 @@ WHEEL_SD_SLOPE = 0.002
 WHEEL_SLOPE_LENGTH = 20.0 / (2 * math.pi)
 #: Noise scales under which a stated probability must hold (its least is stated).
 WHEEL_NOISE_SCALES = (1.0, 2.0)
+#: The error model's factor under which some start must fit the readings for any belief to be stated:
+#: the noisiest level the filter is meant to be trusted at (four times the `paper` preset).
+WHEEL_FIT_SCALE = 4.0
 
 
 class WheelFilter:
@@ -288,6 +304,9 @@ class WheelFilter:
             wf = w if f == self.noise_scales[0] else self._posterior(f)
             near = np.abs(np.asarray(self.part.arc_offset(present, map_arc))) <= radius
             mass = min(mass, float(wf[near].sum()))
+        consistent = self.consistent()
+        if not consistent:
+            mass = 0.0
         modes = find_modes(self.part, w, present, self.grid, radius)
         prior = self.prior / self.prior.sum()
         nz = w > 0
@@ -302,7 +321,17 @@ class WheelFilter:
             ambiguous=ambiguous,
             informative=informative,
             steps=self.steps,
+            consistent=consistent,
         )
+
+    def consistent(self) -> bool:
+        """Whether some start the wheel can touch fits the readings used, under :data:`WHEEL_FIT_SCALE`
+        times the error model (χ² test at :data:`~localizer.FIT_ALPHA`)."""
+        k = len(self.L_used)
+        if k == 0:
+            return True
+        best = float(np.min(np.where(self.prior > 0, self._quad, np.inf)))
+        return bool(chi2.sf(best / WHEEL_FIT_SCALE**2, k) >= FIT_ALPHA)
 
 
 def _free_runs(touch: np.ndarray, h: float) -> tuple[FloatArray, FloatArray]:
