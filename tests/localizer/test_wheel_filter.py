@@ -108,3 +108,18 @@ def test_bad_settings_and_drawings_are_refused():
     f = WheelFilter(part, WheelJaw(5.0))
     with pytest.raises(QueryError, match="finite"):
         f.update(math.nan, 0.0)
+
+
+def test_readings_that_fit_nowhere_state_nothing():
+    """A wheel jammed between two walls reads as rolling on a concave arc of its own radius: on the
+    kidney, whose concave radius is 65 mm at the least, no start fits that, and the belief says so."""
+    part = load_part(KIDNEY)
+    f = WheelFilter(part, WheelJaw(5.0))
+    for L in np.arange(0.25, 12.01, 0.25):
+        f.update(L, -L / 5.0)
+    b = f.belief()
+    assert not b.consistent and b.mass == 0.0
+    g = WheelFilter(part, WheelJaw(5.0))  # the same length of true rolling fits
+    for L in np.arange(0.25, 12.01, 0.25):
+        g.update(L, float(theta(part, 60.0 + L) - theta(part, 60.0)))
+    assert g.belief().consistent
