@@ -194,7 +194,7 @@ class Study:
         The file's keys (``parts``: absolute paths; ``rolls_deg`` and ``step_deg`` in degrees;
         ``success_radius`` in mm; ``noise``: a preset or a resolved file).
     parameter, values
-        The ``[sweep]``: the swept noise-model field (or ``"noise"``) and its values.
+        The ``[sweep]``: the swept noise-model field (or ``"noise"``, or ``"jaw"``: fingers) and its values.
     sd_length, sd_turn_deg
         The ``[likelihood]`` table (mm, degrees).
     source : str
@@ -203,6 +203,8 @@ class Study:
         The methods scored on the same trials.
     reactive, particle : ReactiveOptions, ParticleOptions
         The ``[reactive]`` and ``[particle]`` tables.
+    jaw : str
+        The finger (``"straight:100"`` or ``"wheel:R"``) when no sweep names it.
     """
 
     name: str
