@@ -9,7 +9,7 @@ import numpy as np
 
 from ._types import FloatArray
 
-__all__ = ["Belief", "Mode", "find_modes"]
+__all__ = ["Belief", "Mode", "find_modes", "belief_flags"]
 
 
 @dataclass(frozen=True)
@@ -107,3 +107,16 @@ def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray
         out.append(Mode(arc=float(present[top]), mass=float(mass[bins].sum()), start_arc=float(starts[top])))
     out.sort(key=lambda m: -m.mass)
     return out
+
+
+def belief_flags(
+    w: FloatArray, prior: FloatArray, modes: list[Mode], mode_floor: float, confidence: float
+) -> tuple[bool, bool]:
+    """(informative, ambiguous) of a posterior ``w`` over hypotheses with ``prior`` (each sums to 1):
+    informative when it gained more than 0.05 nats on the prior (KL(posterior ‖ prior); a flat
+    posterior gains about 0), ambiguous when informative and two or more of its ``modes`` hold
+    ``mode_floor`` each while the first does not reach ``confidence``."""
+    nz = w > 0
+    informative = float(np.sum(w[nz] * np.log(w[nz] / prior[nz]))) > 0.05
+    strong = [m for m in modes if m.mass >= mode_floor]
+    return informative, informative and len(strong) > 1 and modes[0].mass < confidence

@@ -117,7 +117,7 @@ from typing import Any
 import numpy as np
 from scipy.special import ndtr
 
-from ._belief import Belief, Mode, find_modes
+from ._belief import Belief, Mode, belief_flags, find_modes
 from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
@@ -781,12 +781,7 @@ class ContactFilter:
         modes = self._modes(w, present, radius)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
         prior /= prior.sum()
-        # information gained: KL(posterior || prior) in nats; a flat posterior gains ~0
-        nz = w > 0
-        kl = float(np.sum(w[nz] * np.log(w[nz] / prior[nz])))
-        informative = kl > 0.05
-        strong = [m for m in modes if m.mass >= self.mode_floor]
-        ambiguous = informative and len(strong) > 1 and modes[0].mass < self.confidence
+        informative, ambiguous = belief_flags(w, prior, modes, self.mode_floor, self.confidence)
         return Belief(
             map_arc=map_arc,
             mass=mass,

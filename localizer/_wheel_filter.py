@@ -52,7 +52,7 @@ import math
 import numpy as np
 from scipy.stats import chi2
 
-from ._belief import Belief, find_modes
+from ._belief import Belief, belief_flags, find_modes
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
@@ -309,10 +309,7 @@ class WheelFilter:
             mass = 0.0
         modes = find_modes(self.part, w, present, self.grid, radius)
         prior = self.prior / self.prior.sum()
-        nz = w > 0
-        informative = float(np.sum(w[nz] * np.log(w[nz] / prior[nz]))) > 0.05
-        strong = [m for m in modes if m.mass >= self.mode_floor]
-        ambiguous = informative and len(strong) > 1 and modes[0].mass < self.confidence
+        informative, ambiguous = belief_flags(w, prior, modes, self.mode_floor, self.confidence)
         return Belief(
             map_arc=map_arc,
             mass=mass,

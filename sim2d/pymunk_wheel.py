@@ -22,7 +22,7 @@ import numpy as np
 import pymunk
 
 from ._errors import SimError
-from .pymunk_world import _polygon
+from .pymunk_world import drive_hand, polygonise, static_chain
 from .wheel_world import WheelContact, WheelWorld
 
 __all__ = ["PymunkWheelWorld"]
@@ -78,13 +78,7 @@ class PymunkWheelWorld:
         space.collision_slop = 1e-4
         space.iterations = 30
         self.space = space
-        pts, _ = _polygon(part, chord_tolerance)
-        n = len(pts) - 1
-        segs = [pymunk.Segment(space.static_body, tuple(pts[i]), tuple(pts[i + 1]), 0.0) for i in range(n)]
-        for i, s in enumerate(segs):
-            s.friction = friction
-            s.set_neighbors(tuple(pts[i - 1]), tuple(pts[(i + 2) % n]))
-        space.add(*segs)
+        static_chain(space, polygonise(part, chord_tolerance), friction)
         self.hand_body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         carrier_mass, wheel_mass = 0.05, 0.01
         self.carrier = pymunk.Body(carrier_mass, pymunk.moment_for_circle(carrier_mass, 0.0, 5.0))
@@ -121,23 +115,9 @@ class PymunkWheelWorld:
         places everything there directly: the arm's start-up pose must be clear of the part)."""
         if self.hand is None:
             self._place(float(x), float(y), float(phi))
-        target = np.array([x, y], float)
-        hb = self.hand_body
-        for _ in range(1_000_000):
-            dp = target - np.array(hb.position)
-            da = phi - hb.angle
-            dist = float(np.hypot(*dp))
-            if dist < 1e-9 and abs(da) < 1e-12:
-                break
-            t = max(dist / self.linear_speed, abs(da) / self.angular_speed, self.dt)
-            frac = self.dt / t
-            hb.velocity = tuple(dp * frac / self.dt)
-            hb.angular_velocity = da * frac / self.dt
-            self.space.step(self.dt)
-        hb.velocity, hb.angular_velocity = (0.0, 0.0), 0.0
-        hb.position, hb.angle = (float(x), float(y)), float(phi)
-        for _ in range(self.settle_steps):
-            self.space.step(self.dt)
+        drive_hand(
+            self.space, self.hand_body, (x, y, phi), self.dt, self.linear_speed, self.angular_speed, self.settle_steps
+        )
         self.hand = (float(x), float(y), float(phi))
 
     @property

@@ -30,12 +30,12 @@ from .machining import MachinedOutline
 from .quasistatic import outline_touch, tangent_point
 from .world import Contact
 
-__all__ = ["PymunkWorld", "polygonise"]
+__all__ = ["PymunkWorld", "polygonise", "static_chain", "drive_hand"]
 
 _MN_PER_N = 1000.0
 
 
-def polygonise(part: Part, chord_tolerance: float) -> np.ndarray:
+def polygonise(part: Part | MachinedOutline, chord_tolerance: float) -> np.ndarray:
     """Points on the spline whose chords stay within ``chord_tolerance`` mm of it (closed, first = last).
 
     Each piece gets n chords with the sagitta bound κ_max·h²/8 <= tolerance,
@@ -85,6 +85,55 @@ def _outline_polygon(machined: MachinedOutline, chord_tolerance: float):
     j = np.unique(j)
     pts = machined.xy[j]
     return np.vstack([pts, pts[:1]]), machined.arcs[j]
+
+
+def static_chain(space: pymunk.Space, pts: np.ndarray, friction: float) -> None:
+    """Add the closed polygon ``pts`` (first = last, mm) to ``space`` as static segments with ``friction``,
+    each told its neighbours so that a body sliding over a vertex does not catch on it."""
+    body = space.static_body
+    n = len(pts) - 1
+    segs = []
+    for i in range(n):
+        seg = pymunk.Segment(body, tuple(pts[i]), tuple(pts[i + 1]), 0.0)
+        seg.friction = friction
+        segs.append(seg)
+    for i, seg in enumerate(segs):
+        seg.set_neighbors(tuple(pts[i - 1]), tuple(pts[(i + 2) % n]))
+    space.add(*segs)
+
+
+def drive_hand(
+    space: pymunk.Space,
+    hand: pymunk.Body,
+    pose: tuple[float, float, float],
+    dt: float,
+    linear_speed: float,
+    angular_speed: float,
+    settle_steps: int,
+) -> int:
+    """Drive the kinematic ``hand`` to ``pose`` (mm, mm, rad) at the speed limits (mm/s, rad/s), stepping
+    ``space`` by ``dt`` s, then ``settle_steps`` more; the number of steps taken."""
+    x, y, phi = (float(v) for v in pose)
+    target = np.array([x, y], float)
+    steps = 0
+    for _ in range(1_000_000):
+        dp = target - np.array(hand.position)
+        da = phi - hand.angle
+        dist = float(np.hypot(*dp))
+        if dist < 1e-9 and abs(da) < 1e-12:
+            break
+        # a common time to arrive, within both speed limits
+        t = max(dist / linear_speed, abs(da) / angular_speed, dt)
+        frac = dt / t
+        hand.velocity = tuple(dp * frac / dt)
+        hand.angular_velocity = da * frac / dt
+        space.step(dt)
+        steps += 1
+    hand.velocity, hand.angular_velocity = (0.0, 0.0), 0.0
+    hand.position, hand.angle = (x, y), phi
+    for _ in range(settle_steps):
+        space.step(dt)
+    return steps + settle_steps
 
 
 class PymunkWorld:
@@ -146,16 +195,7 @@ class PymunkWorld:
         self.space = space
         pts, self._poly_t = _polygon(part, chord_tolerance)
         self.polygon = pts
-        body = space.static_body
-        segs = []
-        n = len(pts) - 1
-        for i in range(n):
-            s = pymunk.Segment(body, tuple(pts[i]), tuple(pts[i + 1]), 0.0)
-            s.friction = friction
-            segs.append(s)
-        for i, s in enumerate(segs):
-            s.set_neighbors(tuple(pts[i - 1]), tuple(pts[(i + 2) % n]))
-        space.add(*segs)
+        static_chain(space, pts, friction)
         self.hand_body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         mass, width = 0.05, 6.0
         verts = [(-half_span, -width), (half_span, -width), (half_span, 0.0), (-half_span, 0.0)]
@@ -188,28 +228,9 @@ class PymunkWorld:
         """
         if self.hand is None:
             self._place(float(x), float(y), float(phi))
-        target = np.array([x, y], float)
-        hb = self.hand_body
-        dt = self.dt
-        for _ in range(1_000_000):
-            pos = np.array(hb.position)
-            dp = target - pos
-            da = phi - hb.angle
-            dist = float(np.hypot(*dp))
-            if dist < 1e-9 and abs(da) < 1e-12:
-                break
-            # a common time to arrive, within both speed limits
-            t = max(dist / self.linear_speed, abs(da) / self.angular_speed, dt)
-            frac = dt / t
-            hb.velocity = tuple(dp * frac / dt)
-            hb.angular_velocity = da * frac / dt
-            self.step()
-        hb.velocity = (0.0, 0.0)
-        hb.angular_velocity = 0.0
-        hb.position = (float(x), float(y))
-        hb.angle = float(phi)
-        for _ in range(self.settle_steps):
-            self.step()
+        self.steps += drive_hand(
+            self.space, self.hand_body, (x, y, phi), self.dt, self.linear_speed, self.angular_speed, self.settle_steps
+        )
         self.hand = (float(x), float(y), float(phi))
 
     def step(self) -> None:

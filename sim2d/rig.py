@@ -14,18 +14,19 @@ import numpy as np
 from localizer import Outline, Part
 
 from ._errors import SimError
+from .arm import SimulatedArm
 from .machining import MachinedOutline, machined_outline, machined_part
 from .noise import NoiseModel, load_noise
 from .quasistatic import QuasiStaticWorld
 from .world import World
-from .wrist import Wrist, encoder_angle
+from .wrist import Wrist
 
 __all__ = ["SimRig"]
 
 ENGINES = ("kinematic", "pymunk")
 
 
-class SimRig:
+class SimRig(SimulatedArm):
     """A simulated rig.
 
     Parameters
@@ -98,24 +99,7 @@ class SimRig:
         self.time = 0.0
         self.samples: list[dict] = []
 
-    # ------------------------------------------------------------ Rig: arm
-    def move(self, x: float, y: float, phi: float) -> None:
-        """Move the hand to (``x``, ``y``) mm with jaw angle ``phi`` rad (blocks until there)."""
-        pose = (float(x), float(y), float(phi))
-        if not all(math.isfinite(v) for v in pose):
-            raise SimError(f"move to {pose!r}: the pose must be finite")
-        x0, y0, p0 = self.world.hand or pose
-        self.time += max(
-            math.hypot(pose[0] - x0, pose[1] - y0) / self.linear_speed, abs(pose[2] - p0) / self.angular_speed
-        )
-        self.world.set_hand(*pose)
-
-    def pose(self) -> tuple:
-        """The arm's reading of the hand pose: (x mm, y mm, φ rad quantized by the encoder)."""
-        x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
-        return x, y, float(encoder_angle(phi, self.noise))
-
-    # --------------------------------------------------------- Rig: sensor
+    # --------------------------------------------------------- Rig: sensor (the arm: SimulatedArm)
     def read(self, n: int = 32) -> tuple:
         """Average of ``n`` raw samples of (v1, v2), V; logged with the truth."""
         c = self.world.contact()

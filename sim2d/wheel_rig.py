@@ -18,10 +18,11 @@ import numpy as np
 from localizer import Outline, Part, WheelJaw
 
 from ._errors import SimError
+from .arm import SimulatedArm
 from .machining import machined_outline, machined_part
 from .noise import NoiseModel, load_noise
 from .wheel_world import WheelWorld
-from .wrist import Wrist, encoder_angle
+from .wrist import Wrist
 
 if TYPE_CHECKING:
     from .pymunk_wheel import PymunkWheelWorld
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
 __all__ = ["WheelRig"]
 
 
-class WheelRig:
+class WheelRig(SimulatedArm):
     """A simulated rig with a wheel finger.
 
     Parameters
@@ -108,23 +109,7 @@ class WheelRig:
         self.time = 0.0
         self.samples: list[dict] = []
 
-    # ------------------------------------------------------------ Rig: arm
-    def move(self, x: float, y: float, phi: float) -> None:
-        """Move the axle to (``x``, ``y``) mm, the hand to angle ``phi`` rad (blocks until there)."""
-        pose = (float(x), float(y), float(phi))
-        if not all(math.isfinite(v) for v in pose):
-            raise SimError(f"move to {pose!r}: the pose must be finite")
-        x0, y0, p0 = self.world.hand or pose
-        self.time += max(
-            math.hypot(pose[0] - x0, pose[1] - y0) / self.linear_speed, abs(pose[2] - p0) / self.angular_speed
-        )
-        self.world.set_hand(*pose)
-
-    def pose(self) -> tuple:
-        """The arm's reading of the hand pose: (x mm, y mm, φ rad quantized by the arm's encoder)."""
-        x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
-        return x, y, float(encoder_angle(phi, self.noise))
-
+    # ------------------------------------------------------------ Rig: arm (SimulatedArm)
     def axle(self) -> float:
         """The axle encoder: the disc's angle relative to the hand, rad, quantized by its step."""
         psi = self.world.encoder()

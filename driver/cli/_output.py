@@ -17,6 +17,7 @@ __all__ = [
     "RELEASED",
     "ending_progress_line",
     "run_reactive",
+    "print_belief",
     "print_reactive",
     "run_summary",
     "emit_run",
@@ -87,11 +88,16 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
 
 
 def print_reactive(doc) -> None:
-    verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
     print(
         f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
         f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)"
     )
+    print_belief(doc)
+
+
+def print_belief(doc) -> None:
+    """The verdict, the other modes and the truth of a rolling's JSON object (either finger)."""
+    verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
     print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within {SUCCESS_RADIUS} mm")
     for m in doc["modes"][1:3]:
         print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")

@@ -12,7 +12,7 @@ from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_fo
 from ..rig import GroundTruth, RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
-from ._output import CONNECTING, RELEASED, ending_progress_line
+from ._output import CONNECTING, RELEASED, ending_progress_line, print_belief
 
 __all__ = [
     "wheel_policy",
@@ -71,20 +71,11 @@ def wheel_doc(part, run, rig, calibration) -> dict:
 
 
 def print_wheel(doc) -> None:
-    verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
     print(
         f"{doc['jaw']}: rolled {doc['arc_mm']:.1f} mm, the hand turned {doc['rotation_deg']:.1f}°, in {doc['steps']} "
         f"steps ({doc['stopped']}, {doc['jumps']} jumps undone, slip {doc['slip_mm']:+.3f} mm)"
     )
-    print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within {SUCCESS_RADIUS} mm")
-    for m in doc["modes"][1:3]:
-        print(f"  another mode: arc {m['arc']:.3f} mm, probability {m['probability']:.3f}")
-    if doc.get("error_mm") is not None:
-        err = doc["error_mm"]
-        print(
-            f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
-            f"({'success' if err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
-        )
+    print_belief(doc)
 
 
 def _emit(args, doc, part, run, out: str | None) -> int:
