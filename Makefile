@@ -1,5 +1,5 @@
 # make demo : set up .venv, simulate two rolls on a shipped part with the paper's noise, localize; then roll
-#             reactively on the bracket drawn in CAD (plots in out/)
+#             reactively on the bracket drawn in CAD, and a 5 mm wheel from inside the kidney's concave waist (plots in out/)
 # make test : set up .venv; lint (ruff), type-check (mypy), run the tests, the doctests and the benchmark smoke run
 PYTHON ?= python3.11
 VENV   := .venv
@@ -19,6 +19,7 @@ demo: $(STAMP)
 	$(VENV)/bin/rolltouch simulate parts/trefoil.json --start 120 --roll 20 --roll 15 --noise paper --engine pymunk --out out/demo.npz --plot out/demo.png
 	$(VENV)/bin/rolltouch locate out/demo.npz --part parts/trefoil.json
 	$(VENV)/bin/rolltouch simulate parts/bracket.dxf --start 75 --reactive --noise paper --seed 2 --out out/demo-cad.npz --plot out/demo-cad.png
+	$(VENV)/bin/rolltouch simulate parts/kidney.csv --jaw wheel:5 --start 66 --reactive --noise paper --seed 2 --out out/demo-wheel.npz --plot out/demo-wheel.png
 
 CODE   := localizer passivity sim2d driver bench tests
 
