@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["trapezoid_perimeter", "trefoil_part", "PARTS_DIR"]
+__all__ = ["trapezoid_perimeter", "trefoil_part", "PARTS_DIR", "per_second"]
 
 from pathlib import Path
 
@@ -45,3 +45,12 @@ def random_outline(rng, n: int = 40, amplitude: float = 3.0, radius: float = 40.
     for k in range(2, 6):
         r += amplitude / k * rng.uniform(-1, 1) * np.cos(k * a + rng.uniform(0, 2 * np.pi))
     return np.c_[r * np.cos(a), r * np.sin(a)]
+
+
+def per_second(benchmark, key: str, count: float = 1.0) -> None:
+    """Put the benchmark's figure of merit in its ``extra_info``: ``count`` units per second of its fastest
+    round (nothing when the benchmark is disabled, as in the test run's smoke pass)."""
+    stats = getattr(benchmark, "stats", None)
+    if benchmark.disabled or stats is None:
+        return
+    benchmark.extra_info[key] = float(count) / float(stats.stats.min)

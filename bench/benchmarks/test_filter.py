@@ -11,7 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from localizer import ContactFilter, ParticleFilter, part_from_points
+from bench.benchmarks.baselines import PARTS_DIR, per_second
+from localizer import ContactFilter, ParticleFilter, WheelFilter, WheelJaw, load_part, part_from_points
 
 STEP = math.radians(0.2)
 
@@ -41,12 +42,14 @@ def test_grid_filter_update(benchmark, part100):
     z, turn = _roll(flt, part100)
     benchmark.extra_info.update({"part": "egg100 (100 knots)", "hypotheses": int(flt.grid.size)})
     benchmark(flt.update, z, turn)
+    per_second(benchmark, "updates_per_second")
 
 
 def test_grid_filter_belief(benchmark, part100):
     flt = ContactFilter(part100)
     _roll(flt, part100)
     b = benchmark(flt.belief)
+    per_second(benchmark, "beliefs_per_second")
     assert abs(part100.arc_offset(b.map_arc, flt.current[int(round(40.0 / flt.tracks.h))])) < 0.05
 
 
@@ -57,6 +60,7 @@ def test_particle_filter_update(benchmark, part100, particles):
     z, turn = _roll(grid, part100)
     benchmark.extra_info.update({"particles": particles})
     benchmark(pf.update, z, turn)
+    per_second(benchmark, "updates_per_second")
 
 
 @pytest.mark.parametrize("scales", ["weighed", "told"])
@@ -98,3 +102,28 @@ def test_reach_build(benchmark, part100, name):
     )
     r = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)
     benchmark.extra_info.update({"perimeter_mm": round(part.perimeter, 1), "grid": int(r.sigma.size)})
+    per_second(benchmark, "grid_points_per_second", r.sigma.size)
+
+
+def test_wheel_filter_roll(benchmark):
+    """A 5 mm wheel's filter over a 20 mm roll from inside the kidney's waist: 80 readings 0.25 mm apart
+    (one a millimetre used by the likelihood), a belief every 4, as :func:`driver.wheel.localize_with_wheel`."""
+    part = load_part(PARTS_DIR / "kidney.csv")
+    flt = WheelFilter(part, WheelJaw(5.0))
+    start = 66.0
+    lengths = np.arange(0.25, 20.01, 0.25)
+    theta = part.tangent_angle(part.param_at_arc(start + np.r_[0.0, lengths]))
+    turns = theta[1:] - theta[0]
+
+    def roll():
+        flt.reset()
+        for k, (L, om) in enumerate(zip(lengths, turns)):
+            flt.update(float(L), float(om))
+            if k % 4 == 3:
+                b = flt.belief()
+        return b
+
+    b = benchmark.pedantic(roll, rounds=5, iterations=1)
+    assert abs(float(part.arc_offset(b.map_arc, start + lengths[-1]))) < 0.3
+    benchmark.extra_info.update({"starts": int(flt.grid.size), "readings": int(lengths.size)})
+    per_second(benchmark, "readings_per_second", lengths.size)

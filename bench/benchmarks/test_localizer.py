@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from bench.benchmarks.baselines import trapezoid_perimeter, trefoil_part
+from bench.benchmarks.baselines import per_second, trapezoid_perimeter, trefoil_part
 from localizer import feasible_segments
 
 N_QUERIES = 20
@@ -70,6 +70,7 @@ def _timed(fn, *args):
 def test_perimeter_integration_h1e5(benchmark, part):
     value = benchmark.pedantic(trapezoid_perimeter, args=(part,), rounds=3, iterations=1)
     assert value == pytest.approx(part.perimeter, rel=1e-9)
+    per_second(benchmark, "steps_per_second", part.n_knots / 1e-5)
 
 
 def test_table_build(benchmark):
