@@ -278,7 +278,7 @@ class _Wheel:
         self.hand.press_by(0.2)
         self.stiffness = max((dv1 - lighter) / 0.2, 1e-3)
         self.depth = pol.target / self.stiffness
-        self.state = self._state()
+        self.state = self.settled()
         return self.state
 
     def _read(self) -> tuple[float, float]:
@@ -306,11 +306,7 @@ class _Wheel:
         return f, a
 
     def settled(self) -> tuple[float, float, float, float, float]:
-        """The state (φ, α, ψ_e, x, y) after servoing where the hand is now."""
-        return self._state()
-
-    def _state(self) -> tuple[float, float, float, float, float]:
-        """(φ, α, ψ_e, x, y) at a settled pose."""
+        """(φ, α, ψ_e, x, y) after servoing the hand to the contact where it is now."""
         _, a = self._settle()
         x, y, _ = self.rig.pose()
         phi = float(self.hand.measured_angle())
@@ -323,7 +319,7 @@ class _Wheel:
         before, prev = self.hand.pose, self.state
         x, y, phi = before
         self.hand.go(x + direction * pol.step * math.cos(phi), y + direction * pol.step * math.sin(phi), phi)
-        now = self._state()
+        now = self.settled()
         d_turn = (now[0] + now[1]) - (prev[0] + prev[1])
         d_len = r * ((now[2] - prev[2]) - (now[1] - prev[1]))
         path = _along(prev, now, self.cal.direction_zero)
@@ -331,7 +327,7 @@ class _Wheel:
         lo, hi = sorted((self.kappa_band[0] * d_len, self.kappa_band[1] * d_len))
         if not (lo - JUMP_FLOOR <= d_turn <= hi + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step:
             self.hand.go(*before)
-            self.state = self._state()
+            self.state = self.settled()
             return None
         self.state = now
         return d_turn, d_len, mismatch
