@@ -81,6 +81,7 @@ from driver.reactive import CONFIDENCE, MAX_ROTATION
 from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, check_size, load_part
 
 from .part_cache import cached_part
+from .trial_draw import draw_trial
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -567,17 +568,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
 
     s = spec.study
     t0 = time.perf_counter()
-    rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
-    part_file = s.parts[int(rng.integers(len(s.parts)))]
-    part = cached_part(part_file)
-    noise = s.level_noise(spec.level)
-    row = {
-        "level": spec.level,
-        "trial": spec.trial,
-        "parameter": s.parameter or "",
-        "value": s.level_label(spec.level),
-        "part": Path(part_file).name,
-    }
+    rng, part_file, part, noise, row = draw_trial(spec)
     rolls = [math.radians(r) for r in s.rolls_deg]
     jaw_start = -JAW_START if rolls[0] > 0 else JAW_START
     rule = s.method if s.method in ("paper", "likelihood") else "paper"

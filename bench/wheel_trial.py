@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -33,16 +32,13 @@ def run_wheel_trial(spec) -> dict:
     from sim2d import WheelRig
 
     from .methods import _curve, _err, reactive_stop, rotation_curve
-    from .part_cache import cached_part
+    from .trial_draw import draw_trial
 
     s = spec.study
     t0 = time.perf_counter()
-    rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
-    part_file = s.parts[int(rng.integers(len(s.parts)))]
-    part = cached_part(part_file)
+    rng, part_file, part, noise, row = draw_trial(spec)
     if not isinstance(part, Part):  # load_study refuses drawings with a wheel
         raise TypeError(f"{part_file}: a wheel rolls on spline parts only")
-    noise = s.level_noise(spec.level)
     jaw = s.level_jaw(spec.level)
     wheel = parse_jaw(jaw)
     assert isinstance(wheel, WheelJaw)
@@ -56,21 +52,18 @@ def run_wheel_trial(spec) -> dict:
             start = u
             break
         redraws += 1
-    row = {
-        "level": spec.level,
-        "trial": spec.trial,
-        "parameter": s.parameter or "",
-        "value": s.level_label(spec.level),
-        "part": Path(part_file).name,
-        "start_arc": start,
-        "lengths": "",
-        "turns": "",
-        "restarts": 0,
-        "candidates": "",
-        "jaw": jaw,
-        "redraws": redraws,
-        "reachable": float(sure.mean()),
-    }
+    row.update(
+        {
+            "start_arc": start,
+            "lengths": "",
+            "turns": "",
+            "restarts": 0,
+            "candidates": "",
+            "jaw": jaw,
+            "redraws": redraws,
+            "reachable": float(sure.mean()),
+        }
+    )
     cal_seed, rig_seed = int(rng.integers(1 << 31)), int(rng.integers(1 << 31))
     try:
         if not math.isfinite(start):

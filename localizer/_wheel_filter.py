@@ -50,6 +50,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.linalg import solve_triangular
 from scipy.stats import chi2
 
 from ._belief import Belief, belief_flags, find_modes
@@ -223,12 +224,7 @@ class WheelFilter:
         used = np.array(self.L_used)
         c_new = self._cov(used, np.array([L]))[:, 0] if used.size else np.zeros(0)
         c_nn = float(self._cov(np.array([L]), np.array([L]))[0, 0])
-        if used.size:
-            from scipy.linalg import solve_triangular
-
-            ell = solve_triangular(self._chol, c_new, lower=True)
-        else:
-            ell = np.zeros(0)
+        ell = solve_triangular(self._chol, c_new, lower=True) if used.size else np.zeros(0)
         d2 = max(c_nn - float(ell @ ell), 1e-18)
         kappa = np.asarray(self.part.curvature_at_arc(self.part.wrap_arc(self.grid + L)), dtype=float)
         extra = kappa**2 * (self.sd_length**2 + (L * self.sd_scale) ** 2)

@@ -103,6 +103,8 @@ class WheelWorld:
             raise SimError(f"a wheel world needs a Part or a MachinedOutline, not {type(part).__name__}")
         self._tree = cKDTree(self._xy)
         self.hand: tuple[float, float, float] | None = None
+        # (arc, contact, disc centre, depth) of the disc as set_hand seated it: contact() reads it
+        self._seated: tuple[float, np.ndarray, np.ndarray, float] = (math.nan, np.zeros(2), np.zeros(2), -math.inf)
         self.psi = 0.0
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None  # (arc, point, axle) of the last contact
 
@@ -170,7 +172,7 @@ class WheelWorld:
     def set_hand(self, x: float, y: float, phi: float) -> None:
         """Put the axle at (``x``, ``y``) mm and the hand at angle ``phi`` rad; the disc rolls there."""
         self.hand = (float(x), float(y), float(phi))
-        arc, p, centre, depth = self._seat(np.array([x, y], dtype=float))
+        arc, p, centre, depth = self._seated = self._seat(np.array([x, y], dtype=float))
         if depth <= 0:  # clear: the disc keeps its angle on the bearing
             self._last = None
             return
@@ -189,7 +191,7 @@ class WheelWorld:
         if self.hand is None:
             return WheelContact(0.0, math.nan, math.nan, -math.inf)
         c = np.array(self.hand[:2])
-        arc, p, centre, depth = self._seat(c)
+        arc, p, centre, depth = self._seated  # where set_hand seated it
         if depth <= 0:
             return WheelContact(0.0, math.nan, math.nan, depth)
         v = c - centre  # the spring pulls the disc back towards the commanded axle: (−sin β, cos β)

@@ -17,6 +17,8 @@ __all__ = [
     "RELEASED",
     "ending_progress_line",
     "run_reactive",
+    "belief_fields",
+    "truth_fields",
     "print_belief",
     "print_reactive",
     "run_summary",
@@ -69,22 +71,30 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
     doc = {
         "part": part.name,
         "method": "reactive",
-        "estimate_arc": b.map_arc,
-        "mass": b.mass,
-        "ambiguous": b.ambiguous,
-        "informative": b.informative,
+        **belief_fields(b),
         "stopped": res.stopped,
         "rotation_deg": math.degrees(res.rotation),
         "steps": res.steps,
         "reversals": res.reversals,
         "regrasps": res.regrasps,
         "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+        **truth_fields(part, b, rig),
     }
-    if isinstance(rig, GroundTruth):
-        true_arc = rig.truth()["contact_arc"]
-        doc["true_arc"] = true_arc
-        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
     return doc, res
+
+
+def belief_fields(b) -> dict:
+    """``estimate_arc``, ``mass``, ``ambiguous`` and ``informative`` of a belief, for a rolling's JSON object."""
+    return {"estimate_arc": b.map_arc, "mass": b.mass, "ambiguous": b.ambiguous, "informative": b.informative}
+
+
+def truth_fields(part, b, rig) -> dict:
+    """``true_arc`` and ``error_mm`` (mm) of a belief on a rig that knows the truth (nothing on a real rig)."""
+    if not isinstance(rig, GroundTruth):
+        return {}
+    true_arc = rig.truth()["contact_arc"]
+    error = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
+    return {"true_arc": true_arc, "error_mm": error}
 
 
 def print_reactive(doc) -> None:

@@ -9,10 +9,10 @@ import sys
 
 from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_for
 
-from ..rig import GroundTruth, RigError
+from ..rig import RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
-from ._output import CONNECTING, RELEASED, ending_progress_line, print_belief
+from ._output import CONNECTING, RELEASED, belief_fields, ending_progress_line, print_belief, truth_fields
 
 __all__ = [
     "wheel_policy",
@@ -45,14 +45,11 @@ def wheel_policy(args):
 def wheel_doc(part, run, rig, calibration) -> dict:
     """The JSON object of a wheel's run."""
     b = run.belief
-    doc = {
+    return {
         "part": part.name,
         "method": "reactive",
         "jaw": calibration.jaw,
-        "estimate_arc": b.map_arc,
-        "mass": b.mass,
-        "ambiguous": b.ambiguous,
-        "informative": b.informative,
+        **belief_fields(b),
         "stopped": run.stopped,
         "rotation_deg": math.degrees(run.rotation),
         "arc_mm": run.arc,
@@ -62,12 +59,8 @@ def wheel_doc(part, run, rig, calibration) -> dict:
         "slip_mm": run.slip,
         "calibration": calibration.as_dict(),
         "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+        **truth_fields(part, b, rig),
     }
-    if isinstance(rig, GroundTruth):
-        true_arc = rig.truth()["contact_arc"]
-        doc["true_arc"] = true_arc
-        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true_arc))) if math.isfinite(true_arc) else None
-    return doc
 
 
 def print_wheel(doc) -> None:
