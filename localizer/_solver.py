@@ -8,16 +8,17 @@ total curvature Ω:
 with θ the unwrapped tangent angle as a function of arc position (exact, no
 integration) and κ the signed curvature.
 
-Completeness comes from a certificate on every cell of a grid in σ
-(:func:`localizer._certify.certify_cells`, which the outline solver shares). The part's table
-bounds |dκ/dσ| on each of its cells, so ``K = K(base cell) + K(end cell)`` bounds |g''| on a cell,
-and with g and g' known exactly at the cell's ends a cell is certified to hold one root, none, a
-near-double root (at a width of ``double_width`` mm) or a flat stretch (|g| below ``flat_tol``
-everywhere: a circular arc of radius L/Ω, one ``"continuum"`` segment with its extent), or it is
-bisected; no root is ever skipped.
+Completeness comes from a certificate on every cell of a grid in σ (the certificates of
+:func:`localizer._certify.certify_cells`, which the outline solver uses; here compiled,
+:func:`localizer._solver_kernels.cell_pass`). The part's table bounds |dκ/dσ| on each of its cells;
+a cell of the grid spans a run of whole table cells at its start, and the largest bound over those and
+over the table cells its end sweeps bounds |g''| on it. With g and g' known exactly at the cell's
+ends a cell is certified to hold one root, none, a near-double root (at a width of ``double_width``
+mm) or a flat stretch (|g| below ``flat_tol`` everywhere: a circular arc of radius L/Ω, one
+``"continuum"`` segment with its extent), or it is bisected; no root is ever skipped.
 
-Bracketed roots are refined together by a safeguarded Newton iteration to
-``tol`` mm.
+Bracketed roots start from the cubic Hermite root on their bracket and are settled by Newton on the
+exact spline to ``tol`` mm (compiled, :func:`localizer._solver_kernels.polish`).
 """
 
 from __future__ import annotations
@@ -28,16 +29,22 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ._certify import certify_cells
+from ._certify import merge_flats
 from ._errors import QueryError
 from ._march import PAPER_MARCH, MarchOptions, march
 from ._outline import Outline
 from ._outline_solver import outline_segments
-from ._part import _TWO_PI, Part
+from ._part import Part
 from ._segment import DIRECTIONS, KINDS, Segment
+from ._solver_kernels import TOO_MANY_CELLS, cell_pass, hermite_roots, polish
 from ._table import ArcTable, arc_table
 
 __all__ = ["feasible_segments", "ExactOptions", "EXACT", "METHODS"]
+
+# The cell pass starts from about this many cells of whole table cells (fewer on a table of fewer cells):
+# on the trefoil (360 table cells) and three traced outlines (2880) a query cost least between 32
+# and 128; one cell per table cell cost 2 to 5 times more.
+_SUPER_CELLS = 64
 
 #: Solver methods accepted by :func:`feasible_segments`.
 METHODS = ("exact", "march")
@@ -72,24 +79,22 @@ def _polish(
     machine precision. Returns (start arc, start param, end param, converged,
     |Φ - Ω| at the start).
     """
-    k = sigma.size
     p, lap = table.param_at(np.concatenate([sigma, sigma + length]))
     both = p + lap * part.n_knots
-    for it in range(max_iter + 1):
-        lam, th, ka, v = part.state(both)
-        f1 = lam[k:] - lam[:k] - length
-        f2 = th[k:] - th[:k] - turn
-        gp = ka[k:] - ka[:k]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dss = (ka[k:] * f1 - f2) / gp
-        dss = np.where(np.isfinite(dss), dss, np.inf)
-        step = np.abs(dss) + np.abs(f1)
-        if np.all(step <= tol) or it == max_iter:
-            break
-        both = both + np.concatenate([dss / v[:k], (dss - f1) / v[k:]])
-    # the last correction is below tol: the start is known to tol (Newton's error
-    # after a step is quadratic in that correction)
-    return lam[:k], both[:k], both[k:], step <= tol, np.abs(f2)
+    k = sigma.size
+    return polish(
+        part._dcols,
+        part._theta_nodes,
+        part._sig_nodes,
+        part.cells_per_piece,
+        part.perimeter,
+        both[:k],
+        both[k:],
+        length,
+        turn,
+        tol,
+        max_iter,
+    )
 
 
 # ------------------------------------------------------------------ checks
@@ -159,63 +164,29 @@ def _solve_ccw(
     positions, and a list of (start, span) pairs.
     """
     table = arc_table(part)
-    P = part.perimeter
-    nodes = table.sig[:-1]
-    margin = 4.0 * table.theta_error + 1e-14  # |g - g_table| <= 2 theta_error
-    dmargin = 1e-9  # slack on g' (tabulated κ is ~1e-11 off)
-    # Breakpoints: the table nodes (their θ, κ are the table's constants) and the
-    # starts whose end falls on a node; one table evaluation covers both.
-    J = nodes.size
-    th_n, k_n = table.theta_cols[0], table.kappa_cols[0]
-    shifted = nodes - length
-    wrapped = shifted < 0.0
-    shifted = np.where(wrapped, shifted + P, shifted)
-    th_x, k_x, c_x = table.theta_kappa_cell(np.concatenate([nodes + length, shifted]))
-    bp = np.concatenate([nodes, shifted])
-    g = np.concatenate([th_x[:J] - th_n, th_n + _TWO_PI * wrapped - th_x[J:]]) - turn
-    dg = np.concatenate([k_x[:J] - k_n, k_n - k_x[J:]])
-    # table cells of each breakpoint's start and end, known exactly by construction
-    idx = np.arange(J)
-    cell_s = np.concatenate([idx, c_x[J:]])
-    cell_e = np.concatenate([c_x[:J], idx])
-    order = np.argsort(bp, kind="stable")
-    bp, g, dg, cell_s, cell_e = bp[order], g[order], dg[order], cell_s[order], cell_e[order]
-    keep = np.concatenate([np.diff(bp) > 1e-12 * P, [True]]) & (bp < P)
-    bp, g, dg, cell_s, cell_e = bp[keep], g[keep], dg[keep], cell_s[keep], cell_e[keep]
-    a = bp
-    b = np.append(bp[1:], P)
-    ga, da = g, dg
-    gb, db = np.append(g[1:], g[0]), np.append(dg[1:], dg[0])
-    # a cell [a, b] lies in the start's table cell and its end [a+L, b+L] in the end's
-    slope = table.kappa_slope
-    K = slope[cell_s] + slope[cell_e]
-
-    return certify_cells(
-        (a, b, ga, gb, da, db, K),
-        lambda m: _g_table(table, m, length, turn),
-        P,
-        margin=margin,
-        dmargin=dmargin,
-        flat_tol=options.flat_tol,
-        double_width=options.double_width,
-        max_cells=options.max_cells,
-        degenerate=f"the query length={length!r} mm, turn={turn!r} rad is degenerate on part {part.name!r}",
+    zeros, brackets, doubles, flats, status = cell_pass(
+        table.sig,
+        table.theta_cols,
+        table.kappa_cols,
+        table.inv_h,
+        table.kappa_slope,
+        length,
+        turn,
+        4.0 * table.theta_error + 1e-14,  # |g - g_table| <= 2 theta_error
+        1e-9,  # slack on g' (tabulated κ is ~1e-11 off)
+        options.flat_tol,
+        options.double_width,
+        options.max_cells,
+        max(1, (table.sig.size - 1) // _SUPER_CELLS),
     )
-
-
-def _hermite_root(g0: np.ndarray, g1: np.ndarray, d0: np.ndarray, d1: np.ndarray, iterations: int = 2) -> np.ndarray:
-    """Root in [0, 1] of the cubic Hermite through (0, g0, d0) and (1, g1, d1); g0·g1 < 0.
-
-    Newton on the cubic from the secant point, kept inside [0, 1].
-    """
-    c2 = 3.0 * (g1 - g0) - 2.0 * d0 - d1
-    c3 = 2.0 * (g0 - g1) + d0 + d1
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = g0 / (g0 - g1)
-        for _ in range(iterations):
-            f = ((c3 * x + c2) * x + d0) * x + g0
-            x = x - f / ((3.0 * c3 * x + 2.0 * c2) * x + d0)
-    return np.where(np.isfinite(x), np.clip(x, 0.0, 1.0), 0.5)
+    if status == TOO_MANY_CELLS:
+        raise QueryError(
+            f"the query length={length!r} mm, turn={turn!r} rad is degenerate on part {part.name!r}: g stays "
+            f"near zero on too many cells (more than {options.max_cells}); the part is nearly a circular arc "
+            "there. Raise flat_tol or max_cells"
+        )
+    joined = (*brackets[:, :6].T, brackets[:, 6] > 0.0) if len(brackets) else None
+    return zeros, joined, doubles, merge_flats(flats, table.perimeter)
 
 
 def _roots_from_brackets(
@@ -231,7 +202,7 @@ def _roots_from_brackets(
     """
     lo, hi, glo, ghi, dlo, dhi, dbl = brackets
     P = part.perimeter
-    x0 = lo + (hi - lo) * _hermite_root(glo, ghi, dlo * (hi - lo), dhi * (hi - lo))
+    x0 = hermite_roots(lo, hi, glo, ghi, dlo, dhi)
     lam, ps, pe, ok, res = _polish(part, table, x0, length, turn, tol, max_iter=4)
     inside = np.mod(lam - lo + 1e-9, P) <= hi - lo + 2e-9
     bad = np.flatnonzero(~(ok & inside))

@@ -57,6 +57,8 @@ class ArcTable:
     theta_cols, kappa_cols, param_cols : ndarray, shapes (6, J), (5, J), (6, J)
         ``theta``, ``dtheta`` and ``param`` column by column (gathering 1-D columns is several
         times faster), for the exact solver's breakpoints and the evaluations here.
+    inv_h : ndarray, shape (J,), 1/mm
+        1 / ``h``.
     """
 
     perimeter: float
@@ -71,14 +73,14 @@ class ArcTable:
     theta_cols: FloatArray = field(init=False, repr=False)
     kappa_cols: FloatArray = field(init=False, repr=False)
     param_cols: FloatArray = field(init=False, repr=False)
-    _inv_h: FloatArray = field(init=False, repr=False)
+    inv_h: FloatArray = field(init=False, repr=False)
     _last: int = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "theta_cols", np.ascontiguousarray(self.theta.T))
         object.__setattr__(self, "kappa_cols", np.ascontiguousarray(self.dtheta.T))
         object.__setattr__(self, "param_cols", np.ascontiguousarray(self.param.T))
-        object.__setattr__(self, "_inv_h", 1.0 / self.h)
+        object.__setattr__(self, "inv_h", 1.0 / self.h)
         object.__setattr__(self, "_last", len(self.h) - 1)
 
     def locate(self, sigma: ArrayLike) -> tuple[FloatArray, IntArray, FloatArray]:
@@ -88,7 +90,7 @@ class ArcTable:
         ss = sigma - lap * self.perimeter
         cell = np.searchsorted(self.sig, ss, side="right") - 1
         np.minimum(cell, self._last, out=cell)
-        x = (ss - self.sig[cell]) * self._inv_h[cell]
+        x = (ss - self.sig[cell]) * self.inv_h[cell]
         return lap, cell, x
 
     def theta_kappa(self, sigma: ArrayLike) -> tuple[FloatArray, FloatArray]:
