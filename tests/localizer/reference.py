@@ -12,14 +12,19 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
 
-def random_part_points(rng, n=None, convex=None):
-    """Star-shaped random smooth outline (simple by construction)."""
+def random_part_points(rng, n=None, convex=None, harmonics=5, jitter=0.0):
+    """Star-shaped random smooth outline (simple by construction).
+
+    ``harmonics`` up to 24 and a radial ``jitter`` (mm, uniform ±) make a rough outline as traced
+    from a silhouette, whose curvature changes fast.
+    """
     n = n or int(rng.integers(16, 60))
     a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     r = np.full(n, 40.0)
     amp = 1.0 if convex else 5.0 if convex is False else rng.uniform(0.5, 5.0)
-    for k in range(2, 6):
+    for k in range(2, harmonics + 1):
         r += amp / k * rng.uniform(-1, 1) * np.cos(k * a + rng.uniform(0, 2 * np.pi))
+    r += rng.uniform(-jitter, jitter, n)
     return np.c_[r * np.cos(a), r * np.sin(a)]
 
 
