@@ -14,6 +14,20 @@ Where the curvature is the same at both ends (a circle, a stretch of constant cu
 says nothing about the start and the bound is infinite. Of the contact's place at the roll's end,
 s + L, the bound is the same expression with κ(s) in the numerator's place of κ(s+L) (the roll
 read backwards). docs/wheel.md uses it for the wheel finger with its own σ_L and σ_Ω.
+
+A whole trial (:func:`trial_bound`) reads the contact's travel z_j and the arm's angle Ω_j at every
+step j = 0 … k of its rolls, with the nuisances the filters carry: an offset c_s per contact segment
+(flat prior) and the calibration's scale b ~ N(1, sd_scale²), and the jaw's angle offset φ:
+
+    z_j = c_s + b·(σ_j − σ_0) + e_j,   Ω_j = θ(σ_j) + φ + ε_j,   e_j ~ N(0, sd_position²), ε_j ~ N(0, sd_turn²).
+
+The unknowns are the path σ_0 … σ_k and g = (φ, c_1 … c_S, b). Reading j's information over (σ_j, g)
+is [[a_j, u_jᵀ], [u_j, M_j]] with a_j = 1/sd_position² + κ_j²/sd_turn²; σ_j appears in no other
+reading, so eliminating it leaves M_j − u_j u_jᵀ / a_j on g. Summing those over j < k, adding reading
+k's block (σ_k kept) and the prior 1/sd_scale² on b, and inverting gives the bound of the contact's
+final place σ_k. For two readings without a scale this is the roll bound above with
+sd_length = √2·sd_position and sd_turn = √2 times the arm's (a roll's L and Ω are differences of
+two readings). docs/robustness.md gives the derivation in full.
 """
 
 from __future__ import annotations
@@ -26,7 +40,7 @@ from ._boundary import Boundary
 from ._errors import QueryError
 from ._types import ArrayLike, FloatArray
 
-__all__ = ["roll_bound"]
+__all__ = ["roll_bound", "trial_bound"]
 
 
 def roll_bound(
@@ -80,3 +94,94 @@ def roll_bound(
     with np.errstate(divide="ignore"):
         out: FloatArray = np.where(gap > 1e-12, spread / np.maximum(gap, 1e-300), np.inf)
     return out
+
+
+def trial_bound(
+    part: Boundary,
+    path: ArrayLike,
+    *,
+    sd_position: float,
+    sd_turn: float,
+    sd_scale: float = 0.0,
+    segments: ArrayLike | None = None,
+) -> float:
+    """The Cramér–Rao bound, mm, of the contact's final place after the readings along ``path``.
+
+    Parameters
+    ----------
+    part : Part or Outline
+    path : array_like (k+1,), mm
+        The true contact's arc position at every reading of the trial, in order (the first where
+        the jaw was laid); wrapped or unrolled, each step shorter than half the perimeter.
+    sd_position : float, mm
+        Standard deviation of one reading of the contact's travel (> 0).
+    sd_turn : float, rad
+        Standard deviation of one reading of the arm's angle (> 0).
+    sd_scale : float
+        Prior standard deviation of the calibration's relative scale (0: the scale is known).
+    segments : array_like of int (k+1,), optional
+        The contact segment of each reading (a regrasp or a bridge starts one with its own offset);
+        default one segment.
+
+    Returns
+    -------
+    float, mm
+        ``inf`` where the readings do not fix the place (a circle, or a single reading).
+
+    Examples
+    --------
+    Two readings are one roll (its L and Ω each the difference of two readings):
+
+    >>> from localizer import part_from_points
+    >>> a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    >>> egg = part_from_points(np.c_[30 * np.cos(a) + 4 * np.cos(2 * a), 22 * np.sin(a)])
+    >>> two = trial_bound(egg, [10.0, 22.0], sd_position=0.01, sd_turn=2e-4)
+    >>> one = float(roll_bound(egg, 10.0, 12.0, sd_length=0.01 * 2**0.5, sd_turn=2e-4 * 2**0.5, at="end"))
+    >>> round(two, 4), abs(two - one) < 1e-9 * one
+    (0.0278, True)
+
+    Rolling on adds readings, and the bound falls:
+
+    >>> path = np.linspace(10.0, 40.0, 151)
+    >>> round(trial_bound(egg, path, sd_position=0.01, sd_turn=2e-4, sd_scale=0.01), 4)
+    0.0165
+    """
+    for name, value in (("sd_position", sd_position), ("sd_turn", sd_turn)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise QueryError(f"{name}={value!r} must be a positive number")
+    if not (isinstance(sd_scale, (int, float)) and math.isfinite(sd_scale) and sd_scale >= 0):
+        raise QueryError(f"sd_scale={sd_scale!r} must be a number ≥ 0")
+    sigma = np.asarray(path, dtype=float).ravel()
+    if sigma.size == 0 or not np.all(np.isfinite(sigma)):
+        raise QueryError(f"path: {sigma.size} readings; a trial's path must be finite arc positions, at least one")
+    seg = np.zeros(sigma.size, dtype=int) if segments is None else np.asarray(segments).ravel()
+    if seg.shape != sigma.shape:
+        raise QueryError(f"segments has {seg.size} entries for {sigma.size} readings")
+    if sigma.size < 2:
+        return math.inf
+    P = part.perimeter
+    steps = np.diff(sigma)
+    travel = np.concatenate([[0.0], np.cumsum(steps - P * np.round(steps / P))])
+    kappa = np.asarray(part.curvature_at_arc(np.mod(sigma, P)), dtype=float)
+    labels, seg_index = np.unique(seg, return_inverse=True)
+    # columns of g: φ, one offset per segment, then b (when its scale is not known)
+    n_g = 1 + labels.size + (1 if sd_scale > 0 else 0)
+    k = sigma.size
+    e_z = np.zeros((k, n_g))
+    e_z[np.arange(k), 1 + seg_index] = 1.0
+    if sd_scale > 0:
+        e_z[:, -1] = travel
+    e_o = np.zeros((k, n_g))
+    e_o[:, 0] = 1.0
+    w_z, w_o = 1.0 / sd_position**2, 1.0 / sd_turn**2
+    a = w_z + kappa**2 * w_o
+    u = w_z * e_z + (kappa * w_o)[:, None] * e_o
+    info = w_z * e_z.T @ e_z + w_o * e_o.T @ e_o - (u[:-1].T / a[:-1]) @ u[:-1]
+    if sd_scale > 0:
+        info[-1, -1] += 1.0 / sd_scale**2
+    # σ_k's share: a_k − u_kᵀ info⁻¹ u_k, the information left on it once g is unknown
+    if np.linalg.cond(info) > 1e14:  # a nuisance the readings do not fix: nor is the place
+        return math.inf
+    solved = np.linalg.solve(info, u[-1])
+    left = float(a[-1] - u[-1] @ solved)
+    return math.inf if left <= a[-1] * 1e-12 else 1.0 / math.sqrt(left)

@@ -39,3 +39,92 @@ def test_bad_queries_are_refused_by_name():
     ):
         with pytest.raises(QueryError, match=says):
             roll_bound(cam, 10.0, **kwargs)
+
+
+def _egg():
+    from localizer import part_from_points
+
+    a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    return part_from_points(np.c_[30 * np.cos(a) + 4 * np.cos(2 * a), 22 * np.sin(a)])
+
+
+def _dense_fisher_bound(part, path, segments, sd_z, sd_o, sd_b):
+    """Reference: the whole Fisher matrix over (σ_0 … σ_k, φ, c_1 … c_S, b), θ' by central differences,
+    inverted densely (no elimination)."""
+    k = len(path)
+    labels = sorted(set(segments))
+    n = k + 1 + len(labels) + 1
+    rows, w = [], []
+    h = 1e-5
+    for j, (s, g) in enumerate(zip(path, segments)):
+        rz = np.zeros(n)
+        rz[j] = 1.0
+        rz[k + 1 + labels.index(g)] = 1.0
+        rz[-1] = s - path[0]
+        ro = np.zeros(n)
+        ro[j] = float(part.tangent_angle_at_arc(s + h) - part.tangent_angle_at_arc(s - h)) / (2 * h)
+        ro[k] = 1.0
+        rows += [rz, ro]
+        w += [1 / sd_z**2, 1 / sd_o**2]
+    H = np.array(rows)
+    J = H.T @ (np.array(w)[:, None] * H)
+    J[-1, -1] += 1 / sd_b**2
+    return float(np.sqrt(np.linalg.inv(J)[k - 1, k - 1]))
+
+
+@pytest.mark.parametrize("segments", [[0] * 12, [0] * 5 + [1] * 7])
+def test_trial_bound_is_the_dense_fisher_bound(segments):
+    from localizer import trial_bound
+
+    egg = _egg()
+    path = list(np.r_[np.linspace(10.0, 25.0, 8), np.linspace(24.0, 18.0, 4)])  # out and partly back
+    got = trial_bound(egg, path, sd_position=0.02, sd_turn=3e-4, sd_scale=0.02, segments=segments)
+    ref = _dense_fisher_bound(egg, path, segments, 0.02, 3e-4, 0.02)
+    assert got == pytest.approx(ref, rel=1e-5)
+
+
+def test_trial_bound_spread_of_the_maximum_likelihood_place():
+    """Small noise: the maximum-likelihood estimate of the whole model is efficient, so the spread of its
+    final place over 300 simulated trials is the bound (sampling error ~4%; 15% allowed)."""
+    from scipy.optimize import least_squares
+
+    from localizer import trial_bound
+
+    egg = _egg()
+    path = np.linspace(12.0, 30.0, 7)
+    sd_z, sd_o, sd_b = 0.01, 2e-4, 0.01
+    theta = np.asarray(egg.tangent_angle_at_arc(path), float)
+    rng = np.random.default_rng(11)
+    finals = []
+    for _ in range(300):
+        b = 1 + rng.normal(0, sd_b)
+        z = 3.0 + b * (path - path[0]) + rng.normal(0, sd_z, path.size)
+        om = theta + 0.5 + rng.normal(0, sd_o, path.size)
+
+        def residuals(x, z=z, om=om):
+            sig, phi, c, bb = x[: path.size], x[-3], x[-2], x[-1]
+            th = np.asarray(egg.tangent_angle_at_arc(sig), float)
+            return np.r_[(z - c - bb * (sig - sig[0])) / sd_z, (om - th - phi) / sd_o, [(bb - 1) / sd_b]]
+
+        x0 = np.r_[path, 0.5, 3.0, 1.0]
+        finals.append(least_squares(residuals, x0, x_scale="jac").x[path.size - 1] - path[-1])
+    bound = trial_bound(egg, path, sd_position=sd_z, sd_turn=sd_o, sd_scale=sd_b)
+    assert np.std(finals) == pytest.approx(bound, rel=0.15), (np.std(finals), bound)
+
+
+def test_trial_bound_falls_with_readings_rises_with_an_unknown_scale_and_is_infinite_on_a_circle():
+    from localizer import part_from_points, trial_bound
+
+    egg = _egg()
+    path = np.linspace(10.0, 40.0, 61)
+    kw = dict(sd_position=0.02, sd_turn=3e-4)
+    short, longer = trial_bound(egg, path[:20], **kw), trial_bound(egg, path, **kw)
+    assert longer < short
+    assert trial_bound(egg, path, sd_scale=0.05, **kw) > longer
+    a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    circle = part_from_points(np.c_[30 * np.cos(a), 30 * np.sin(a)])
+    assert trial_bound(circle, path, **kw) > 100 * longer  # a spline circle's curvature varies by 1e-5
+    with pytest.raises(QueryError, match="sd_turn"):
+        trial_bound(egg, path, sd_position=0.02, sd_turn=0.0)
+    with pytest.raises(QueryError, match="segments"):
+        trial_bound(egg, path, segments=[0, 1], **kw)
