@@ -8,7 +8,8 @@
   same machined part and noise) from the same start.
 
 Each method also gets a curve: its error (mm) had it stopped after every 5° of rolled rotation,
-stored as ``"5:0.412 10:0.108 ..."`` in the ``<method>_curve`` column.
+stored as ``"5:0.412 10:0.108 ..."`` in the ``<method>_curve`` column, and the Cramér–Rao bound of
+its final place from the readings it took (``<method>_bound_mm``, :func:`method_bound`).
 """
 
 from __future__ import annotations
@@ -61,6 +62,54 @@ def fixed_readings(rolls, part) -> dict:
         "steps": np.array(steps),
         "jaw": np.array(jaw),
     }
+
+
+def reading_noise(seq, part, noise) -> tuple:
+    """(sd_position mm, sd_turn rad): one reading's own noise on this trial's rig, for the bound.
+
+    The travel's: the fixed rolls' readings against the truth, first differences (which cancel the
+    smooth errors: machining, the calibration's shape, drift, which the bound does not model), over
+    √2. The angle's: the encoder's quantization, step/√12 (nan without one: no bound).
+    """
+    truth = np.asarray(seq["truth"], dtype=float)
+    steps = np.diff(truth)
+    travel = np.concatenate([[0.0], np.cumsum(steps - part.perimeter * np.round(steps / part.perimeter))])
+    residual = np.asarray(seq["z"], dtype=float) - travel
+    sd_position = float(np.std(np.diff(residual)) / math.sqrt(2.0)) if residual.size > 2 else math.nan
+    sd_turn = noise.encoder_step / math.sqrt(12.0) if noise.encoder_step > 0 else math.nan
+    return sd_position, sd_turn
+
+
+def method_bound(part, path, segments, sds: tuple, sd_scale: float, noise) -> float:
+    """The Cramér–Rao bound (mm) of a method's final place from the readings along ``path``
+    (:func:`localizer.trial_bound`), with the rig's ``noise`` model's machining deviation as a nuisance;
+    nan where the noise has no level to bound with."""
+    from localizer import QueryError, TrialNoise, trial_bound
+
+    sd_position, sd_turn = sds
+    if not (sd_position > 0 and sd_turn > 0):
+        return math.nan
+    model = TrialNoise(
+        sd_position=sd_position,
+        sd_turn=sd_turn,
+        sd_scale=sd_scale,
+        machining_error=noise.machining_error,
+        machining_wavelength=noise.machining_wavelength,
+    )
+    try:
+        return trial_bound(part, path, model, segments=segments)
+    except QueryError:  # a path the rig did not know (a real rig's NaN truth)
+        return math.nan
+
+
+def _sd_scale(study) -> float:
+    """The calibration scale's prior standard deviation: the study's [reactive] sd_scale, else the filter's."""
+    import inspect
+
+    from localizer import ContactFilter
+
+    given = study.reactive.sd_scale
+    return float(given if given is not None else inspect.signature(ContactFilter).parameters["sd_scale"].default)
 
 
 def _err(part, est, truth) -> float:
@@ -328,6 +377,7 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
         "stopped": reactive_stop(res),
         "mass": res.belief.mass,
         "bridges": res.bridges,
+        "path": (res.true_arcs, res.segments),
     }
 
 
@@ -351,6 +401,7 @@ def score_methods(
     """
     seq = fixed_readings(rolls, part)
     rules = {} if rules is None else rules
+    sds, sd_scale = reading_noise(seq, part, noise), _sd_scale(study)
     out = {}
     for m in study.methods:
         try:
@@ -374,6 +425,7 @@ def score_methods(
                 "mass": "",
                 "failure": text[:200],
             }
+        path, segments = r.get("path", (seq["truth"], None))
         out.update(
             {
                 f"{m}_success": int(r["error_mm"] < study.success_radius),
@@ -385,6 +437,9 @@ def score_methods(
                 f"{m}_mass": r["mass"],
                 f"{m}_failure": r["failure"],
                 f"{m}_bridges": r.get("bridges", ""),
+                f"{m}_bound_mm": method_bound(part, path, segments, sds, sd_scale, noise)
+                if not r["failure"]
+                else math.nan,
             }
         )
     return out

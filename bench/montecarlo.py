@@ -353,6 +353,7 @@ def method_detail(study: Study, m: str, rows) -> dict:
         d["trials"] += 1
         d["success"] += int(r[f"{m}_success"])
     wrong = sum(1 - int(r[f"{m}_success"]) for r in confident)
+    ratio = error_over_bound(m, rows)
     return {
         "success": ok,
         "trials": n,
@@ -366,7 +367,20 @@ def method_detail(study: Study, m: str, rows) -> dict:
         "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
         "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
         "per_part": dict(sorted(per_part.items())),
+        "error_over_bound_rms": float(np.sqrt(np.mean(ratio**2))) if ratio.size else None,
+        "error_over_bound_median": float(np.median(ratio)) if ratio.size else None,
+        "bounded_successes": int(ratio.size),
     }
+
+
+def error_over_bound(m: str, rows) -> np.ndarray:
+    """Error / Cramér–Rao bound of method ``m`` over its successful trials that have a finite bound."""
+    out = []
+    for r in rows:
+        bound = _number(r.get(f"{m}_bound_mm", ""))
+        if int(r[f"{m}_success"]) and math.isfinite(bound) and bound > 0:
+            out.append(_number(r[f"{m}_error_mm"]) / bound)
+    return np.array(out, dtype=float)
 
 
 def summarize_methods(study: Study, rows) -> dict:
@@ -424,6 +438,7 @@ def plot_study(study: Study, rows, out: Path) -> None:
     if study.methods and rows:
         _plot_methods(study, full, out)
         _plot_reliability(study, rows, out)
+        _plot_bound(study, rows, out)
     if study.parameter == "jaw" and rows:
         _plot_fingers(study, rows, summ, out)
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
@@ -528,6 +543,44 @@ def _plot_fingers(study: Study, rows, levels: list, out: Path) -> None:
     fig.suptitle(f"{study.name}: fingers on the same trial seeds, noise {Path(str(study.noise)).stem}", fontsize=10)
     fig.tight_layout()
     fig.savefig(out / "fingers.png", dpi=110)
+    plt.close(fig)
+
+
+def _plot_bound(study: Study, rows, out: Path) -> None:
+    """bound.png: each method's final error against the Cramér–Rao bound of its readings, trial by trial
+    (successes filled, failures hollow), with the bound itself and 1.3 times it."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 5.0))
+    lo, hi = math.inf, 0.0
+    for k, m in enumerate(study.methods):
+        bound = np.array([_number(r.get(f"{m}_bound_mm", "")) for r in rows])
+        err = np.array([_number(r[f"{m}_error_mm"]) for r in rows])
+        ok = np.array([int(r[f"{m}_success"]) for r in rows], dtype=bool)
+        keep = np.isfinite(bound) & (bound > 0) & np.isfinite(err)
+        if not keep.any():
+            continue
+        err = np.maximum(err, 1e-5)
+        ratio = error_over_bound(m, rows)
+        rms = f", rms error/bound {np.sqrt(np.mean(ratio**2)):.2f} over {ratio.size} successes" if ratio.size else ""
+        colour = f"C{k}"
+        ax.loglog(bound[keep & ok], err[keep & ok], "o", ms=3, color=colour, alpha=0.6, label=f"{m}{rms}")
+        ax.loglog(bound[keep & ~ok], err[keep & ~ok], "o", ms=3, mfc="none", color=colour, alpha=0.6)
+        lo, hi = min(lo, bound[keep].min(), err[keep].min()), max(hi, bound[keep].max(), err[keep].max())
+    if hi > 0:
+        line = np.array([lo, hi])
+        ax.loglog(line, line, "k-", lw=1, label="error = bound")
+        ax.loglog(line, 1.3 * line, "k--", lw=1, label="1.3 × bound")
+        ax.axhline(
+            study.success_radius, color="tab:red", lw=1, ls=":", label=f"success radius {study.success_radius} mm"
+        )
+    ax.set_xlabel("Cramér–Rao bound of the final place from the readings taken (mm)")
+    ax.set_ylabel("final error (mm)")
+    ax.set_title(f"{study.name}: error against its bound (hollow: failures)", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "bound.png", dpi=110)
     plt.close(fig)
 
 

@@ -136,7 +136,9 @@ METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
 #: ``stopped``: confident, budget, ambiguous (the reactive method), fixed (the fixed-roll methods) or
 #: error; ``mass``: the stated probability within the success radius at the end (empty if the method
-#: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met.
+#: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met;
+#: ``bound_mm``: the Cramér–Rao bound of the final place from the readings the method took
+#: (:func:`bench.methods.method_bound`; empty for a wheel, or without an encoder step).
 METHOD_COLUMNS = (
     "success",
     "error_mm",
@@ -147,6 +149,7 @@ METHOD_COLUMNS = (
     "mass",
     "failure",
     "bridges",
+    "bound_mm",
 )
 #: Columns of a study that names its finger: the finger, how many uniform draws over the boundary were
 #: redrawn before one the finger can start from, the fraction of the boundary it can start from, and

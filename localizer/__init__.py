@@ -1,7 +1,7 @@
 """Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
 
 from ._belief import Belief, Mode
-from ._bound import roll_bound, trial_bound
+from ._bound import TrialNoise, roll_bound, trial_bound
 from ._boundary import Boundary
 from ._cad import CAD_SUFFIXES, load_outline
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, SLOPE_ENVELOPE, TEMPER, ContactFilter
@@ -108,4 +108,5 @@ __all__ = [
     "arc_from_jaw_positions",
     "roll_bound",
     "trial_bound",
+    "TrialNoise",
 ]

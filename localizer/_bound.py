@@ -33,6 +33,7 @@ two readings). docs/robustness.md gives the derivation in full.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -40,7 +41,7 @@ from ._boundary import Boundary
 from ._errors import QueryError
 from ._types import ArrayLike, FloatArray
 
-__all__ = ["roll_bound", "trial_bound"]
+__all__ = ["roll_bound", "trial_bound", "TrialNoise"]
 
 
 def roll_bound(
@@ -96,15 +97,51 @@ def roll_bound(
     return out
 
 
-def trial_bound(
-    part: Boundary,
-    path: ArrayLike,
-    *,
-    sd_position: float,
-    sd_turn: float,
-    sd_scale: float = 0.0,
-    segments: ArrayLike | None = None,
-) -> float:
+@dataclass(frozen=True)
+class TrialNoise:
+    """What :func:`trial_bound` takes the readings' errors and the nuisances to be.
+
+    Attributes
+    ----------
+    sd_position : float, mm
+        Standard deviation of one reading of the contact's travel (> 0).
+    sd_turn : float, rad
+        Standard deviation of one reading of the arm's angle (> 0).
+    sd_scale : float
+        Prior standard deviation of the calibration's relative scale (0: the scale is known).
+    machining_error : float, mm
+        RMS of the real boundary's normal deviation from the model (0: none), as harmonics of the
+        perimeter with 1/k amplitudes down to ``machining_wavelength`` (the simulator's model):
+        its slope turns the arm's angle and its curvature's share lengthens the travel.
+    machining_wavelength : float, mm
+        The deviation's shortest wavelength.
+    """
+
+    sd_position: float
+    sd_turn: float
+    sd_scale: float = 0.0
+    machining_error: float = 0.0
+    machining_wavelength: float = 20.0
+
+    def __post_init__(self) -> None:
+        for name in ("sd_position", "sd_turn", "machining_wavelength"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise QueryError(f"{name}={value!r} must be a positive number")
+        for name in ("sd_scale", "machining_error"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise QueryError(f"{name}={value!r} must be a number ≥ 0")
+
+
+def _harmonics(noise: TrialNoise, perimeter: float) -> FloatArray:
+    """The machining deviation's harmonic numbers k (empty without one)."""
+    if noise.machining_error <= 0:
+        return np.empty(0)
+    return np.arange(1, max(1, int(perimeter / noise.machining_wavelength)) + 1, dtype=float)
+
+
+def trial_bound(part: Boundary, path: ArrayLike, noise: TrialNoise, *, segments: ArrayLike | None = None) -> float:
     """The Cramér–Rao bound, mm, of the contact's final place after the readings along ``path``.
 
     Parameters
@@ -113,12 +150,8 @@ def trial_bound(
     path : array_like (k+1,), mm
         The true contact's arc position at every reading of the trial, in order (the first where
         the jaw was laid); wrapped or unrolled, each step shorter than half the perimeter.
-    sd_position : float, mm
-        Standard deviation of one reading of the contact's travel (> 0).
-    sd_turn : float, rad
-        Standard deviation of one reading of the arm's angle (> 0).
-    sd_scale : float
-        Prior standard deviation of the calibration's relative scale (0: the scale is known).
+    noise : TrialNoise
+        The readings' errors and the nuisances' priors.
     segments : array_like of int (k+1,), optional
         The contact segment of each reading (a regrasp or a bridge starts one with its own offset);
         default one segment.
@@ -135,22 +168,18 @@ def trial_bound(
     >>> from localizer import part_from_points
     >>> a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     >>> egg = part_from_points(np.c_[30 * np.cos(a) + 4 * np.cos(2 * a), 22 * np.sin(a)])
-    >>> two = trial_bound(egg, [10.0, 22.0], sd_position=0.01, sd_turn=2e-4)
+    >>> two = trial_bound(egg, [10.0, 22.0], TrialNoise(sd_position=0.01, sd_turn=2e-4))
     >>> one = float(roll_bound(egg, 10.0, 12.0, sd_length=0.01 * 2**0.5, sd_turn=2e-4 * 2**0.5, at="end"))
     >>> round(two, 4), abs(two - one) < 1e-9 * one
     (0.0278, True)
 
-    Rolling on adds readings, and the bound falls:
+    Rolling on adds readings and the bound falls; an unknown scale and a machined part raise it:
 
     >>> path = np.linspace(10.0, 40.0, 151)
-    >>> round(trial_bound(egg, path, sd_position=0.01, sd_turn=2e-4, sd_scale=0.01), 4)
-    0.0165
+    >>> [round(trial_bound(egg, path, TrialNoise(0.01, 2e-4, **kw)), 4)
+    ...  for kw in ({}, {"sd_scale": 0.01}, {"sd_scale": 0.01, "machining_error": 0.009})]
+    [0.0085, 0.0165, 0.1341]
     """
-    for name, value in (("sd_position", sd_position), ("sd_turn", sd_turn)):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise QueryError(f"{name}={value!r} must be a positive number")
-    if not (isinstance(sd_scale, (int, float)) and math.isfinite(sd_scale) and sd_scale >= 0):
-        raise QueryError(f"sd_scale={sd_scale!r} must be a number ≥ 0")
     sigma = np.asarray(path, dtype=float).ravel()
     if sigma.size == 0 or not np.all(np.isfinite(sigma)):
         raise QueryError(f"path: {sigma.size} readings; a trial's path must be finite arc positions, at least one")
@@ -161,24 +190,45 @@ def trial_bound(
         return math.inf
     P = part.perimeter
     steps = np.diff(sigma)
-    travel = np.concatenate([[0.0], np.cumsum(steps - P * np.round(steps / P))])
+    steps = steps - P * np.round(steps / P)
+    travel = np.concatenate([[0.0], np.cumsum(steps)])
     kappa = np.asarray(part.curvature_at_arc(np.mod(sigma, P)), dtype=float)
     labels, seg_index = np.unique(seg, return_inverse=True)
-    # columns of g: φ, one offset per segment, then b (when its scale is not known)
-    n_g = 1 + labels.size + (1 if sd_scale > 0 else 0)
+    harm = _harmonics(noise, P)
+    # columns of g: φ, one offset per segment, b (when its scale is not known), the deviation's
+    # cosine and sine coefficients
+    n_c = 1 + labels.size
+    n_b = 1 if noise.sd_scale > 0 else 0
+    n_g = n_c + n_b + 2 * harm.size
     k = sigma.size
     e_z = np.zeros((k, n_g))
     e_z[np.arange(k), 1 + seg_index] = 1.0
-    if sd_scale > 0:
-        e_z[:, -1] = travel
     e_o = np.zeros((k, n_g))
     e_o[:, 0] = 1.0
-    w_z, w_o = 1.0 / sd_position**2, 1.0 / sd_turn**2
+    prior = np.zeros(n_g)
+    if n_b:
+        e_z[:, n_c] = travel
+        prior[n_c] = 1.0 / noise.sd_scale**2
+    if harm.size:
+        # d(σ) = Σ α_k cos(ω_k σ) + β_k sin(ω_k σ), var α_k = var β_k = rms² / (k² Σ 1/j²); the arm reads
+        # the real tangent, θ + d', and the travel on the real boundary grows by ∫ κ d dσ
+        w = 2 * np.pi * harm / P
+        cos, sin = np.cos(np.outer(sigma, w)), np.sin(np.outer(sigma, w))
+        e_o[:, n_c + n_b :] = np.hstack([-sin * w, cos * w])
+        mid = 0.5 * (kappa[1:] + kappa[:-1])[:, None] * steps[:, None]
+        grow = np.vstack(
+            [
+                np.zeros((1, 2 * harm.size)),
+                np.cumsum(mid * 0.5 * np.hstack([cos[1:] + cos[:-1], sin[1:] + sin[:-1]]), axis=0),
+            ]
+        )
+        e_z[:, n_c + n_b :] = grow
+        var = noise.machining_error**2 / (harm**2 * np.sum(1.0 / harm**2))
+        prior[n_c + n_b :] = np.tile(1.0 / var, 2)
+    w_z, w_o = 1.0 / noise.sd_position**2, 1.0 / noise.sd_turn**2
     a = w_z + kappa**2 * w_o
     u = w_z * e_z + (kappa * w_o)[:, None] * e_o
-    info = w_z * e_z.T @ e_z + w_o * e_o.T @ e_o - (u[:-1].T / a[:-1]) @ u[:-1]
-    if sd_scale > 0:
-        info[-1, -1] += 1.0 / sd_scale**2
+    info = w_z * e_z.T @ e_z + w_o * e_o.T @ e_o - (u[:-1].T / a[:-1]) @ u[:-1] + np.diag(prior)
     # σ_k's share: a_k − u_kᵀ info⁻¹ u_k, the information left on it once g is unknown
     if np.linalg.cond(info) > 1e14:  # a nuisance the readings do not fix: nor is the place
         return math.inf

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import QueryError, feasible_segments, load_part, roll_bound
+from localizer import QueryError, TrialNoise, feasible_segments, load_part, roll_bound, trial_bound
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 
@@ -48,47 +48,63 @@ def _egg():
     return part_from_points(np.c_[30 * np.cos(a) + 4 * np.cos(2 * a), 22 * np.sin(a)])
 
 
-def _dense_fisher_bound(part, path, segments, sd_z, sd_o, sd_b):
-    """Reference: the whole Fisher matrix over (σ_0 … σ_k, φ, c_1 … c_S, b), θ' by central differences,
-    inverted densely (no elimination)."""
+def _dense_fisher_bound(part, path, segments, sd_z, sd_o, sd_b, rms=0.0, wavelength=20.0):
+    """Reference: the whole Fisher matrix over (σ_0 … σ_k, φ, c_1 … c_S, b, deviation coefficients), θ'
+    by central differences, the deviation's travel term by dense quadrature, inverted densely (no
+    elimination)."""
     k = len(path)
+    P = part.perimeter
     labels = sorted(set(segments))
-    n = k + 1 + len(labels) + 1
+    harm = np.arange(1, int(P / wavelength) + 1) if rms > 0 else np.arange(0)
+    n_d = 2 * harm.size
+    n = k + 1 + len(labels) + 1 + n_d
     rows, w = [], []
     h = 1e-5
+
+    def dev_columns(s):  # d'(s) per coefficient, and ∫_{path[0]}^{s} κ·basis dσ
+        om = 2 * np.pi * harm / P
+        slope = np.r_[-om * np.sin(om * s), om * np.cos(om * s)]
+        x = np.linspace(path[0], s, 2001)
+        kap = np.asarray(part.curvature_at_arc(np.mod(x, P)), float)[:, None]
+        basis = np.hstack([np.cos(np.outer(x, om)), np.sin(np.outer(x, om))])
+        return slope, np.trapezoid(kap * basis, x, axis=0) if n_d else np.zeros(0)
+
     for j, (s, g) in enumerate(zip(path, segments)):
+        slope, grow = dev_columns(s)
         rz = np.zeros(n)
         rz[j] = 1.0
         rz[k + 1 + labels.index(g)] = 1.0
-        rz[-1] = s - path[0]
+        rz[k + 1 + len(labels)] = s - path[0]
+        rz[n - n_d :] = grow
         ro = np.zeros(n)
         ro[j] = float(part.tangent_angle_at_arc(s + h) - part.tangent_angle_at_arc(s - h)) / (2 * h)
         ro[k] = 1.0
+        ro[n - n_d :] = slope
         rows += [rz, ro]
         w += [1 / sd_z**2, 1 / sd_o**2]
     H = np.array(rows)
     J = H.T @ (np.array(w)[:, None] * H)
-    J[-1, -1] += 1 / sd_b**2
+    J[k + 1 + len(labels), k + 1 + len(labels)] += 1 / sd_b**2
+    if n_d:
+        var = rms**2 / (harm**2 * np.sum(1.0 / harm**2))
+        J[n - n_d :, n - n_d :] += np.diag(np.tile(1 / var, 2))
     return float(np.sqrt(np.linalg.inv(J)[k - 1, k - 1]))
 
 
-@pytest.mark.parametrize("segments", [[0] * 12, [0] * 5 + [1] * 7])
-def test_trial_bound_is_the_dense_fisher_bound(segments):
-    from localizer import trial_bound
-
+@pytest.mark.parametrize("segments, rms", [([0] * 12, 0.0), ([0] * 5 + [1] * 7, 0.0), ([0] * 5 + [1] * 7, 0.009)])
+def test_trial_bound_is_the_dense_fisher_bound(segments, rms):
     egg = _egg()
     path = list(np.r_[np.linspace(10.0, 25.0, 8), np.linspace(24.0, 18.0, 4)])  # out and partly back
-    got = trial_bound(egg, path, sd_position=0.02, sd_turn=3e-4, sd_scale=0.02, segments=segments)
-    ref = _dense_fisher_bound(egg, path, segments, 0.02, 3e-4, 0.02)
-    assert got == pytest.approx(ref, rel=1e-5)
+    noise = TrialNoise(sd_position=0.02, sd_turn=3e-4, sd_scale=0.02, machining_error=rms)
+    got = trial_bound(egg, path, noise, segments=segments)
+    ref = _dense_fisher_bound(egg, path, segments, 0.02, 3e-4, 0.02, rms)
+    assert got == pytest.approx(ref, rel=1e-4)
 
 
 def test_trial_bound_spread_of_the_maximum_likelihood_place():
     """Small noise: the maximum-likelihood estimate of the whole model is efficient, so the spread of its
     final place over 300 simulated trials is the bound (sampling error ~4%; 15% allowed)."""
     from scipy.optimize import least_squares
-
-    from localizer import trial_bound
 
     egg = _egg()
     path = np.linspace(12.0, 30.0, 7)
@@ -108,23 +124,25 @@ def test_trial_bound_spread_of_the_maximum_likelihood_place():
 
         x0 = np.r_[path, 0.5, 3.0, 1.0]
         finals.append(least_squares(residuals, x0, x_scale="jac").x[path.size - 1] - path[-1])
-    bound = trial_bound(egg, path, sd_position=sd_z, sd_turn=sd_o, sd_scale=sd_b)
+    bound = trial_bound(egg, path, TrialNoise(sd_position=sd_z, sd_turn=sd_o, sd_scale=sd_b))
     assert np.std(finals) == pytest.approx(bound, rel=0.15), (np.std(finals), bound)
 
 
-def test_trial_bound_falls_with_readings_rises_with_an_unknown_scale_and_is_infinite_on_a_circle():
-    from localizer import part_from_points, trial_bound
+def test_trial_bound_falls_with_readings_rises_with_nuisances_and_is_infinite_on_a_circle():
+    from localizer import part_from_points
 
     egg = _egg()
     path = np.linspace(10.0, 40.0, 61)
-    kw = dict(sd_position=0.02, sd_turn=3e-4)
-    short, longer = trial_bound(egg, path[:20], **kw), trial_bound(egg, path, **kw)
+    base = TrialNoise(sd_position=0.02, sd_turn=3e-4)
+    short, longer = trial_bound(egg, path[:20], base), trial_bound(egg, path, base)
     assert longer < short
-    assert trial_bound(egg, path, sd_scale=0.05, **kw) > longer
+    scaled = trial_bound(egg, path, TrialNoise(0.02, 3e-4, sd_scale=0.05))
+    assert scaled > longer
+    assert trial_bound(egg, path, TrialNoise(0.02, 3e-4, sd_scale=0.05, machining_error=0.01)) > scaled
     a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     circle = part_from_points(np.c_[30 * np.cos(a), 30 * np.sin(a)])
-    assert trial_bound(circle, path, **kw) > 100 * longer  # a spline circle's curvature varies by 1e-5
+    assert trial_bound(circle, path, base) > 100 * longer  # a spline circle's curvature varies by 1e-5
     with pytest.raises(QueryError, match="sd_turn"):
-        trial_bound(egg, path, sd_position=0.02, sd_turn=0.0)
+        TrialNoise(sd_position=0.02, sd_turn=0.0)
     with pytest.raises(QueryError, match="segments"):
-        trial_bound(egg, path, segments=[0, 1], **kw)
+        trial_bound(egg, path, base, segments=[0, 1])
