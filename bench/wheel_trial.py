@@ -96,6 +96,7 @@ def run_wheel_trial(spec) -> dict:
                 "reactive_mass": "",
                 "reactive_failure": text,
                 "reactive_bridges": "",
+                "reactive_bound_mm": "",
                 "time_s": time.perf_counter() - t0,
             }
         )
@@ -123,6 +124,7 @@ def run_wheel_trial(spec) -> dict:
             "reactive_mass": run.belief.mass,
             "reactive_failure": "",
             "reactive_bridges": run.jumps,
+            "reactive_bound_mm": "",  # the bound models the straight jaw's readings
             "time_s": time.perf_counter() - t0,
         }
     )

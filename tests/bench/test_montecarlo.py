@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -201,7 +202,16 @@ def test_reactive_study_scores_three_methods_on_the_same_trials(tmp_path):
         assert r["success"] == r["paper_success"] and float(r["reactive_rotation_deg"]) > 0
         assert r["paper_stopped"] == "fixed" and r["reactive_stopped"] in ("confident", "budget", "ambiguous")
         assert 0.0 <= float(r["reactive_mass"]) <= 1.0 and int(r["reactive_bridges"]) >= 0
-    assert (out / "methods.png").exists()
+        # each method's bound from its own readings: the reactive rolling reads more, so bounds less
+        bounds = {m: float(r[f"{m}_bound_mm"]) for m in summary["methods"]}
+        assert all(0 < b < 10 for b in bounds.values()), bounds
+        assert bounds["paper"] == bounds["particle"] and bounds["reactive"] < bounds["paper"]
+    for m, d in summary["method_details"].items():
+        ok = [r for r in rows if int(r[f"{m}_success"])]
+        assert d["bounded_successes"] == len(ok)
+        ratios = [float(r[f"{m}_error_mm"]) / float(r[f"{m}_bound_mm"]) for r in ok]
+        assert d["error_over_bound_rms"] == (pytest.approx(np.sqrt(np.mean(np.square(ratios)))) if ok else None)
+    assert (out / "methods.png").exists() and (out / "bound.png").stat().st_size > 5000
 
 
 def test_grid_method_scores_the_filter_on_the_fixed_readings(tmp_path):
