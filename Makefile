@@ -6,7 +6,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench march-report passivity-report clean
+.PHONY: demo test bench bench-compare bench-baseline march-report passivity-report clean
 
 $(STAMP): pyproject.toml
 	@test -x $(PY) || { command -v $(PYTHON) >/dev/null 2>&1 || { echo "$(PYTHON) not found; run: make PYTHON=/path/to/python3.11"; exit 1; }; $(PYTHON) -m venv $(VENV); }
@@ -31,7 +31,23 @@ test: $(STAMP)
 	$(PY) -m pytest -q bench --benchmark-disable -p no:cacheprovider
 
 bench: $(STAMP)
-	$(PY) -m pytest bench --benchmark-only --benchmark-json=out/bench.json
+	@mkdir -p out
+	$(PY) -m pytest bench --benchmark-only --benchmark-json=out/bench.json -p no:cacheprovider
+
+# Regression runs against the committed baseline (bench/baseline/<machine>/0001_baseline.json), on
+# the fastest round of each benchmark. BENCH_FAIL is the allowed slow-down: this 2-core machine's
+# own spread between back-to-back runs is up to 25% (README, "Benchmark regressions").
+BENCH_STORE := file://bench/baseline
+BENCH_FAIL  ?= min:40%
+bench-compare: $(STAMP)
+	@mkdir -p out
+	@ls bench/baseline/*/0001_baseline.json >/dev/null 2>&1 || { echo "no baseline under bench/baseline: run 'make bench-baseline' on the commit to compare against"; exit 1; }
+	$(PY) -m pytest bench --benchmark-only --benchmark-storage=$(BENCH_STORE) --benchmark-compare=0001 \
+		--benchmark-compare-fail=$(BENCH_FAIL) --benchmark-json=out/bench.json -p no:cacheprovider
+
+bench-baseline: $(STAMP)
+	rm -rf bench/baseline
+	$(PY) -m pytest bench --benchmark-only --benchmark-storage=$(BENCH_STORE) --benchmark-save=baseline -p no:cacheprovider
 
 passivity-report: $(STAMP)
 	$(PY) -m bench.reports.passivity --out docs/generated/passivity

@@ -398,35 +398,34 @@ def _check_points(points: ArrayLike, source: str) -> FloatArray:
 
 
 def _segments_cross(poly: FloatArray) -> tuple[int, int] | None:
-    """First pair of non-adjacent crossing edges of a closed polyline, or None."""
+    """First pair of non-adjacent crossing edges of a closed polyline, or None.
+
+    Sweep and prune: edges in order of their lowest x; each is paired with the later ones whose
+    lowest x is within its own x range (all pairs at once, in that order), the pairs whose y ranges
+    overlap are tested exactly, and the first crossing pair is returned.
+    """
     a = poly[:-1]
     b = poly[1:]
     n = len(a)
-    lo = np.minimum(a, b)
-    hi = np.maximum(a, b)
-    order = np.argsort(lo[:, 0])
-    for idx in range(n):
-        i = order[idx]
-        # candidates: edges whose x-range overlaps, later in the sort order
-        cand = order[idx + 1 :]
-        cand = cand[lo[cand, 0] <= hi[i, 0]]
-        if cand.size == 0:
-            continue
-        cand = cand[(lo[cand, 1] <= hi[i, 1]) & (hi[cand, 1] >= lo[i, 1])]
-        cand = cand[(np.abs(cand - i) > 1) & (np.abs(cand - i) < n - 1)]
-        if cand.size == 0:
-            continue
-        p, r = a[i], b[i] - a[i]
-        q, sv = a[cand], b[cand] - a[cand]
-        rxs = r[0] * sv[:, 1] - r[1] * sv[:, 0]
-        qp = q - p
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tt = (qp[:, 0] * sv[:, 1] - qp[:, 1] * sv[:, 0]) / rxs
-            uu = (qp[:, 0] * r[1] - qp[:, 1] * r[0]) / rxs
-        hit = (rxs != 0) & (tt >= 0) & (tt <= 1) & (uu >= 0) & (uu <= 1)
-        if hit.any():
-            return int(i), int(cand[np.argmax(hit)])
-    return None
+    order = np.argsort(np.minimum(a[:, 0], b[:, 0]), kind="stable")
+    a, b = a[order], b[order]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    end = np.searchsorted(lo[:, 0], hi[:, 0], side="right")
+    count = np.maximum(end - np.arange(n) - 1, 0)
+    ii = np.repeat(np.arange(n), count)
+    jj = ii + 1 + np.arange(ii.size) - np.repeat(np.cumsum(count) - count, count)
+    gap = np.abs(order[jj] - order[ii])
+    keep = (lo[jj, 1] <= hi[ii, 1]) & (hi[jj, 1] >= lo[ii, 1]) & (gap > 1) & (gap < n - 1)
+    ii, jj = ii[keep], jj[keep]
+    r, sv, qp = b[ii] - a[ii], b[jj] - a[jj], a[jj] - a[ii]
+    rxs = r[:, 0] * sv[:, 1] - r[:, 1] * sv[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tt = (qp[:, 0] * sv[:, 1] - qp[:, 1] * sv[:, 0]) / rxs
+        uu = (qp[:, 0] * r[:, 1] - qp[:, 1] * r[:, 0]) / rxs
+    hit = np.flatnonzero((rxs != 0) & (tt >= 0) & (tt <= 1) & (uu >= 0) & (uu <= 1))
+    if hit.size == 0:
+        return None
+    return int(order[ii[hit[0]]]), int(order[jj[hit[0]]])
 
 
 def part_from_points(points: ArrayLike, *, name: str = "part", units: str = "mm", source: str | None = None) -> Part:
