@@ -566,9 +566,9 @@ def _plot_bound(study: Study, rows, out: Path) -> None:
         colour = f"C{k}"
         ax.loglog(bound[keep & ok], err[keep & ok], "o", ms=3, color=colour, alpha=0.6, label=f"{m}{rms}")
         ax.loglog(bound[keep & ~ok], err[keep & ~ok], "o", ms=3, mfc="none", color=colour, alpha=0.6)
-        lo, hi = min(lo, bound[keep].min(), err[keep].min()), max(hi, bound[keep].max(), err[keep].max())
+        lo, hi = min(lo, bound[keep].min()), max(hi, bound[keep].max())
     if hi > 0:
-        line = np.array([lo, hi])
+        line = np.array([lo / 2, hi * 2])
         ax.loglog(line, line, "k-", lw=1, label="error = bound")
         ax.loglog(line, 1.3 * line, "k--", lw=1, label="1.3 × bound")
         ax.axhline(
