@@ -32,22 +32,23 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	@mkdir -p out
-	$(PY) -m pytest bench --benchmark-only --benchmark-json=out/bench.json -p no:cacheprovider
+	$(PY) -m pytest bench $(BENCH_OPTS) --benchmark-json=out/bench.json
 
 # Regression runs against the committed baseline (bench/baseline/<machine>/0001_baseline.json), on
 # the fastest round of each benchmark. BENCH_FAIL is the allowed slow-down: this 2-core machine's
 # own spread between back-to-back runs is up to 25% (README, "Benchmark regressions").
 BENCH_STORE := file://bench/baseline
+BENCH_OPTS  := --benchmark-only --benchmark-max-time=2 -p no:cacheprovider
 BENCH_FAIL  ?= min:40%
 bench-compare: $(STAMP)
 	@mkdir -p out
 	@ls bench/baseline/*/0001_baseline.json >/dev/null 2>&1 || { echo "no baseline under bench/baseline: run 'make bench-baseline' on the commit to compare against"; exit 1; }
-	$(PY) -m pytest bench --benchmark-only --benchmark-storage=$(BENCH_STORE) --benchmark-compare=0001 \
-		--benchmark-compare-fail=$(BENCH_FAIL) --benchmark-json=out/bench.json -p no:cacheprovider
+	$(PY) -m pytest bench $(BENCH_OPTS) --benchmark-storage=$(BENCH_STORE) --benchmark-compare=0001 \
+		--benchmark-compare-fail=$(BENCH_FAIL) --benchmark-json=out/bench.json
 
 bench-baseline: $(STAMP)
 	rm -rf bench/baseline
-	$(PY) -m pytest bench --benchmark-only --benchmark-storage=$(BENCH_STORE) --benchmark-save=baseline -p no:cacheprovider
+	$(PY) -m pytest bench $(BENCH_OPTS) --benchmark-storage=$(BENCH_STORE) --benchmark-save=baseline
 
 passivity-report: $(STAMP)
 	$(PY) -m bench.reports.passivity --out docs/generated/passivity

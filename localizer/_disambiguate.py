@@ -242,12 +242,22 @@ def _likelihood(
     seeds = np.sort(np.array(found))
     seeds = seeds[np.concatenate([[True], np.diff(seeds) > 0.1 * min_separation])]
 
+    # the solver asks for the residuals and the Jacobian at the same x: one chain for both
+    last_x: list[FloatArray] = []
+    last_chain: list[tuple[FloatArray, FloatArray, FloatArray, FloatArray]] = []
+
+    def chain_at(x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        if not last_x or not np.array_equal(last_x[0], x):
+            last_x[:] = [np.array(x, dtype=float, copy=True)]
+            last_chain[:] = [_chain_turns(part, x[0], x[1:], sign)]
+        return last_chain[0]
+
     def resid(x: FloatArray) -> FloatArray:
-        pos, turns, _, _ = _chain_turns(part, x[0], x[1:], sign)
+        pos, turns, _, _ = chain_at(x)
         return np.concatenate([(turns - W) / sd_turn, (x[1:] - L) / sd_length])
 
     def jac(x: FloatArray) -> FloatArray:
-        pos, turns, kappa, _ = _chain_turns(part, x[0], x[1:], sign)
+        pos, turns, kappa, _ = chain_at(x)
         J = np.zeros((2 * n, n + 1))
         dk = kappa[1:] - kappa[:-1]
         J[:n, 0] = dk

@@ -65,6 +65,8 @@ class QuasiStaticWorld:
             self._xy = part.point(self._t)
             self._x, self._y = self._xy[:, 0].copy(), self._xy[:, 1].copy()
         self.hand: tuple[float, float, float] | None = (0.0, 0.0, 0.0)
+        # the contact is a function of the hand's pose alone; a reading and the truth ask for the same one
+        self._last: tuple[tuple[float, float, float] | None, Contact] | None = None
 
     def set_hand(self, x: float, y: float, phi: float) -> None:
         """Put the hand (wrist axis at (x, y) mm, jaw angle φ rad) there."""
@@ -72,6 +74,13 @@ class QuasiStaticWorld:
 
     def contact(self) -> Contact:
         """The contact for the present hand pose (force 0 when the jaw is clear)."""
+        if self._last is not None and self._last[0] == self.hand:
+            return self._last[1]
+        c = self._contact()
+        self._last = (self.hand, c)
+        return c
+
+    def _contact(self) -> Contact:
         x, y, phi = self.hand or (0.0, 0.0, 0.0)
         spline = self._spline
         if spline is None:

@@ -98,6 +98,7 @@ class SimRig(SimulatedArm):
         self.sample_period = float(sample_period)
         self.time = 0.0
         self.samples: list[dict] = []
+        self._last_arc: tuple | None = None
 
     # --------------------------------------------------------- Rig: sensor (the arm: SimulatedArm)
     def read(self, n: int = 32) -> tuple:
@@ -119,9 +120,7 @@ class SimRig(SimulatedArm):
                 "v2": out[1],
                 "force": c.force,
                 "jaw_position": c.jaw_position,
-                "contact_arc": float(self.model.wrap_arc(self.model.arc_at_param(c.param)))
-                if c.force > 0
-                else float("nan"),
+                "contact_arc": self._contact_arc(c),
                 "at_edge": c.at_edge,
             }
         )
@@ -206,8 +205,21 @@ class SimRig(SimulatedArm):
     def truth(self) -> dict:
         """Ground truth of the present contact (simulation only)."""
         c = self.world.contact()
+        return {
+            "force": c.force,
+            "jaw_position": c.jaw_position,
+            "contact_arc": self._contact_arc(c),
+            "at_edge": c.at_edge,
+        }
+
+    def _contact_arc(self, c) -> float:
+        """The model's arc position (mm) of contact ``c`` (nan when clear); the last one is kept, as a
+        reading and the truth after it ask for the same contact."""
+        if self._last_arc is not None and self._last_arc[0] is c:
+            return self._last_arc[1]
         arc = float(self.model.wrap_arc(self.model.arc_at_param(c.param))) if c.force > 0 else float("nan")
-        return {"force": c.force, "jaw_position": c.jaw_position, "contact_arc": arc, "at_edge": c.at_edge}
+        self._last_arc = (c, arc)
+        return arc
 
     # ------------------------------------------------- simulation helpers
     def calibration_pose(self, standoff: float = 1.0) -> tuple:
