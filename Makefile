@@ -36,10 +36,10 @@ bench: $(STAMP)
 
 # Regression runs against the committed baseline (bench/baseline/<machine>/0001_baseline.json), on
 # the fastest round of each benchmark. BENCH_FAIL is the allowed slow-down: this 2-core machine's
-# own spread between back-to-back runs is up to 25% (README, "Benchmark regressions").
+# own spread between back-to-back runs reached 58% (README, "Benchmark regressions in a pull request").
 BENCH_STORE := file://bench/baseline
 BENCH_OPTS  := --benchmark-only --benchmark-max-time=2 -p no:cacheprovider
-BENCH_FAIL  ?= min:40%
+BENCH_FAIL  ?= min:75%
 bench-compare: $(STAMP)
 	@mkdir -p out
 	@ls bench/baseline/*/0001_baseline.json >/dev/null 2>&1 || { echo "no baseline under bench/baseline: run 'make bench-baseline' on the commit to compare against"; exit 1; }
