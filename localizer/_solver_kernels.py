@@ -80,6 +80,23 @@ def _grow(a: FloatArray) -> FloatArray:
     return out
 
 
+@numba.njit(cache=True)
+def _put(
+    rows: FloatArray, n: int, a: float, b: float, ga: float, gb: float, da: float, db: float, last: float
+) -> FloatArray:
+    """``rows`` (grown when full) with row ``n`` set to a cell: its ends (mm), g and g' there, and ``last``."""
+    if n == rows.shape[0]:
+        rows = _grow(rows)
+    rows[n, 0] = a
+    rows[n, 1] = b
+    rows[n, 2] = ga
+    rows[n, 3] = gb
+    rows[n, 4] = da
+    rows[n, 5] = db
+    rows[n, 6] = last
+    return rows
+
+
 @numba.njit(cache=True, error_model="numpy")
 def cell_pass(
     sig: FloatArray,
@@ -172,13 +189,7 @@ def cell_pass(
             if c == ce[r + 1]:
                 break
             c = c + 1 if c + 1 < J else 0
-        stack[0, 0] = bp[r]
-        stack[0, 1] = bp[r + 1]
-        stack[0, 2] = g[r]
-        stack[0, 3] = g[r + 1]
-        stack[0, 4] = dg[r]
-        stack[0, 5] = dg[r + 1]
-        stack[0, 6] = K_s + K_e
+        stack = _put(stack, 0, bp[r], bp[r + 1], g[r], g[r + 1], dg[r], dg[r + 1], K_s + K_e)
         top = 1
         hs = r * group
         he = ce[r]
@@ -200,15 +211,7 @@ def cell_pass(
             change = ga * gb < 0.0
             if mono:
                 if change:
-                    if nb == brackets.shape[0]:
-                        brackets = _grow(brackets)
-                    brackets[nb, 0] = a
-                    brackets[nb, 1] = b
-                    brackets[nb, 2] = ga
-                    brackets[nb, 3] = gb
-                    brackets[nb, 4] = da
-                    brackets[nb, 5] = db
-                    brackets[nb, 6] = 0.0
+                    brackets = _put(brackets, nb, a, b, ga, gb, da, db, 0.0)
                     nb += 1
                 continue
             # same-sign ends: no root if the quadratic envelopes' zero crossings overlap
@@ -231,15 +234,7 @@ def cell_pass(
                 continue
             if w <= double_width:
                 if change:
-                    if nb == brackets.shape[0]:
-                        brackets = _grow(brackets)
-                    brackets[nb, 0] = a
-                    brackets[nb, 1] = b
-                    brackets[nb, 2] = ga
-                    brackets[nb, 3] = gb
-                    brackets[nb, 4] = da
-                    brackets[nb, 5] = db
-                    brackets[nb, 6] = 1.0
+                    brackets = _put(brackets, nb, a, b, ga, gb, da, db, 1.0)
                     nb += 1
                 else:
                     if nd == dbuf.size:
@@ -254,23 +249,9 @@ def cell_pass(
             th_e, k_e, _ = _theta_kappa(sig, thc, kac, inv_h, P, mid + length, he)
             gm = th_e - th_s - turn
             dm = k_e - k_s
-            if top + 2 > stack.shape[0]:
-                stack = _grow(stack)
             # the right half below the left, so cells come out in order
-            stack[top, 0] = mid
-            stack[top, 1] = b
-            stack[top, 2] = gm
-            stack[top, 3] = gb
-            stack[top, 4] = dm
-            stack[top, 5] = db
-            stack[top, 6] = K
-            stack[top + 1, 0] = a
-            stack[top + 1, 1] = mid
-            stack[top + 1, 2] = ga
-            stack[top + 1, 3] = gm
-            stack[top + 1, 4] = da
-            stack[top + 1, 5] = dm
-            stack[top + 1, 6] = K
+            stack = _put(stack, top, mid, b, gm, gb, dm, db, K)
+            stack = _put(stack, top + 1, a, mid, ga, gm, da, dm, K)
             top += 2
     return zbuf[:nz].copy(), brackets[:nb].copy(), dbuf[:nd].copy(), flats[:nf].copy(), 0
 
