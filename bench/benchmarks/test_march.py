@@ -32,7 +32,9 @@ def query(part):
 
 def test_march_query_at_paper_step(benchmark, part, query):
     s0, L, w = query
-    res = benchmark.pedantic(march, args=(part, L, w), kwargs={"options": MarchOptions(step=H)}, rounds=100, iterations=1)
+    res = benchmark.pedantic(
+        march, args=(part, L, w), kwargs={"options": MarchOptions(step=H)}, rounds=100, iterations=1
+    )
     assert 0 < res.steps <= 6 * res.grid_cells  # Theorem 2
     nearest = min(abs(part.arc_offset(g.start_arc, s0)) for g in res.segments)
     assert nearest < 0.1
