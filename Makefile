@@ -1,6 +1,7 @@
 # make demo : set up .venv, simulate two rolls on a shipped part with the paper's noise, localize; then roll
 #             reactively on the bracket drawn in CAD, and a 5 mm wheel from inside the kidney's concave waist (plots in out/)
-# make test : set up .venv; lint (ruff), type-check (mypy), run the tests, the doctests and the benchmark smoke run
+# make test : set up .venv; lint (ruff), type-check (mypy), run the tests and the doctests (two processes, a test
+#             file to each at a time) and the benchmark smoke run
 PYTHON ?= python3.11
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -27,7 +28,7 @@ test: $(STAMP)
 	$(VENV)/bin/ruff check $(CODE)
 	$(VENV)/bin/ruff format --check $(CODE)
 	$(VENV)/bin/mypy
-	$(PY) -m pytest -q tests localizer passivity sim2d driver
+	$(PY) -m pytest -q -n 2 --dist loadfile tests localizer passivity sim2d driver
 	$(PY) -m pytest -q bench --benchmark-disable -p no:cacheprovider
 
 bench: $(STAMP)
