@@ -121,6 +121,7 @@ from ._belief import Belief, Mode, belief_flags, find_modes
 from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
+from ._filter_kernels import add_row
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._tracks import tracks_for
 from ._types import ArrayLike, FloatArray, IntArray
@@ -590,16 +591,8 @@ class ContactFilter:
         wt = 1.0 / math.hypot(1.0, rho * self.sd_turn / self.sd_position)
         self._row_weight = wt
         z, p, vals = z * wt, p * wt, vals * wt
-        sel = slice(None) if idx is None else idx
-        if idx is None:
-            self._up[cols] += np.outer(vals, p)
-        else:
-            self._up[np.ix_(cols, idx)] += np.outer(vals, p)
-        self._touched[cols] = True
-        self._spp[sel] += p * p
-        self._szp[sel] += z * p
-        self._uz[cols] += vals * z
-        self._uu[np.ix_(cols, cols)] += np.outer(vals, vals)
+        live = np.arange(self.grid.size) if idx is None else np.asarray(idx, dtype=np.int64)
+        add_row(self._up, self._uu, self._uz, self._spp, self._szp, self._touched, cols, vals, live, p, z)
         self._szz += z * z
 
     def _solved(self, factor: float = 1.0) -> dict[str, Any]:
