@@ -11,6 +11,7 @@ from scipy.optimize import brentq
 from ._boundary import Boundary
 from ._cache import per_part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
+from ._tracks_kernels import step_along
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = ["ModeTracks", "tracks_for", "PIVOT_SPREAD", "PIVOT_KAPPA", "BRIDGE_EXCESS"]
@@ -263,19 +264,27 @@ class ModeTracks:
         ok : ndarray of bool
         """
         idx = np.asarray(index)
-        run = self._run[idx]
-        target = self.theta[idx] + turn + run * self._span
-        first, last = self._first[run], self._last[run]
-        lo_b, hi_b = self._banded[first], self._banded[last]
-        ok = self.convex[idx] & (target >= lo_b - turn_margin) & (target <= hi_b + turn_margin)
-        target = np.clip(target, lo_b, hi_b)
-        j = np.clip(np.searchsorted(self._banded, target, side="left"), first + 1, last)
-        b0, b1 = self._banded[j - 1], self._banded[j]
-        w = (target - b0) / np.where(b1 > b0, b1 - b0, 1.0)
-        arc = self._s[j - 1] + w * (self._s[j] - self._s[j - 1])
+        shape = idx.shape
+        idx = np.ascontiguousarray(idx, dtype=np.int64).ravel()
+        turns = np.ascontiguousarray(turn, dtype=float).ravel()
+        arc, node, ok, j, target = step_along(
+            idx,
+            turns,
+            float(turn_margin),
+            self.theta,
+            self._run,
+            float(self._span),
+            self._first,
+            self._last,
+            self._banded,
+            self.convex,
+            self._s,
+            self._node,
+        )
+        arc, node, ok = arc.reshape(shape), node.reshape(shape), ok.reshape(shape)
+        j, target, idx = j.reshape(shape), target.reshape(shape), idx.reshape(shape)
         # no turn, no move: on a flat face the angle alone does not say where along it the contact is
         still = np.abs(np.asarray(turn)) <= NO_TURN
-        node = np.where(w < 0.5, self._node[j - 1], self._node[j])
         if jaw is not None and at is not None and self.has_faces:
             # flush on a face: the entry at or before the landing on a face of (nearly) that angle
             for e in (j, j - 1):
