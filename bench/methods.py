@@ -402,6 +402,7 @@ def score_methods(
     seq = fixed_readings(rolls, part)
     rules = {} if rules is None else rules
     sds, sd_scale = reading_noise(seq, part, noise), _sd_scale(study)
+    fixed_bound: list = []  # the fixed-roll methods share one path, so one bound
     out = {}
     for m in study.methods:
         try:
@@ -425,7 +426,15 @@ def score_methods(
                 "mass": "",
                 "failure": text[:200],
             }
-        path, segments = r.get("path", (seq["truth"], None))
+        if r["failure"]:
+            bound = math.nan
+        elif "path" in r:  # the method rolled on its own
+            path, segments = r["path"]
+            bound = method_bound(part, path, segments, sds, sd_scale, noise)
+        else:
+            if not fixed_bound:
+                fixed_bound.append(method_bound(part, seq["truth"], None, sds, sd_scale, noise))
+            bound = fixed_bound[0]
         out.update(
             {
                 f"{m}_success": int(r["error_mm"] < study.success_radius),
@@ -437,9 +446,7 @@ def score_methods(
                 f"{m}_mass": r["mass"],
                 f"{m}_failure": r["failure"],
                 f"{m}_bridges": r.get("bridges", ""),
-                f"{m}_bound_mm": method_bound(part, path, segments, sds, sd_scale, noise)
-                if not r["failure"]
-                else math.nan,
+                f"{m}_bound_mm": bound,
             }
         )
     return out

@@ -19,11 +19,11 @@ import math
 import numba
 import numpy as np
 
+from ._part import _TWO_PI
 from ._types import BoolArray, FloatArray
 
 __all__ = ["cell_pass", "hermite_roots", "polish", "TOO_MANY_CELLS"]
 
-_TWO_PI = 2.0 * math.pi
 
 #: ``cell_pass`` status: more than ``max_cells`` cells were processed (a nearly circular stretch).
 TOO_MANY_CELLS = 1

@@ -36,7 +36,6 @@ __all__ = ["QuasiStaticWorld", "tangent_point", "outline_touch", "FLUSH"]
 FLUSH = 1e-6
 #: A contact this close to the jaw's end (mm), four of the outline's sample steps, is at its edge.
 EDGE = 0.02
-_TWO_PI = 2.0 * math.pi
 
 
 class QuasiStaticWorld:
@@ -62,8 +61,8 @@ class QuasiStaticWorld:
         self._spline = None if isinstance(part, MachinedOutline) else part
         if not isinstance(part, MachinedOutline):
             self._t = np.arange(part.n_knots * 32) / 32.0
-            self._xy = part.point(self._t)
-            self._x, self._y = self._xy[:, 0].copy(), self._xy[:, 1].copy()
+            xy = part.point(self._t)
+            self._x, self._y = xy[:, 0].copy(), xy[:, 1].copy()
         self.hand: tuple[float, float, float] | None = (0.0, 0.0, 0.0)
         # the contact is a function of the hand's pose alone; a reading and the truth ask for the same one
         self._last: tuple[tuple[float, float, float] | None, Contact] | None = None
@@ -167,7 +166,7 @@ def tangent_point(part: Part, t0: float, phi: float) -> float:
         tt = t % n
         piece = min(int(tt), n - 1)
         dx, dy, ddx, ddy = (float(v) for v in part.derivatives(piece, tt - piece))
-        f = (math.atan2(dy, dx) - phi + math.pi) % _TWO_PI - math.pi
+        f = (math.atan2(dy, dx) - phi + math.pi) % math.tau - math.pi
         df = (dx * ddy - dy * ddx) / (dx * dx + dy * dy)  # dθ/dt = κ·speed
         if df <= 0:
             return t0
