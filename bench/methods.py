@@ -351,13 +351,14 @@ def rotation_curve(part, history, rotation_deg: float, final: float, budget_deg:
     return curve
 
 
-def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None) -> dict:
-    """The reactive filter from the same start on a rig with the same seed."""
+def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None, change=None) -> dict:
+    """The reactive filter from the same start on a rig with the same seed (in world ``change``: the
+    study's ``[world]``, :class:`sim2d.WorldChange`)."""
     from driver.reactive import localize_reactively
     from sim2d import SimRig
 
     o = study.reactive
-    rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine)
+    rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine, change=change)
     res = localize_reactively(
         rig,
         part,
@@ -378,7 +379,17 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
         "mass": res.belief.mass,
         "bridges": res.bridges,
         "path": (res.true_arcs, res.segments),
+        "mismatch_arc": mismatch_cell(res.belief),
+        "spikes": rig.spikes.count,
     }
+
+
+def mismatch_cell(belief) -> str:
+    """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), empty when none."""
+    arcs = getattr(belief, "mismatch", None)
+    if not arcs:
+        return ""
+    return f"{arcs[0]:.2f}-{arcs[1]:.2f}"
 
 
 def score_methods(
@@ -392,20 +403,28 @@ def score_methods(
     true_arc: float,
     rules: dict | None = None,
     filter_class=None,
+    change=None,
+    fixed_failure: str = "",
 ) -> dict:
     """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
 
-    ``rolls`` are the fixed rolls' :class:`driver.procedures.RollResult`; ``rules`` caches the
-    localizer's results per rule within the trial; ``filter_class`` is the reactive method's filter
-    (default :class:`localizer.ContactFilter`).
+    ``rolls`` are the fixed rolls' :class:`driver.procedures.RollResult` (None where they could not run
+    in the trial's world: ``fixed_failure`` says why, and the fixed-roll methods fail with it); ``rules``
+    caches the localizer's results per rule within the trial; ``filter_class`` is the reactive method's
+    filter (default :class:`localizer.ContactFilter`); ``change`` the trial's world
+    (:class:`sim2d.WorldChange`, None: the model as machined). With the reactive method, the cell
+    ``_spikes`` holds its rig's spiked readings.
     """
-    seq = fixed_readings(rolls, part)
+    seq = fixed_readings(rolls, part) if rolls is not None else None
     rules = {} if rules is None else rules
-    sds, sd_scale = reading_noise(seq, part, noise), _sd_scale(study)
+    sds = reading_noise(seq, part, noise) if seq is not None else (math.nan, math.nan)
+    sd_scale = _sd_scale(study)
     fixed_bound: list = []  # the fixed-roll methods share one path, so one bound
     out = {}
     for m in study.methods:
         try:
+            if seq is None and m != "reactive":
+                raise _MethodError(fixed_failure)
             if m in ("paper", "likelihood"):
                 r = score_paper(study, part, rolls, seq, m, rules)
             elif m == "particle":
@@ -413,7 +432,8 @@ def score_methods(
             elif m == "grid":
                 r = score_grid(study, part, noise, seq)
             else:
-                r = score_reactive(study, part, noise, cal, start, rig_seed, filter_class)
+                r = score_reactive(study, part, noise, cal, start, rig_seed, filter_class, change)
+                out["_spikes"] = r["spikes"]
             r["failure"] = ""
         except Exception as exc:  # noqa: BLE001 - this method failed on this trial; the others still count
             text = str(exc) if isinstance(exc, _MethodError) else f"{type(exc).__name__}: {exc}"
@@ -433,6 +453,7 @@ def score_methods(
             bound = method_bound(part, path, segments, sds, sd_scale, noise)
         else:
             if not fixed_bound:
+                assert seq is not None  # the fixed-roll methods failed above without their rolls
                 fixed_bound.append(method_bound(part, seq["truth"], None, sds, sd_scale, noise))
             bound = fixed_bound[0]
         out.update(
@@ -447,6 +468,7 @@ def score_methods(
                 f"{m}_failure": r["failure"],
                 f"{m}_bridges": r.get("bridges", ""),
                 f"{m}_bound_mm": bound,
+                f"{m}_mismatch_arc": r.get("mismatch_arc", ""),
             }
         )
     return out

@@ -79,9 +79,10 @@ import numpy as np
 from driver.procedures import STEP_RANGE_DEG
 from driver.reactive import CONFIDENCE, MAX_ROTATION
 from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, check_size, load_part
+from sim2d import WorldSpec
 
 from .part_cache import cached_part
-from .trial_draw import draw_trial
+from .trial_draw import draw_trial, draw_world
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -90,7 +91,7 @@ MAX_STUDY_BYTES = 2**20
 #: The most trials one study may run (split a larger one: its table is read whole).
 MAX_TRIALS = 100_000
 
-__all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS"]
+__all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS", "WORLD_COLUMNS"]
 
 #: Columns of trials.csv, in order.
 TRIAL_COLUMNS = (
@@ -131,6 +132,7 @@ _KEYS = {
     "reactive",
     "particle",
     "jaw",
+    "world",
 }
 METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: Per-method columns of trials.csv for a study with ``methods``, after TRIAL_COLUMNS.
@@ -138,7 +140,8 @@ METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: error; ``mass``: the stated probability within the success radius at the end (empty if the method
 #: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met;
 #: ``bound_mm``: the Cramér–Rao bound of the final place from the readings the method took
-#: (:func:`bench.methods.method_bound`; empty for a wheel, or without an encoder step).
+#: (:func:`bench.methods.method_bound`; empty for a wheel, or without an encoder step);
+#: ``mismatch_arc``: where on the model the readings stopped fitting, "A-B" mm (empty when they fit).
 METHOD_COLUMNS = (
     "success",
     "error_mm",
@@ -150,11 +153,15 @@ METHOD_COLUMNS = (
     "failure",
     "bridges",
     "bound_mm",
+    "mismatch_arc",
 )
 #: Columns of a study that names its finger: the finger, how many uniform draws over the boundary were
 #: redrawn before one the finger can start from, the fraction of the boundary it can start from, and
 #: the arc a wheel rolled (mm; empty for the straight jaw).
 FINGER_COLUMNS = ("jaw", "redraws", "reachable", "arc_mm")
+#: Columns of a study with a ``[world]`` table: the defects' centres (model arc, mm) and signed heights
+#: (mm), space-separated, the world's scale, and the wrist's spikes in the localizing rig's readings.
+WORLD_COLUMNS = ("world_defect_arc", "world_defect_height_mm", "world_scale", "world_spikes")
 
 
 @dataclass(frozen=True)
@@ -209,6 +216,8 @@ class Study:
         The ``[reactive]`` and ``[particle]`` tables.
     jaw : str
         The finger (``"straight:100"`` or ``"wheel:R"``) when no sweep names it.
+    world : WorldSpec or None
+        The ``[world]`` table: how each trial's world differs from the model (None: no table).
     """
 
     name: str
@@ -230,6 +239,7 @@ class Study:
     reactive: ReactiveOptions = ReactiveOptions()
     particle: ParticleOptions = ParticleOptions()
     jaw: str = "straight:100"
+    world: WorldSpec | None = None
 
     @property
     def fingers(self) -> bool:
@@ -241,7 +251,8 @@ class Study:
     def columns(self) -> tuple:
         """The columns of this study's trials.csv."""
         extra = tuple(f"{m}_{c}" for m in self.methods for c in METHOD_COLUMNS) if self.methods else ()
-        return TRIAL_COLUMNS + extra + (FINGER_COLUMNS if self.fingers else ())
+        world = WORLD_COLUMNS if self.world is not None else ()
+        return TRIAL_COLUMNS + extra + (FINGER_COLUMNS if self.fingers else ()) + world
 
     def level_jaw(self, level: int) -> str:
         """The finger of ``level`` (a spec, :func:`localizer.parse_jaw`)."""
@@ -420,6 +431,12 @@ def load_study(path) -> Study:
         for p in parts:
             if not isinstance(load_part(p), Part):
                 raise StudyError(f"study {path}: part {p} is a drawing; a wheel rolls on spline parts only")
+    world = None
+    if "world" in data:
+        try:
+            world = WorldSpec.from_table(data["world"], f"study {path}", here, len(parts))
+        except SimError as exc:
+            raise StudyError(str(exc)) from None
     lk = data.get("likelihood", {})
     if not isinstance(lk, dict) or set(lk) - {"sd_length", "sd_turn_deg"}:
         raise StudyError(f"study {path}: [likelihood] takes 'sd_length' and 'sd_turn_deg'")
@@ -443,6 +460,7 @@ def load_study(path) -> Study:
         reactive=reactive,
         particle=particle,
         jaw=jaw,
+        world=world,
     )
 
 
@@ -602,6 +620,23 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
             break
         if run is None:
             raise RigError("no start out of 20 let the rolls run on the simulated rig")
+        # the start was drawn on the model as machined, the same in every world; the world's own part and
+        # wrist (a [world] table) then roll the fixed rolls from there
+        change = draw_world(spec, part_file, part, start)
+        fixed_failure = ""
+        if change is not None and change.differs:
+            rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine, change=change)
+            try:
+                run = roll_sequence(
+                    rig,
+                    rolls,
+                    calibration=cal,
+                    step=math.radians(s.step_deg),
+                    approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0),
+                    faces=part.faces if isinstance(part, Outline) else (),
+                )
+            except RigError as exc:
+                run, fixed_failure = None, f"the fixed rolls on the world's part: {type(exc).__name__}: {exc}"[:200]
     except Exception as exc:  # the trial broke before any method could run: every method's failure
         text = f"{type(exc).__name__}: {exc}"[:200]
         row.update(
@@ -634,6 +669,8 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
                     f"{m}_bridges": "",
                 }
             )
+        if s.world is not None:
+            row.update(world_cells(None))
         row["time_s"] = time.perf_counter() - t0
         return row
     true_arc = rig.truth()["contact_arc"]
@@ -643,12 +680,12 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
             "true_arc": true_arc,
             "restarts": restarts,
             "failure": "",
-            "lengths": " ".join(f"{r.length:.6f}" for r in run),
-            "turns": " ".join(f"{r.turn:.8f}" for r in run),
+            "lengths": " ".join(f"{r.length:.6f}" for r in run) if run is not None else "",
+            "turns": " ".join(f"{r.turn:.8f}" for r in run) if run is not None else "",
         }
     )
     rules: dict = {}
-    own = score_rule(s, part, run, rule, true_arc, rules)
+    own = score_rule(s, part, run, rule, true_arc, rules) if run is not None else _broken(fixed_failure)
     row.update(
         {
             "estimate_arc": own["estimate_arc"],
@@ -663,11 +700,50 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
     if s.methods:
         row.update(
             score_methods(
-                s, part, noise, cal, run, start, rig_seed, true_arc, rules, filter_class=spec.extra.get("filter_class")
+                s,
+                part,
+                noise,
+                cal,
+                run,
+                start,
+                rig_seed,
+                true_arc,
+                rules,
+                filter_class=spec.extra.get("filter_class"),
+                change=change,
+                fixed_failure=fixed_failure,
             )
         )
         first_method = s.methods[0]
         for key in ("success", "error_mm", "estimate_arc"):
             row[key] = row[f"{first_method}_{key}"]
+    spikes = row.pop("_spikes", rig.spikes.count)
+    if s.world is not None:
+        row.update(world_cells(change, spikes))
     row["time_s"] = time.perf_counter() - t0
     return row
+
+
+def world_cells(change, spikes: int | str = "") -> dict:
+    """The :data:`WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
+    if change is None:
+        return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
+    return {
+        "world_defect_arc": " ".join(f"{d.arc:.3f}" for d in change.defects),
+        "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
+        "world_scale": change.scale,
+        "world_spikes": spikes,
+    }
+
+
+def _broken(text: str) -> dict:
+    """The study's own columns of a localizer rule that had no rolls to take."""
+    return {
+        "estimate_arc": math.nan,
+        "error_mm": math.inf,
+        "candidates": 0,
+        "probability": 0.0,
+        "ambiguous": 0,
+        "mass": "",
+        "failure": text,
+    }

@@ -11,7 +11,7 @@ import numpy as np
 
 from .part_cache import cached_part
 
-__all__ = ["TrialDraw", "draw_trial"]
+__all__ = ["TrialDraw", "draw_trial", "draw_world"]
 
 
 class TrialDraw(NamedTuple):
@@ -39,3 +39,15 @@ def draw_trial(spec) -> TrialDraw:
         "part": Path(part_file).name,
     }
     return TrialDraw(rng, part_file, cached_part(part_file), s.level_noise(spec.level), row)
+
+
+def draw_world(spec, part_file: str, part, start: float):
+    """The world of trial ``spec`` (its study's ``[world]`` table, :meth:`sim2d.WorldSpec.draw`) for a
+    rolling that starts at ``start`` mm on ``part``, from a stream of its own
+    (``SeedSequence([seed, level, trial, 2])``): the trial's other draws are the same in every world,
+    so a study with a ``[world]`` table runs the same trials as one without. None without the table."""
+    s = spec.study
+    if s.world is None:
+        return None
+    rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial, 2]))
+    return s.world.draw(part, start, rng, s.parts.index(part_file))

@@ -31,8 +31,9 @@ def run_wheel_trial(spec) -> dict:
     from localizer import Part, WheelJaw, parse_jaw, wheel_reach_for
     from sim2d import WheelRig
 
-    from .methods import _curve, _err, reactive_stop, rotation_curve
-    from .trial_draw import draw_trial
+    from .methods import _curve, _err, mismatch_cell, reactive_stop, rotation_curve
+    from .study import world_cells
+    from .trial_draw import draw_trial, draw_world
 
     s = spec.study
     t0 = time.perf_counter()
@@ -65,12 +66,15 @@ def run_wheel_trial(spec) -> dict:
         }
     )
     cal_seed, rig_seed = int(rng.integers(1 << 31)), int(rng.integers(1 << 31))
+    change = None
     try:
         if not math.isfinite(start):
             raise RuntimeError(f"no start the {wheel} reaches in {MAX_REDRAWS} draws on {part.name}")
         cal_rig = WheelRig(part, wheel, noise=noise, seed=cal_seed, true_radius=true_radius)
         cal = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
-        rig = WheelRig(part, wheel, noise=noise, seed=rig_seed, true_radius=true_radius)
+        # the world (a [world] table) is the localizing rig's; the calibration is another session's
+        change = draw_world(spec, part_file, part, start)
+        rig = WheelRig(part, wheel, noise=noise, seed=rig_seed, true_radius=true_radius, change=change)
         policy = WheelPolicy(confidence=s.reactive.confidence, max_rotation=math.radians(s.reactive.max_rotation_deg))
         run = localize_with_wheel(
             rig, part, wheel, approach_pose=rig.approach_pose(start), calibration=cal, policy=policy
@@ -97,7 +101,9 @@ def run_wheel_trial(spec) -> dict:
                 "reactive_failure": text,
                 "reactive_bridges": "",
                 "reactive_bound_mm": "",
+                "reactive_mismatch_arc": "",
                 "time_s": time.perf_counter() - t0,
+                **(world_cells(change) if s.world is not None else {}),
             }
         )
         return row
@@ -125,7 +131,9 @@ def run_wheel_trial(spec) -> dict:
             "reactive_failure": "",
             "reactive_bridges": run.jumps,
             "reactive_bound_mm": "",  # the bound models the straight jaw's readings
+            "reactive_mismatch_arc": mismatch_cell(run.belief),
             "time_s": time.perf_counter() - t0,
+            **(world_cells(change, rig.spikes.count) if s.world is not None else {}),
         }
     )
     return row

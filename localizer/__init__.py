@@ -13,7 +13,7 @@ from ._limits import MAX_PART_BYTES, check_size
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
 from ._outline_solver import outline_segments
-from ._part import UNITS_TO_MM, Part, part_from_points
+from ._part import UNITS_TO_MM, Part, part_from_points, polygon_crossing
 from ._particle_filter import ParticleFilter
 from ._pieces import CircularArc, CubicBezier, Line, elliptical_arc
 from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
@@ -88,6 +88,7 @@ __all__ = [
     "Part",
     "load_part",
     "part_from_points",
+    "polygon_crossing",
     "UNITS_TO_MM",
     "Segment",
     "feasible_segments",

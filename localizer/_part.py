@@ -21,11 +21,11 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ._boundary import ArcPositions
-from ._errors import PartError
+from ._errors import PartError, QueryError
 from ._poly import bernstein_bounds, horner, poly_der, poly_mul
 from ._types import ArrayLike, FloatArray, IntArray
 
-__all__ = ["Part", "part_from_points", "UNITS_TO_MM"]
+__all__ = ["Part", "part_from_points", "polygon_crossing", "UNITS_TO_MM"]
 
 #: Length units a part file may declare, and their size in millimetres.
 UNITS_TO_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "um": 1e-3}
@@ -426,6 +426,32 @@ def _segments_cross(poly: FloatArray) -> tuple[int, int] | None:
     if hit.size == 0:
         return None
     return int(order[ii[hit[0]]]), int(order[jj[hit[0]]])
+
+
+def polygon_crossing(points: ArrayLike) -> tuple[int, int] | None:
+    """The first pair of non-adjacent edges of a closed polyline that cross, or None when it is simple.
+
+    Parameters
+    ----------
+    points : array_like, shape (n + 1, 2), mm
+        The polyline, its last point equal to its first.
+
+    Returns
+    -------
+    (i, j) or None
+        Edge i runs from point i to point i + 1.
+
+    Examples
+    --------
+    >>> polygon_crossing([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]) is None
+    True
+    >>> sorted(polygon_crossing([[0, 0], [1, 1], [1, 0], [0, 1], [0, 0]]))
+    [0, 2]
+    """
+    poly = np.asarray(points, dtype=float)
+    if poly.ndim != 2 or poly.shape[1] != 2 or poly.shape[0] < 4:
+        raise QueryError(f"points of shape {poly.shape}: give a closed polyline of at least 3 edges, shape (n + 1, 2)")
+    return _segments_cross(poly)
 
 
 def part_from_points(points: ArrayLike, *, name: str = "part", units: str = "mm", source: str | None = None) -> Part:

@@ -4,9 +4,11 @@ from ._errors import SimError
 from .machining import machined_part, machining_slope
 from .noise import PRESETS, NoiseModel, load_noise
 from .rig import SimRig
+from .sampled import SampledPart
 from .wheel_rig import WheelRig
 from .wheel_world import WheelContact, WheelWorld
 from .world import Contact, World
+from .world_part import Defect, WorldChange, WorldSpec, load_world, world_part
 from .wrist import Wrist, encoder_angle
 
 __all__ = [
@@ -24,4 +26,10 @@ __all__ = [
     "machining_slope",
     "World",
     "Contact",
+    "SampledPart",
+    "Defect",
+    "WorldChange",
+    "WorldSpec",
+    "load_world",
+    "world_part",
 ]

@@ -3,19 +3,15 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from localizer import Outline, Part, part_from_points
 
 from .noise import NoiseModel
+from .sampled import SAMPLE_SPACING, SampledPart, model_sample
 
-__all__ = ["machined_part", "machined_outline", "MachinedOutline", "machining_slope"]
-
-#: Arc between the points of a machined outline, mm: the kinematic world takes the deepest of them as
-#: the contact, so this bounds the contact's place error (a quarter of a µm of depth on a 10 mm radius).
-OUTLINE_SPACING = 0.005
+__all__ = ["machined_part", "machined_outline", "machining_deviation", "machining_slope"]
 
 
 def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Part:
@@ -30,12 +26,12 @@ def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Pa
     if noise.machining_error <= 0:
         return part
     knots = np.arange(part.n_knots, dtype=float)
-    dev = _deviation(part.arc_at_param(knots), part.perimeter, noise, rng)
+    dev = machining_deviation(part.arc_at_param(knots), part.perimeter, noise, rng)
     pts = part.points + dev[:, None] * part.normal(knots)
     return part_from_points(pts, name=f"{part.name} (machined)")
 
 
-def _deviation(sigma: np.ndarray, perimeter: float, noise: NoiseModel, rng: np.random.Generator) -> np.ndarray:
+def machining_deviation(sigma: np.ndarray, perimeter: float, noise: NoiseModel, rng: np.random.Generator) -> np.ndarray:
     """The random normal deviation, mm, at arc positions ``sigma``: harmonics of the perimeter with 1/k
     amplitudes down to ``noise.machining_wavelength``, scaled to an RMS of ``noise.machining_error``."""
     kmax = max(1, int(perimeter / noise.machining_wavelength))
@@ -46,45 +42,15 @@ def _deviation(sigma: np.ndarray, perimeter: float, noise: NoiseModel, rng: np.r
     return scaled
 
 
-@dataclass(frozen=True, eq=False)
-class MachinedOutline:
-    """An outline as machined: dense points of the real boundary, each the model's point at arc ``arcs``
-    moved along the model's outward normal (after the jump at a corner).
-
-    Attributes
-    ----------
-    model : Outline
-    arcs : ndarray, shape (n,), mm
-        The model's arc position of each point (every corner's included).
-    xy : ndarray, shape (n, 2), mm
-    """
-
-    model: Outline
-    arcs: np.ndarray
-    xy: np.ndarray
-
-    @property
-    def name(self) -> str:
-        return f"{self.model.name} (machined)"
-
-    @property
-    def perimeter(self) -> float:
-        return self.model.perimeter
-
-
 def machined_outline(
-    outline: Outline, noise: NoiseModel, rng: np.random.Generator, spacing: float = OUTLINE_SPACING
-) -> MachinedOutline:
+    outline: Outline, noise: NoiseModel, rng: np.random.Generator, spacing: float = SAMPLE_SPACING
+) -> SampledPart:
     """The ``outline`` as machined under the ``noise`` model (the same deviation as :func:`machined_part`:
     harmonics of the arc position, drawn from ``rng``), sampled every ``spacing`` mm with its corners."""
-    P = outline.perimeter
-    arcs = np.unique(np.concatenate([np.arange(0.0, P, spacing), [c.arc for c in outline.corners]]))
-    xy = np.asarray(outline.point_at_arc(arcs), dtype=float)
+    arcs, xy, normal = model_sample(outline, spacing)
     if noise.machining_error > 0:
-        theta = np.asarray(outline.tangent_angle_at_arc(arcs))
-        normal = np.stack([np.sin(theta), -np.cos(theta)], axis=-1)
-        xy = xy + _deviation(arcs, P, noise, rng)[:, None] * normal
-    return MachinedOutline(outline, arcs, xy)
+        xy = xy + machining_deviation(arcs, outline.perimeter, noise, rng)[:, None] * normal
+    return SampledPart(outline, arcs, xy)
 
 
 def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:

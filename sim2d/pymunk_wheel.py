@@ -35,7 +35,7 @@ class PymunkWheelWorld:
 
     Parameters
     ----------
-    part : Part or MachinedOutline
+    part : Part or SampledPart
         The real part.
     model : Part or Outline
         The model whose arc positions the contacts report.

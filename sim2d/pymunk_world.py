@@ -23,11 +23,11 @@ import math
 import numpy as np
 import pymunk
 
-from localizer import Line, Part
+from localizer import Line, Outline, Part
 
 from ._errors import SimError
-from .machining import MachinedOutline
 from .quasistatic import outline_touch, tangent_point
+from .sampled import SampledPart, polygon_vertices
 from .world import Contact
 
 __all__ = ["PymunkWorld", "polygonise", "static_chain", "drive_hand"]
@@ -35,7 +35,7 @@ __all__ = ["PymunkWorld", "polygonise", "static_chain", "drive_hand"]
 _MN_PER_N = 1000.0
 
 
-def polygonise(part: Part | MachinedOutline, chord_tolerance: float) -> np.ndarray:
+def polygonise(part: Part | SampledPart, chord_tolerance: float) -> np.ndarray:
     """Points on the spline whose chords stay within ``chord_tolerance`` mm of it (closed, first = last).
 
     Each piece gets n chords with the sagitta bound κ_max·h²/8 <= tolerance,
@@ -44,12 +44,14 @@ def polygonise(part: Part | MachinedOutline, chord_tolerance: float) -> np.ndarr
     return _polygon(part, chord_tolerance)[0]
 
 
-def _polygon(part: Part | MachinedOutline, chord_tolerance: float):
+def _polygon(part: Part | SampledPart, chord_tolerance: float):
     """(points, parameters) of :func:`polygonise`."""
     if not chord_tolerance > 0:
         raise SimError(f"chord_tolerance={chord_tolerance!r} mm must be positive")
-    if isinstance(part, MachinedOutline):
-        return _outline_polygon(part, chord_tolerance)
+    if isinstance(part, SampledPart):
+        if isinstance(part.model, Outline) and not part.altered:
+            return _outline_polygon(part, chord_tolerance)
+        return _sample_polygon(part, chord_tolerance)
     ts = []
     for i in range(part.n_knots):
         u = i + np.linspace(0.0, 1.0, 33)
@@ -64,12 +66,13 @@ def _polygon(part: Part | MachinedOutline, chord_tolerance: float):
     return np.vstack([pts, pts[:1]]), t
 
 
-def _outline_polygon(machined: MachinedOutline, chord_tolerance: float):
+def _outline_polygon(machined: SampledPart, chord_tolerance: float):
     """(points, arcs) of the machined outline's polygon: its sample points at the model's piece ends
     (so every corner), one chord per line, curves at the spacing whose sagitta κ_max·h²/8 on the model
     meets the tolerance. The machined deviation between vertices is left to the contact's refinement
     on the dense sample (:func:`sim2d.quasistatic.outline_touch`)."""
     model = machined.model
+    assert isinstance(model, Outline)
     arcs = []
     for start, piece in zip(model.starts[:-1], model.pieces):
         if isinstance(piece, Line):
@@ -85,6 +88,16 @@ def _outline_polygon(machined: MachinedOutline, chord_tolerance: float):
     j = np.unique(j)
     pts = machined.xy[j]
     return np.vstack([pts, pts[:1]]), machined.arcs[j]
+
+
+def _sample_polygon(sampled: SampledPart, chord_tolerance: float):
+    """(points, arcs) of a polygon through a sampled part's points within ``chord_tolerance`` of it
+    (:func:`sim2d.sampled.polygon_vertices`), every corner of the model a vertex."""
+    corners = [c.arc for c in sampled.model.corners]
+    keep = np.searchsorted(sampled.arcs, corners) % sampled.arcs.size if corners else None
+    j = polygon_vertices(sampled.xy, chord_tolerance, keep)
+    pts = sampled.xy[j]
+    return np.vstack([pts, pts[:1]]), sampled.arcs[j]
 
 
 def static_chain(space: pymunk.Space, pts: np.ndarray, friction: float) -> None:
@@ -141,7 +154,7 @@ class PymunkWorld:
 
     Parameters
     ----------
-    part : Part or MachinedOutline
+    part : Part or SampledPart
         The real part: a spline, or an outline from CAD as machined. On an outline the contact's
         ``param`` is the model's arc position (mm), as in :class:`QuasiStaticWorld`.
     stiffness : float, N/mm
@@ -164,7 +177,7 @@ class PymunkWorld:
 
     def __init__(
         self,
-        part: Part | MachinedOutline,
+        part: Part | SampledPart,
         *,
         stiffness: float = 1.0,
         half_span: float = 50.0,
@@ -261,7 +274,7 @@ class PymunkWorld:
         if total <= 0 or not points:
             return Contact(0.0, 0.0, float("nan"), 0.0, False)
         depth = float(-((np.array(jb.position) - (hx, hy)) @ m))
-        if isinstance(self.part, MachinedOutline):
+        if isinstance(self.part, SampledPart):
             # the jaw where the solver settled it against the polygon, laid on the dense machined
             # sample: a corner stays the contact while the jaw pivots, a face flush under the jaw
             # gives its middle (the quasi-static world's rule). At the hand's angle: the gear joint's

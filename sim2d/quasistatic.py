@@ -8,7 +8,7 @@ wrist gives along m by the depth of the deepest point and the contact force is
 in the direction -m: a straight edge touches the part's convex hull, so across
 a concavity the contact jumps from one side to the other and the jaw bridges.
 
-On an outline from CAD (:class:`sim2d.machining.MachinedOutline`) the same holds point by point
+On an outline from CAD (:class:`sim2d.sampled.SampledPart`) the same holds point by point
 over its dense sample: at a convex corner the corner stays the deepest point while the jaw turns
 through the jump (a pivot). Lying flush on a face the rigid jaw touches a line: the load is
 taken as shared evenly by the points within :data:`FLUSH` of the deepest, so the wrist reads their
@@ -25,7 +25,7 @@ import numpy as np
 from localizer import Part
 
 from ._errors import SimError
-from .machining import MachinedOutline
+from .sampled import SampledPart
 from .world import Contact
 
 __all__ = ["QuasiStaticWorld", "tangent_point", "outline_touch", "FLUSH"]
@@ -43,7 +43,7 @@ class QuasiStaticWorld:
 
     Parameters
     ----------
-    part : Part or MachinedOutline
+    part : Part or SampledPart
         The real part (machined, if so). On a spline the contact's ``param`` is the spline
         parameter; on an outline it is the model's arc position (mm).
     stiffness : float, N/mm
@@ -52,14 +52,14 @@ class QuasiStaticWorld:
         Half the jaw's length (paper: 50).
     """
 
-    def __init__(self, part: Part | MachinedOutline, *, stiffness: float = 1.0, half_span: float = 50.0):
+    def __init__(self, part: Part | SampledPart, *, stiffness: float = 1.0, half_span: float = 50.0):
         if not (stiffness > 0 and half_span > 0):
             raise SimError(f"stiffness={stiffness!r} N/mm and half_span={half_span!r} mm must be positive")
         self.part = part
         self.stiffness = float(stiffness)
         self.half_span = float(half_span)
-        self._spline = None if isinstance(part, MachinedOutline) else part
-        if not isinstance(part, MachinedOutline):
+        self._spline = None if isinstance(part, SampledPart) else part
+        if not isinstance(part, SampledPart):
             self._t = np.arange(part.n_knots * 32) / 32.0
             xy = part.point(self._t)
             self._x, self._y = xy[:, 0].copy(), xy[:, 1].copy()
@@ -83,7 +83,7 @@ class QuasiStaticWorld:
         x, y, phi = self.hand or (0.0, 0.0, 0.0)
         spline = self._spline
         if spline is None:
-            assert isinstance(self.part, MachinedOutline)
+            assert isinstance(self.part, SampledPart)
             under, du_o, arc, dd_o, edge = outline_touch(self.part, (x, y), phi, self.half_span)
             if not under:
                 return Contact(0.0, 0.0, float("nan"), 0.0, False)
@@ -110,13 +110,13 @@ class QuasiStaticWorld:
 
 
 def outline_touch(
-    outline: MachinedOutline, origin: tuple[float, float], phi: float, half_span: float
+    outline: SampledPart, origin: tuple[float, float], phi: float, half_span: float
 ) -> tuple[bool, float, float, float, bool]:
     """Where a straight edge touches a sampled outline: the deepest point, or the middle of a flush line.
 
     Parameters
     ----------
-    outline : MachinedOutline
+    outline : SampledPart
     origin : (float, float), mm
         The point of the edge's line from which places along it are measured (the jaw's centre).
     phi : float, rad

@@ -15,10 +15,11 @@ from localizer import Outline, Part
 
 from ._errors import SimError
 from .arm import SimulatedArm
-from .machining import MachinedOutline, machined_outline, machined_part
 from .noise import NoiseModel, load_noise
 from .quasistatic import QuasiStaticWorld
+from .sampled import SampledPart
 from .world import World
+from .world_part import Spikes, WorldChange, world_part
 from .wrist import Wrist
 
 __all__ = ["SimRig"]
@@ -53,6 +54,10 @@ class SimRig(SimulatedArm):
         Time between two raw sensor samples.
     world_options : dict, optional
         Further arguments of the world (e.g. ``chord_tolerance``, ``friction``).
+    change : WorldChange, optional
+        How the real part and the wrist differ from the model beyond machining and noise (a burr, a
+        dent, a scale, a part of its own, spikes: :mod:`sim2d.world_part`). The machining and the
+        noise draw the same values with it as without.
     """
 
     def __init__(
@@ -68,18 +73,17 @@ class SimRig(SimulatedArm):
         angular_speed: float = math.radians(30.0),
         sample_period: float = 1e-3,
         world_options: dict | None = None,
+        change: WorldChange | None = None,
     ):
         if engine not in ENGINES:
             raise SimError(f"unknown engine {engine!r}; use one of {list(ENGINES)}")
         self.model = part
         self.noise: NoiseModel = load_noise(noise)
         self.rng = np.random.default_rng(seed)
-        self.part: Part | MachinedOutline
+        self.change = WorldChange() if change is None else change
+        self.part: Part | SampledPart = world_part(part, self.change, self.noise, self.rng)
         self.world: World
-        if isinstance(part, Outline):
-            self.part = machined_outline(part, self.noise, self.rng)
-        else:
-            self.part = machined_part(part, self.noise, self.rng)
+        self.spikes = Spikes(self.change, self.noise.v2_noise, seed)
         if engine == "pymunk":
             from .pymunk_world import PymunkWorld
 
@@ -107,7 +111,8 @@ class SimRig(SimulatedArm):
         times = self.time + self.sample_period * np.arange(1, n + 1)
         v1, v2 = self.wrist.voltages(np.full(n, c.force), np.full(n, c.jaw_position), times, self.noise, self.rng)
         self.time = float(times[-1])
-        out = (float(np.mean(v1)), float(np.mean(v2)))
+        spike = self.spikes()  # on the twist channel: the contact's place
+        out = (float(np.mean(v1)), float(np.mean(v2)) + spike)
         x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
         self.samples.append(
             {
@@ -122,6 +127,7 @@ class SimRig(SimulatedArm):
                 "jaw_position": c.jaw_position,
                 "contact_arc": self._contact_arc(c),
                 "at_edge": c.at_edge,
+                "spike": spike,
             }
         )
         return out
@@ -217,7 +223,12 @@ class SimRig(SimulatedArm):
         reading and the truth after it ask for the same contact."""
         if self._last_arc is not None and self._last_arc[0] is c:
             return self._last_arc[1]
-        arc = float(self.model.wrap_arc(self.model.arc_at_param(c.param))) if c.force > 0 else float("nan")
+        if c.force <= 0:
+            arc = float("nan")
+        elif isinstance(self.part, SampledPart):  # the contact names the model's arc already
+            arc = float(self.model.wrap_arc(c.param))
+        else:
+            arc = float(self.model.wrap_arc(self.model.arc_at_param(c.param)))
         self._last_arc = (c, arc)
         return arc
 

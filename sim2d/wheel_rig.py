@@ -19,9 +19,9 @@ from localizer import Outline, Part, WheelJaw
 
 from ._errors import SimError
 from .arm import SimulatedArm
-from .machining import machined_outline, machined_part
 from .noise import NoiseModel, load_noise
 from .wheel_world import WheelWorld
+from .world_part import Spikes, WorldChange, world_part
 from .wrist import Wrist
 
 if TYPE_CHECKING:
@@ -58,6 +58,9 @@ class WheelRig(SimulatedArm):
         :class:`sim2d.pymunk_wheel.PymunkWheelWorld` (a disc rolling by friction on a bearing).
     linear_speed, angular_speed : float, mm/s and rad/s
     sample_period : float, s
+    change : WorldChange, optional
+        How the real part and the wrist differ from the model beyond machining and noise
+        (:mod:`sim2d.world_part`); the spikes fall on the channel across the hand (v2).
     """
 
     def __init__(
@@ -76,6 +79,7 @@ class WheelRig(SimulatedArm):
         linear_speed: float = 20.0,
         angular_speed: float = math.radians(30.0),
         sample_period: float = 1e-3,
+        change: WorldChange | None = None,
     ):
         if not isinstance(wheel, WheelJaw):
             raise SimError(f"a WheelRig needs a WheelJaw, not {wheel!r}")
@@ -83,11 +87,9 @@ class WheelRig(SimulatedArm):
         self.wheel = wheel
         self.noise: NoiseModel = load_noise(noise)
         self.rng = np.random.default_rng(seed)
-        real = (
-            machined_outline(part, self.noise, self.rng)
-            if isinstance(part, Outline)
-            else machined_part(part, self.noise, self.rng)
-        )
+        self.change = WorldChange() if change is None else change
+        real = world_part(part, self.change, self.noise, self.rng)
+        self.spikes = Spikes(self.change, self.noise.v2_noise, seed)
         radius = wheel.radius if true_radius is None else float(true_radius)
         self.world: WheelWorld | PymunkWheelWorld
         if engine == "pymunk":
@@ -135,8 +137,9 @@ class WheelRig(SimulatedArm):
         if nz.adc_step:
             v1, v2 = np.round(v1 / nz.adc_step) * nz.adc_step, np.round(v2 / nz.adc_step) * nz.adc_step
         self.time = float(times[-1])
-        out = (float(np.mean(v1)), float(np.mean(v2)))
-        self.samples.append({"time": self.time, "v1": out[0], "v2": out[1], **self.truth()})
+        spike = self.spikes()
+        out = (float(np.mean(v1)), float(np.mean(v2)) + spike)
+        self.samples.append({"time": self.time, "v1": out[0], "v2": out[1], "spike": spike, **self.truth()})
         return out
 
     def truth(self) -> dict:

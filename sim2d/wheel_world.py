@@ -30,7 +30,7 @@ from scipy.spatial import cKDTree
 from localizer import Part
 
 from ._errors import SimError
-from .machining import MachinedOutline
+from .sampled import SampledPart
 
 __all__ = ["WheelWorld", "WheelContact", "SAMPLE_STEP", "JUMP_EXCESS"]
 
@@ -69,7 +69,7 @@ class WheelWorld:
 
     Parameters
     ----------
-    part : Part or MachinedOutline
+    part : Part or SampledPart
         The real part (machined, if so).
     model : Part or Outline
         The model whose arc positions the contacts report.
@@ -90,7 +90,7 @@ class WheelWorld:
         self.radius, self.stiffness, self.slip = float(radius), float(stiffness), float(slip)
         self.perimeter = float(model.perimeter)
         self._spline: Part | None = None
-        if isinstance(part, MachinedOutline):
+        if isinstance(part, SampledPart):
             self._xy, self._arc = np.asarray(part.xy, dtype=float), np.asarray(part.arcs, dtype=float)
         elif isinstance(part, Part):
             n = max(256, int(math.ceil(part.perimeter / SAMPLE_STEP)))
@@ -100,7 +100,7 @@ class WheelWorld:
             self._arc = np.asarray(model.wrap_arc(model.arc_at_param(self._t)), dtype=float)
             self._spline, self._model = part, model
         else:
-            raise SimError(f"a wheel world needs a Part or a MachinedOutline, not {type(part).__name__}")
+            raise SimError(f"a wheel world needs a Part or a SampledPart, not {type(part).__name__}")
         self._tree = cKDTree(self._xy)
         self.hand: tuple[float, float, float] | None = None
         # (arc, contact, disc centre, depth) of the disc as set_hand seated it: contact() reads it

@@ -1,0 +1,105 @@
+"""The real part as a dense sample: each point of its boundary tagged with the model's arc position it
+stands for.
+
+A machined spline keeps the model's knots (:func:`sim2d.machining.machined_part`), so a contact's spline
+parameter names the model's arc. A drawing as machined, a part with a burr or a dent, a part scaled
+against its model or a scanned part of its own are not splines of the model's knots: the worlds take
+them as this dense sample, and a contact on it reports the tagged model arc
+(:func:`sim2d.quasistatic.outline_touch`, :class:`sim2d.wheel_world.WheelWorld`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from localizer import Outline, Part
+
+__all__ = ["SampledPart", "SAMPLE_SPACING", "model_sample", "polygon_vertices"]
+
+#: Arc between the points of a sampled part, mm: the kinematic world takes the deepest of them as the
+#: contact, so this bounds the contact's place error (a quarter of a µm of depth on a 10 mm radius).
+SAMPLE_SPACING = 0.005
+
+
+@dataclass(frozen=True, eq=False)
+class SampledPart:
+    """The real boundary as dense points, each with the model's arc position it stands for.
+
+    Attributes
+    ----------
+    model : Part or Outline
+        The part's model: what the localizer is given, and whose arc positions the truth reports.
+    arcs : ndarray, shape (n,), mm
+        The model's arc position of each point, increasing, in [0, perimeter) (every corner's included).
+    xy : ndarray, shape (n, 2), mm
+        The real boundary's points, counter-clockwise.
+    label : str
+        How it differs from the model, for its name ("machined", "a 0.3 mm bump ...").
+    altered : bool
+        Whether it differs from the model by more than its machining (a defect, a scale, a part of its
+        own): a polygon of it must then follow the sample, not the model's pieces.
+    """
+
+    model: Part | Outline
+    arcs: np.ndarray
+    xy: np.ndarray
+    label: str = "machined"
+    altered: bool = False
+
+    @property
+    def name(self) -> str:
+        return f"{self.model.name} ({self.label})"
+
+    @property
+    def perimeter(self) -> float:
+        """The model's perimeter, mm: the arcs' period."""
+        return float(self.model.perimeter)
+
+
+def model_sample(model: Part | Outline, spacing: float = SAMPLE_SPACING) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(arcs mm, points mm, outward unit normals) of the ``model`` every ``spacing`` mm of arc, with every
+    corner's arc among them (the normal there is the one after the corner)."""
+    P = float(model.perimeter)
+    arcs = np.unique(np.concatenate([np.arange(0.0, P, spacing), [c.arc for c in model.corners]]))
+    xy = np.asarray(model.point_at_arc(arcs), dtype=float)
+    theta = np.asarray(model.tangent_angle_at_arc(arcs), dtype=float)
+    return arcs, xy, np.stack([np.sin(theta), -np.cos(theta)], axis=-1)
+
+
+def polygon_vertices(xy: np.ndarray, tolerance: float, keep: np.ndarray | None = None) -> np.ndarray:
+    """Indices of a closed sample's points whose polygon stays within about ``tolerance`` mm of it.
+
+    The chord h allowed where the sample turns at curvature κ is √(8·tolerance/κ) (its sagitta κh²/8);
+    κ is taken as the largest turning per length within a millimetre, so that a short sharp turn (a
+    burr's crest) is not skipped by a long chord. ``keep``
+    (indices) are vertices in any case (an outline's corners).
+
+    Parameters
+    ----------
+    xy : ndarray, shape (n, 2), mm
+        The points, in order, the last joined to the first.
+    tolerance : float, mm
+    keep : ndarray of int, optional
+    """
+    from scipy.ndimage import maximum_filter1d
+
+    n = xy.shape[0]
+    step = np.diff(np.vstack([xy, xy[:1]]), axis=0)
+    length = np.hypot(step[:, 0], step[:, 1])
+    heading = np.arctan2(step[:, 1], step[:, 0])
+    turn = np.abs((heading - np.roll(heading, 1) + math.pi) % (2 * math.pi) - math.pi)  # at each point
+    local = 0.5 * (length + np.roll(length, 1))
+    kappa = turn / np.maximum(local, 1e-12)
+    # over ±1 mm: longer than the chord of any curved stretch at this tolerance (0.9 mm at a radius of a
+    # metre), so that a chord about to span a sharp spot is shortened before it
+    window = int(min(2 * math.ceil(1.0 / float(np.mean(length))) + 1, n // 4 * 2 + 1))
+    kappa = maximum_filter1d(kappa, size=max(window, 1), mode="wrap")
+    density = np.sqrt(kappa / (8.0 * tolerance))  # chords per mm
+    count = np.cumsum(density * length)
+    picks = np.flatnonzero(np.diff(np.floor(count), prepend=-1.0) > 0)
+    extra = [np.array([0])] if keep is None else [np.array([0]), np.asarray(keep, dtype=np.int64)]
+    out: np.ndarray = np.unique(np.concatenate([picks, *extra]))
+    return out
