@@ -327,10 +327,11 @@ def reactive_policy(study):
 
 
 def reactive_stop(run) -> str:
-    """A reactive run's stop as trials.csv says it: confident, ambiguous (the belief ended with two or
-    more strong modes) or budget (not sure otherwise: the rotation budget, or blocked both ways)."""
-    if run.stopped == "confident":
-        return "confident"
+    """A reactive run's stop as trials.csv says it: confident, mismatch (the readings did not fit the part),
+    ambiguous (the belief ended with two or more strong modes) or budget (not sure otherwise: the
+    rotation budget, or blocked both ways)."""
+    if run.stopped in ("confident", "mismatch"):
+        return run.stopped
     return "ambiguous" if run.belief.ambiguous else "budget"
 
 

@@ -128,22 +128,26 @@ def record_trial(study_path, level: int, trial: int) -> Recorded:
 
 def replay(rec: Recorded, **changes) -> VariantResult:
     """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied."""
-    settings = {**rec.settings, **changes, "prune": math.inf}
+    settings = {**rec.settings, **changes}
     flt = ContactFilter(rec.part, **settings)
+    # the margin from a filter that prunes nothing (the belief from one as run: what a stretch left out,
+    # or a fit test, says depends on which starts are still weighed)
+    full = ContactFilter(rec.part, **{**settings, "prune": math.inf})
     for name, args, kwargs in rec.calls:
         getattr(flt, name)(*args, **kwargs)
+        getattr(full, name)(*args, **kwargs)
     belief = flt.belief()
     part = rec.part
     off = np.abs(np.asarray(part.arc_offset(flt.grid, rec.start_arc)))
-    ll = flt.log_likelihood() / flt.temper
+    ll = full.log_likelihood() / full.temper
     near, far = ll[off < NEAR], ll[off >= NEAR]
     best_near = float(near.max()) if near.size else -math.inf
     best_far = float(far.max()) if far.size else -math.inf
     margin = best_near - best_far if np.isfinite(best_far) else math.inf
     i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
-    error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(flt.current[i])))))
+    error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(full.current[i])))))
     return VariantResult(
-        settings=dict(changes), mass=belief.mass, error_mm=error, margin=margin, noise_scale=flt.noise_scale()
+        settings=dict(changes), mass=belief.mass, error_mm=error, margin=margin, noise_scale=full.noise_scale()
     )
 
 

@@ -81,8 +81,9 @@ class ReactiveRun:
     steps : int
         Rolling steps that updated the filter.
     stopped : str
-        "confident", "max_rotation", "blocked" (concavities both ways) or "lost" (the contact
-        could not be read back after a bridge).
+        "confident", "max_rotation", "blocked" (concavities both ways), "lost" (the contact
+        could not be read back after a bridge) or "mismatch" (the readings do not fit the part: a
+        burr, a dent, debris, a part that is not its model; ``belief.mismatch`` says where).
     reversals : int
         Direction changes (a concavity ahead or bridged, or the direction rule).
     regrasps : int
@@ -346,6 +347,8 @@ class _Roller:
         if belief is None or belief.steps != flt.steps:
             belief = flt.belief()
             self.history.append((self.rotation, belief.map_arc, belief.mass, self.true_arc()))
+        if belief.mismatch is not None or not belief.consistent:
+            stopped = "mismatch"
         return ReactiveRun(
             belief=belief,
             rotation=self.rotation,
@@ -408,7 +411,7 @@ class _Roller:
         under which the turn leaves their convex stretch (a bridge). A part with neither has none.
         """
         tracks = self.flt.tracks
-        if not (tracks.has_faces or tracks.bridges):
+        if not (tracks.has_faces or tracks.bridges) or self.flt.ruled_out:
             return False
         arc = self.direction * arc_from_jaw_positions([self.d_prev, d], s, self.offset)
         posterior = self.flt.posterior()
@@ -491,7 +494,9 @@ class _Roller:
                     "direction": self.direction,
                 }
             )
-        self.sure = self.sure + 1 if belief.mass >= p.confidence else 0
+        if belief.mismatch is not None or not belief.consistent:
+            return "mismatch"  # the readings do not fit the part: never sure, say where
+        self.sure = self.sure + 1 if belief.sure(p.confidence) else 0
         if self.sure >= p.confirm:
             return "confident"
         direction = self.direction

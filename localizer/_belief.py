@@ -54,6 +54,10 @@ class Belief:
     consistent : bool
         False when no hypothesis fits the readings even under a generous error model (the wheel's
         filter: a contact that jammed, a model that is not the part); ``mass`` is then 0.
+    mismatch : (float, float) or None
+        Where on the model (arc positions, mm, counter-clockwise from the first to the second) the
+        readings stopped fitting the part under the most probable start: a burr, a dent, debris, a
+        part that is not its model. None while they fit. A belief with a mismatch is never sure.
     """
 
     map_arc: float
@@ -64,6 +68,12 @@ class Belief:
     informative: bool
     steps: int
     consistent: bool = True
+    mismatch: tuple[float, float] | None = None
+
+    def sure(self, confidence: float) -> bool:
+        """Whether the belief may be acted on at ``confidence``: its mass reaches it, something fits, and
+        no stretch of the readings contradicts the model."""
+        return self.mass >= confidence and self.consistent and self.mismatch is None
 
 
 def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray, radius: float) -> list[Mode]:

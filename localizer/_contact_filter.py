@@ -112,14 +112,15 @@ whether the data said anything at all (on a circle every start predicts the same
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from scipy.special import ndtr
+from scipy.stats import f as f_dist
 
 from ._belief import Belief, Mode, belief_flags, find_modes
 from ._boundary import Boundary
-from ._defaults import SUCCESS_RADIUS
+from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._filter_kernels import add_row
 from ._reach import DEFAULT_JAW, StraightJaw
@@ -135,6 +136,8 @@ __all__ = [
     "BRIDGE_MISS",
     "ENCODER_SD",
     "TURN_MARGIN",
+    "DEFECT_WINDOW",
+    "Misfit",
 ]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
@@ -168,6 +171,80 @@ SLOPE_RHO_MAX = 1000.0
 #: at that end: the machined part's slope differs from the model's by 0.6 mrad RMS at the `paper`
 #: preset, peaks of 10 mrad at five times that.
 TURN_MARGIN = 0.02
+#: The rolled arc, mm, of a stretch of readings the belief must not rest on alone (module notes, "A part
+#: that is not its model"): a burr or dent of up to 8 mm and the readings at its edges.
+DEFECT_WINDOW = 12.0
+#: Readings a fit test needs outside the stretch it judges (fewer cannot tell misfit from noise).
+FIT_MIN_READINGS = 20
+#: Readings between two fit tests while the belief is not sure (a test before every sure stop too).
+FIT_EVERY = 25
+#: How many times the rest's misfit per reading (against its expectation) a stretch's must be to count
+#: as not fitting: on clean machined parts at the `paper` preset the worst stretch of 60 tuning trials
+#: was 4.8 times off (a glyph's nearly straight stroke), the next 2.6.
+FIT_RATIO = 6.0
+#: The most probable starts a fit test judges the readings under (besides each strong mode's best): a
+#: misfit is the part's only if none of them fits.
+FIT_STARTS = 8
+
+
+def _quad(s: dict[str, Any], t2: float) -> FloatArray:
+    """Each hypothesis' quadratic form of a :meth:`ContactFilter._solve` (the readings' misfit in units of
+    the told reading variance, every nuisance and the calibration's scale, of prior variance ``t2``,
+    weighed out)."""
+    qpp, qpz = s["qpp"], s["qpz"]
+    qpr = qpz - qpp
+    out: FloatArray = s["qzz"] - 2 * qpz + qpp - t2 * qpr**2 / (1 + t2 * qpp)
+    return out
+
+
+class Misfit(NamedTuple):
+    """Where the readings stopped fitting the part (:meth:`ContactFilter.fit_test`).
+
+    Attributes
+    ----------
+    arcs : (float, float), mm
+        The stretch on the model, from the first to the last arc position (counter-clockwise), of the
+        contact under the most probable start over the readings that do not fit.
+    travel : (float, float), mm
+        The same stretch in the rolled arc the readings were given with.
+    p_value : float
+        How likely a misfit this large is from readings that do fit (before the correction for the
+        number of stretches tried).
+    start : float, mm
+        The start of the rolling under which it was judged.
+    """
+
+    arcs: tuple[float, float]
+    travel: tuple[float, float]
+    p_value: float
+    start: float
+
+
+class _Sums(NamedTuple):
+    """Sums of some readings: UᵀU, Uᵀz, zᵀz, and Uᵀp, pᵀp, zᵀp over the hypotheses live now; how many."""
+
+    uu: FloatArray
+    uz: FloatArray
+    szz: float
+    up: FloatArray
+    spp: FloatArray
+    szp: FloatArray
+    readings: int
+
+
+class _Reading(NamedTuple):
+    """One reading as the sums took it: basis columns and weighted values, the weighted z, the hypotheses
+    live then and their weighted predictions, the reading's own arc (mm) and turn (rad), its segment."""
+
+    cols: IntArray
+    vals: FloatArray
+    z: float
+    live: IntArray
+    p: FloatArray
+    arc: float
+    turn: float
+    segment: int
+    weight: float
 
 
 def _bspline(x: float) -> tuple[IntArray, FloatArray]:
@@ -214,6 +291,10 @@ class ContactFilter:
         The jaw, for where it can touch (:class:`localizer.Reach`).
     jaw_margin : float, mm
         How far a measured place on the jaw may be off when checking it against the reach.
+    defect_window : float, mm
+        The rolled arc of a stretch of readings the belief must not rest on alone, and over which
+        :meth:`fit_test` judges whether the readings still fit the part (0: trust every reading, test
+        nothing). Module notes, "A part that is not its model".
     sd_jaw : float, mm
         Standard deviation of the B-spline coefficients of the calibration's error along the jaw
         (a smooth function of the contact's place on the jaw, the same all run long; 0: none).
@@ -277,6 +358,7 @@ class ContactFilter:
         sd_turn: float = ENCODER_SD,
         temper: float = TEMPER,
         sd_drift: float = 1e-4,
+        defect_window: float = DEFECT_WINDOW,
     ) -> None:
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
@@ -307,6 +389,9 @@ class ContactFilter:
             raise QueryError(f"temper={temper!r} must be in (0, 1]")
         if not (math.isfinite(jaw_margin) and jaw_margin >= 0):
             raise QueryError(f"jaw_margin={jaw_margin!r} mm must be ≥ 0")
+        if not (math.isfinite(defect_window) and defect_window >= 0):
+            raise QueryError(f"defect_window={defect_window!r} mm must be ≥ 0 (0: trust every stretch)")
+        self.defect_window = float(defect_window)
         self.part = part
         self.jaw = jaw
         self.jaw_margin = float(jaw_margin)
@@ -384,6 +469,14 @@ class ContactFilter:
         self._rows = 0  # readings added
         self._cached: dict[float, dict[str, Any]] = {}  # per factor on the slope prior
         self._last_row: tuple[IntArray, FloatArray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
+        # every reading as added (weighted): columns, values, z, the hypotheses live then and their
+        # predictions, its arc and turn; and the readings taken out again (quarantine)
+        self._readings: list[_Reading] = []
+        self._out: set[int] = set()
+        self._misfit: Misfit | None = None
+        self._fit_next = FIT_EVERY
+        self._last_map = math.nan
+        self._last_span: tuple[float, float] | None = None
         self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
@@ -458,6 +551,7 @@ class ContactFilter:
             self._uu[np.ix_(cols, cols)] += wt2 * np.outer(vals, vals)
             self._touched[cols] = True
             self._last_row = (cols, vals)
+            self._readings[0] = self._readings[0]._replace(cols=cols, vals=vals * self._row_weight)
             self._version += 1
         idx = self._live_idx
         ok = self.tracks.touches(self.current[idx], float(jaw), self.jaw_margin, node=self.node[idx])
@@ -594,6 +688,40 @@ class ContactFilter:
         live = np.arange(self.grid.size) if idx is None else np.asarray(idx, dtype=np.int64)
         add_row(self._up, self._uu, self._uz, self._spp, self._szp, self._touched, cols, vals, live, p, z)
         self._szz += z * z
+        self._readings.append(_Reading(cols, vals, z, live, p, z / wt, turn, self._segment, wt))
+
+    def _take(self, rows: list[int], sign: float) -> None:
+        """Take the readings ``rows`` (indices into the readings added) out of the sums (``sign`` -1) or
+        put them back (1), for the hypotheses live now."""
+        live = self._live_idx
+        for j in rows:
+            r = self._readings[j]
+            pos = np.searchsorted(r.live, live)
+            add_row(
+                self._up,
+                self._uu,
+                self._uz,
+                self._spp,
+                self._szp,
+                self._touched,
+                r.cols,
+                r.vals,
+                live,
+                r.p[pos],
+                r.z,
+                sign,
+            )
+            self._szz += sign * r.z * r.z
+        self._version += 1
+
+    def set_quarantine(self, rows: set[int] | list[int]) -> None:
+        """Trust all readings but ``rows`` (indices of the readings in the order given, 0 the first): those
+        are taken out of the likelihood, as if never taken; readings quarantined before and not in
+        ``rows`` are put back."""
+        new = {int(j) for j in rows if 0 < int(j) < len(self._readings)}
+        self._take(sorted(new - self._out), -1.0)
+        self._take(sorted(self._out - new), 1.0)
+        self._out = new
 
     def _solved(self, factor: float = 1.0) -> dict[str, Any]:
         """The marginalisation over the live hypotheses and their log-likelihoods, with the slope
@@ -610,37 +738,208 @@ class ContactFilter:
             self._cached[factor] = s
         return s
 
-    def _solve(self, factor: float = 1.0) -> dict[str, Any]:
-        """The closed-form marginalisation over the live hypotheses (see the module notes)."""
+    def _solve(self, factor: float = 1.0, without: _Sums | None = None, hyps: IntArray | None = None) -> dict[str, Any]:
+        """The closed-form marginalisation over the live hypotheses (see the module notes), or over
+        ``hyps``, with the sums of the readings ``without`` taken out (summed over the same hypotheses)."""
         cols = np.flatnonzero(self._touched)
         s2 = self.sd_position**2
         prior = self._slope_var[cols] * factor**2  # the contact's offset ρ·η: (ρ·sd_slope)²
         prior[cols < self._segments] = 1e6  # the segments' offsets: flat
         prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw**2
         prior[cols == self._drift] = self.sd_drift**2
-        g = self._uu[np.ix_(cols, cols)] + np.diag(s2 / prior)
-        live = np.flatnonzero(self._live)
-        v = self._up[np.ix_(cols, live)]  # (m, n_live)
+        live = np.flatnonzero(self._live) if hyps is None else np.asarray(hyps, dtype=np.int64)
+        uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], self._szz
+        v, spp, szp = self._up[np.ix_(cols, live)], self._spp[live], self._szp[live]  # v: (m, n_live)
+        if without is not None:
+            uu, uz, szz = uu - without.uu[np.ix_(cols, cols)], uz - without.uz[cols], szz - without.szz
+            v, spp, szp = v - without.up[cols], spp - without.spp, szp - without.szp
+        g = uu + np.diag(s2 / prior)
         gi_v = np.linalg.solve(g, v)
-        wz = self._uz[cols]
+        wz = uz
         gi_wz = np.linalg.solve(g, wz)
         # ≥ 0 in exact arithmetic (a squared norm after projection); rounding must not make it less
-        qpp = np.maximum(self._spp[live] - np.einsum("ij,ij->j", v, gi_v), 0.0) / s2
-        qpz = (self._szp[live] - gi_wz @ v) / s2
-        qzz = (self._szz - wz @ gi_wz) / s2
-        return {"cols": cols, "g": g, "live": live, "gi_v": gi_v, "gi_wz": gi_wz, "qpp": qpp, "qpz": qpz, "qzz": qzz}
+        qpp = np.maximum(spp - np.einsum("ij,ij->j", v, gi_v), 0.0) / s2
+        qpz = (szp - gi_wz @ v) / s2
+        qzz = (szz - wz @ gi_wz) / s2
+        return {
+            "cols": cols,
+            "g": g,
+            "live": live,
+            "gi_v": gi_v,
+            "gi_wz": gi_wz,
+            "qpp": qpp,
+            "qpz": qpz,
+            "qzz": qzz,
+            "k_less": 0 if without is None else without.readings,
+        }
+
+    def _stretch_sums(self, rows: list[int], hyps: IntArray | None = None) -> _Sums:
+        """The sums of the readings ``rows`` alone, over the hypotheses live now (or ``hyps``, live)."""
+        m, live = self._m, self._live_idx if hyps is None else np.asarray(hyps, dtype=np.int64)
+        out = _Sums(
+            np.zeros((m, m)),
+            np.zeros(m),
+            0.0,
+            np.zeros((m, live.size)),
+            np.zeros(live.size),
+            np.zeros(live.size),
+            len(rows),
+        )
+        at = np.arange(live.size)
+        touched = np.zeros(m, dtype=bool)
+        szz = 0.0
+        for j in rows:
+            r = self._readings[j]
+            pos = np.searchsorted(r.live, live)
+            add_row(out.up, out.uu, out.uz, out.spp, out.szp, touched, r.cols, r.vals, at, r.p[pos], r.z)
+            szz += r.z * r.z
+        return out._replace(szz=szz)
+
+    def _windows(self, rows: list[int]) -> list[tuple[float, IntArray]]:
+        """The stretches of :attr:`defect_window` mm of rolled arc, overlapping by three quarters, over the
+        readings ``rows``: (where each begins, mm, and the positions in ``rows`` of its readings), each
+        set of readings once."""
+        arcs = np.array([self._readings[j].arc for j in rows])
+        w = self.defect_window
+        out, seen = [], set()
+        for a in np.arange(float(arcs.min()) - 0.75 * w, float(arcs.max()) + 1e-9, 0.25 * w):
+            inside = np.flatnonzero((arcs >= a) & (arcs <= a + w))
+            key = (int(inside[0]), int(inside[-1])) if inside.size else (-1, -1)
+            if inside.size and key not in seen:
+                seen.add(key)
+                out.append((float(a), inside))
+        return out
+
+    def _trusted(self) -> list[int]:
+        """The readings the likelihood holds (not the first, which only places the start; not quarantined)."""
+        return [j for j in range(1, len(self._readings)) if j not in self._out]
+
+    def fit_test(self, starts: ArrayLike) -> Misfit | None:
+        """Whether the readings still fit the part under each of the hypotheses ``starts`` (grid indices).
+
+        For each start and each stretch of :attr:`defect_window` mm of rolled arc, the stretch's misfit
+        per reading against the rest's (the quadratic forms of the marginalisation with and without it:
+        every nuisance weighed out, the noise level left to the readings) is an F statistic; its
+        p-value, Bonferroni-corrected over the stretches, below :data:`~localizer.FIT_ALPHA` means the
+        stretch does not come from the part the model describes there. Noise of any level fits
+        (the statistic is a ratio); a burr, a dent, debris or a spike-ridden stretch does not.
+
+        Returns
+        -------
+        Misfit or None
+            None when some start fits every stretch (or there are too few readings to tell); else the
+            first start's worst stretch: where on the model (its path's arcs over the stretch), and
+            how significant.
+        """
+        rows = self._trusted()
+        hyps = np.asarray([int(h) for h in np.atleast_1d(starts) if self._live[int(h)]], dtype=np.int64)
+        if len(rows) < FIT_MIN_READINGS or hyps.size == 0 or self.defect_window <= 0:
+            return None
+        t2 = self.sd_scale**2
+        q_all = _quad(self._solve(1.0, hyps=hyps), t2)
+        k = len(rows)
+        nuisance = len({self._readings[j].segment for j in rows})
+        windows = [
+            (a, inside) for a, inside in self._windows(rows) if inside.size >= 3 and k - inside.size >= FIT_MIN_READINGS
+        ]
+        if not windows:
+            return None
+        # what each reading's misfit should be under each start: the row weights were set from one
+        # reference start's radius of curvature when the reading came (the rotation reading's error moves
+        # the contact by ρ·e), which for another start, or a reference chosen before the readings said
+        # much, is not its own: the statistic compares misfit to expectation, stretch against rest
+        expect = self._expected_misfit(rows, hyps)  # (len(rows), hyps)
+        e_all = expect.sum(axis=0)
+        best_p = np.ones(hyps.size)
+        best_w: list[tuple[float, IntArray] | None] = [None] * hyps.size
+        for a, inside in windows:
+            chosen = [rows[i] for i in inside]
+            q_rest = np.maximum(_quad(self._solve(1.0, without=self._stretch_sums(chosen, hyps), hyps=hyps), t2), 1e-12)
+            kw, kr = inside.size, k - inside.size - nuisance
+            e_w = expect[inside].sum(axis=0)
+            stretch = np.maximum(q_all - q_rest, 0.0) / e_w
+            rest = q_rest / (e_all - e_w) * k / (k - nuisance)
+            f_stat = stretch / rest
+            # a misfit the part's: the stretch's readings at least FIT_RATIO times as far off as the rest,
+            # and as the noise it was told (the model's own approximations leave a stretch up to about five
+            # times off on clean parts; noise-free readings show them alone)
+            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, 1.0), f_dist.sf(f_stat, kw, kr), 1.0)
+            better = pv < best_p
+            best_p = np.where(better, pv, best_p)
+            for i in np.flatnonzero(better):
+                best_w[i] = (a, inside)
+        level = FIT_ALPHA / len(windows)
+        if not np.all(best_p < level):
+            return None
+        a, inside = best_w[0]  # type: ignore[misc]
+        h = int(hyps[0])
+        present = []
+        for i in inside:
+            r = self._readings[rows[i]]
+            pos = int(np.searchsorted(r.live, h))
+            present.append(self.grid[h] + r.p[pos] / r.weight)
+        first = present[0]
+        rel = np.asarray(self.part.arc_offset(np.array(present), first))
+        lo, hi = first + float(rel.min()), first + float(rel.max())
+        return Misfit(
+            arcs=(float(self.part.wrap_arc(lo)), float(self.part.wrap_arc(hi))),
+            travel=(float(a), float(a + self.defect_window)),
+            p_value=float(best_p[0]),
+            start=float(self.grid[h]),
+        )
+
+    def _expected_misfit(self, rows: list[int], hyps: IntArray) -> FloatArray:
+        """Each reading's expected weighted misfit (in units of the told reading variance) under each start
+        ``hyps``: the reading's own error and the rotation reading's, ρ·sd_turn with ρ the start's radius
+        of curvature at its contact then, times the weight the reading was given."""
+        out = np.empty((len(rows), hyps.size))
+        for n, j in enumerate(rows):
+            r = self._readings[j]
+            pos = np.searchsorted(r.live, hyps)
+            here = self.grid[hyps] + r.p[pos] / r.weight
+            kappa = self.tracks.kappa[self.tracks.node_at(here)]
+            rho = np.where(kappa > 0, 1.0 / np.maximum(kappa, 1.0 / RHO_MAX), RHO_MAX)
+            out[n] = r.weight**2 * (1.0 + (rho * self.sd_turn / self.sd_position) ** 2)
+        return out
+
+    def stretch_mass(self, arc: float, radius: float | None = None) -> tuple[float, tuple[float, float]]:
+        """The least probability within ``radius`` of the present contact at ``arc`` (mm) when any one
+        stretch of the readings, ``defect_window`` mm of the rolled arc, is left out, and that stretch
+        (cumulative arc, mm, as :meth:`update` took it).
+
+        A burr, a dent or a speck of debris where the jaw rolls makes the readings over it follow a
+        shape the model does not have, and a crest's tight bend reads like a fillet of the model: the
+        readings of a short stretch alone can look like another place of the part. The belief is sure
+        only where it stays sure without any one such stretch (module notes, "A part that is not its
+        model"). Each stretch is taken out exactly (the marginalisation without its sums); the windows
+        overlap by three quarters, so a stretch up to three quarters of a window lies inside one.
+        """
+        radius = self.radius if radius is None else float(radius)
+        rows = self._trusted()
+        if not rows or self.defect_window <= 0:
+            return 1.0, (math.nan, math.nan)
+        worst, where = 1.0, (math.nan, math.nan)
+        for a, inside in self._windows(rows):
+            s = self._solve(1.0, without=self._stretch_sums([rows[i] for i in inside]))
+            s["ll"] = self._log_likelihood(s, prune=False)
+            ll = s["ll"]
+            wts = np.exp(ll - ll.max())
+            wts /= wts.sum()
+            mean, sd = self._shift_of(s)
+            mass = self._mass_near(wts, self.part.wrap_arc(self.current + mean), sd, arc, radius)
+            if mass < worst:
+                worst, where = mass, (a, a + self.defect_window)
+        return worst, where
 
     def _log_likelihood(self, s: dict[str, Any], prune: bool = True) -> FloatArray:
         """Log-likelihood of each start from a :meth:`_solve`, the noise scale weighed out; prunes the
         hopeless ones. Also leaves in ``s`` each live start's posterior mean of the squared scale."""
-        live, qpp, qpz = s["live"], s["qpp"], s["qpz"]
-        qrr = s["qzz"] - 2 * qpz + qpp
+        live, qpp = s["live"], s["qpp"]
         t2 = self.sd_scale**2
-        qpr = qpz - qpp
-        quad = qrr - t2 * qpr**2 / (1 + t2 * qpp)
+        quad = _quad(s, t2)
         # every standard deviation times λ: the quadratic form scales by 1/λ², the determinant by
         # λ^(2k) with k the readings not absorbed by a flat offset; t2·qpp does not change
-        k = max(self._rows - (self._segment + 1), 0)
+        k = max(self._rows - len(self._out) - s.get("k_less", 0) - (self._segment + 1), 0)
         lam = np.asarray(self.noise_scales)
         terms = -0.5 * quad[None, :] / lam[:, None] ** 2 - k * np.log(lam)[:, None]
         top = terms.max(axis=0)
@@ -702,7 +1001,10 @@ class ContactFilter:
 
     def _shift(self, factor: float) -> tuple[FloatArray, FloatArray]:
         """:meth:`shift` with the slope prior's standard deviations times ``factor``."""
-        s = self._solved(factor)
+        return self._shift_of(self._solved(factor))
+
+    def _shift_of(self, s: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
+        """:meth:`shift` from the marginalisation ``s`` (:meth:`_solve`, with its log-likelihood)."""
         n = self.grid.size
         mean, sd = np.zeros(n), np.zeros(n)
         live = s["live"]
@@ -758,6 +1060,18 @@ class ContactFilter:
         (default: the filter's ``radius``)."""
         radius = self.radius if radius is None else float(radius)
         part = self.part
+        if not self._live.any():  # every start ruled out: nothing on the part fits the readings
+            return Belief(
+                map_arc=self._last_map,
+                mass=0.0,
+                radius=radius,
+                modes=(),
+                ambiguous=False,
+                informative=True,
+                steps=self.steps,
+                consistent=False,
+                mismatch=self._misfit.arcs if self._misfit is not None else self._last_span,
+            )
         w = self.posterior()
         mean, sd = self.shift()
         present = part.wrap_arc(self.current + mean)
@@ -772,6 +1086,22 @@ class ContactFilter:
         if self.slope_envelope:
             self._prune_under_every_prior()
         modes = self._modes(w, present, radius)
+        # do the readings still fit the part? Tested every FIT_EVERY readings and before any sure stop,
+        # under the most probable start of each strong mode; a misfit, once found, stays
+        if self._misfit is None and (mass >= self.confidence or self.steps >= self._fit_next):
+            self._fit_next = self.steps + FIT_EVERY
+            # the most probable starts, and each strong mode's best: all of them must misfit
+            strong = [m for m in modes if m.mass >= self.mode_floor][:3]
+            top = np.argsort(w)[::-1][:FIT_STARTS]
+            reps = [i] + [int(self.tracks.node_at(m.start_arc)) for m in strong[1:]]
+            reps += [int(h) for h in top if w[h] > 0 and int(h) not in reps]
+            self._misfit = self.fit_test(reps)
+        # sure only if sure without any one short stretch of the readings (a burr, a dent, debris):
+        # asked only where it would decide, at the confidence
+        if mass >= self.confidence and self.defect_window > 0 and self._misfit is None:
+            mass = min(mass, self.stretch_mass(map_arc, radius)[0])
+        self._last_map = map_arc
+        self._last_span = (map_arc, map_arc)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
         prior /= prior.sum()
         informative, ambiguous = belief_flags(w, prior, modes, self.mode_floor, self.confidence)
@@ -783,7 +1113,19 @@ class ContactFilter:
             ambiguous=ambiguous,
             informative=informative,
             steps=self.steps,
+            mismatch=self._misfit.arcs if self._misfit is not None else None,
         )
+
+    @property
+    def ruled_out(self) -> bool:
+        """Every start is ruled out: nothing on the part fits the readings (:meth:`belief` then says so)."""
+        return not bool(self._live.any())
+
+    @property
+    def misfit(self) -> Misfit | None:
+        """Where the readings stopped fitting the part (:meth:`fit_test`), found by :meth:`belief`; None
+        while they fit."""
+        return self._misfit
 
     def _mass_near(self, w: FloatArray, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> float:
         """Probability that the present contact is within ``radius`` mm of ``arc``: each start's (weight

@@ -93,13 +93,15 @@ class Defect:
     length: float
 
     def offset(self, sigma: np.ndarray, perimeter: float) -> np.ndarray:
-        """The normal offset (mm) it adds at the model's arc positions ``sigma`` (mm)."""
+        """The normal offset (mm) it adds at the model's arc positions ``sigma`` (mm) on a part of ``perimeter``
+        mm."""
         u = (np.asarray(sigma, dtype=float) - self.arc + perimeter / 2) % perimeter - perimeter / 2
         inside = np.abs(u) < self.length / 2
         out: np.ndarray = np.where(inside, self.height * np.cos(math.pi * u / self.length) ** 4, 0.0)
         return out
 
     def describe(self) -> str:
+        """One line for people: "a 0.3 mm bump 4 mm long at arc 120.00 mm"."""
         kind = "bump" if self.height > 0 else "dent"
         return f"a {abs(self.height):.3g} mm {kind} {self.length:.3g} mm long at arc {self.arc:.2f} mm"
 
@@ -323,7 +325,8 @@ def _number(v: object) -> bool:
 
 
 def load_world(path: str | Path, parts: int | None = None) -> WorldSpec:
-    """The ``[world]`` table of the TOML file at ``path`` (module notes).
+    """The ``[world]`` table of the TOML file at ``path`` (module notes), for a study of ``parts`` model
+    parts (``world_parts`` must be as long; None: not checked).
 
     Raises
     ------

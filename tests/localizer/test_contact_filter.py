@@ -230,8 +230,8 @@ def stop_rule(flt, z, turns, confidence=0.95, every=5):
 def test_noise_four_times_what_it_was_told_does_not_make_it_sure_and_wrong(kidney):
     # Told 0.035 mm, read at 0.14 mm: the filter weighs the noise scale out and discounts the
     # evidence, so it rolls on instead of stopping sure at the wrong place. Held to what it was told
-    # (one scale, the evidence at face value, the slope prior alone), the same readings make it stop
-    # sure and wrong.
+    # (one scale, the evidence at face value, the slope prior alone, every stretch trusted), the same
+    # readings make it stop sure and wrong.
     turns = -STEP * np.arange(1, 551)
     start = 29.3
     travel = exact_travel(kidney, start, turns)
@@ -240,7 +240,7 @@ def test_noise_four_times_what_it_was_told_does_not_make_it_sure_and_wrong(kidne
     for seed in range(16):
         e = 0.14 * np.random.default_rng(seed).standard_normal(len(turns) + 1)
         z = travel + e[1:] - e[0]
-        for name, extra in (("weighed", {}), ("told", {"noise_scales": (1.0,), "temper": 1.0, "slope_envelope": ()})):
+        for name, extra in (("weighed", {}), ("told", {"noise_scales": (1.0,), "temper": 1.0, "slope_envelope": (), "defect_window": 0.0})):
             sure, est, k = stop_rule(ContactFilter(kidney, spacing=0.05, **told, **extra), z, turns, every=10)
             wrong[name] += bool(sure and abs(kidney.arc_offset(est, start + travel[k - 1])) > 0.3)
     assert wrong["weighed"] == 0 and wrong["told"] >= 2, wrong
@@ -317,7 +317,8 @@ def test_a_look_alike_that_the_slope_term_explains_is_not_stated_sure():
     part = load_part(DATA / rec["part"])
     verdicts = {}
     for envelope in ((), SLOPE_ENVELOPE):
-        flt = ContactFilter(part, radius=0.3, confidence=0.95, slope_envelope=envelope)
+        # every stretch trusted (defect_window 0): what the slope envelope alone does
+        flt = ContactFilter(part, radius=0.3, confidence=0.95, slope_envelope=envelope, defect_window=0.0)
         true = int(np.argmin(np.abs(part.arc_offset(flt.grid, rec["start_arc"]))))
         sure = wrong = 0
         for name, args, kwargs in rec["calls"]:
