@@ -240,7 +240,10 @@ def test_noise_four_times_what_it_was_told_does_not_make_it_sure_and_wrong(kidne
     for seed in range(16):
         e = 0.14 * np.random.default_rng(seed).standard_normal(len(turns) + 1)
         z = travel + e[1:] - e[0]
-        for name, extra in (("weighed", {}), ("told", {"noise_scales": (1.0,), "temper": 1.0, "slope_envelope": (), "defect_window": 0.0})):
+        for name, extra in (
+            ("weighed", {}),
+            ("told", {"noise_scales": (1.0,), "temper": 1.0, "slope_envelope": (), "defect_window": 0.0}),
+        ):
             sure, est, k = stop_rule(ContactFilter(kidney, spacing=0.05, **told, **extra), z, turns, every=10)
             wrong[name] += bool(sure and abs(kidney.arc_offset(est, start + travel[k - 1])) > 0.3)
     assert wrong["weighed"] == 0 and wrong["told"] >= 2, wrong
