@@ -103,13 +103,11 @@ def method_bound(part, path, segments, sds: tuple, sd_scale: float, noise) -> fl
 
 
 def _sd_scale(study) -> float:
-    """The calibration scale's prior standard deviation: the study's [reactive] sd_scale, else the filter's."""
-    import inspect
-
-    from localizer import ContactFilter
+    """The scale's prior standard deviation: the study's [reactive] sd_scale, else the filter's default."""
+    from localizer import SCALE_SD
 
     given = study.reactive.sd_scale
-    return float(given if given is not None else inspect.signature(ContactFilter).parameters["sd_scale"].default)
+    return float(given if given is not None else SCALE_SD)
 
 
 def _err(part, est, truth) -> float:
@@ -304,7 +302,7 @@ def reactive_filter(study, part, noise, filter_class=None):
     for key in ("noise_scales", "slope_envelope"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)
-    for key in ("temper", "shape_spacing"):
+    for key in ("temper", "shape_spacing", "defect_window"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)
     cls = ContactFilter if filter_class is None else filter_class
@@ -386,10 +384,13 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
 
 
 def mismatch_cell(belief) -> str:
-    """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), empty when none."""
+    """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), "unknown" where the run
+    found one but could not tell where, empty when none."""
     arcs = getattr(belief, "mismatch", None)
     if not arcs:
         return ""
+    if not all(math.isfinite(a) for a in arcs):
+        return "unknown"
     return f"{arcs[0]:.2f}-{arcs[1]:.2f}"
 
 

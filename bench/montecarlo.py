@@ -363,6 +363,7 @@ def method_detail(study: Study, m: str, rows) -> dict:
         "error_median_mm": float(np.median(err)) if n else None,
         "confident": len(confident),
         "confident_wrong": wrong,
+        "mismatch": stopped.count("mismatch"),
         "confident_wrong_ci95": list(wilson(wrong, len(confident))),
         "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
         "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
@@ -687,4 +688,5 @@ def _print_method(m: str, d: dict, indent: str) -> None:
         f"{indent}{m:10s} {d['success']}/{d['trials']} = {d['success'] / d['trials']:.1%} "
         f"(95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), {rot}median error {d['error_median_mm']:.3f} mm; "
         f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}"
+        + (f"; model mismatch {d['mismatch']}" if d.get("mismatch") else "")
     )

@@ -45,6 +45,19 @@ Several methods on the same trials (instead of ``method``)::
     slope_envelope = [0.25]              # optional: other factors on sd_slope under which the
                                          #   stated mass must hold too (default
                                          #   localizer.SLOPE_ENVELOPE; [] the slope prior alone)
+    defect_window = 12.0                 # optional: mm of rolled arc no belief may rest on alone,
+                                         #   and the stretch the fit test judges (0: neither)
+
+    [world]                              # optional: how each trial's world differs from the model
+    defects = 1                          #   (sim2d.world_part): defects near the start, or anywhere,
+    defect_height_mm = [0.1, 0.5]        #   a bump > 0, a dent < 0, or a range of magnitudes with a
+    defect_length_mm = 4.0               #   random sign; scale; spikes of the wrist (rate per reading,
+    defect_place = "start"               #   size in raw samples' sd); world_parts: a part file per
+    defect_near_mm = 5.0                 #   model part (a scan against its drawing)
+    scale = 1.0
+    spike_rate = 0.0
+    spike_size = 20.0
+    world_parts = []
 
     [particle]                           # the peer baseline, over the fixed rolls' readings
     particles = 2000
@@ -180,6 +193,7 @@ class ReactiveOptions:
     temper: float | None = None  # None: the filter's default
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
     slope_envelope: tuple | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
+    defect_window: float | None = None  # None: localizer.DEFECT_WINDOW (mm); 0: trust every stretch, test none
 
 
 @dataclass(frozen=True)
@@ -501,6 +515,9 @@ def _options(path, table, cls, name):
             ):
                 raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a list of positive factors")
             values[key] = tuple(float(v) for v in value)
+            continue
+        if key == "defect_window" and isinstance(value, (int, float)) and value == 0:
+            values[key] = 0.0
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):
             raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a positive number")

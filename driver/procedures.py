@@ -199,8 +199,11 @@ PRESS = PressSettings()
 
 # ---------------------------------------------------------------- sensing
 def zero(rig: Rig, n: int = 256) -> tuple:
-    """The default readings (v1, v2) with the jaw clear of everything, V."""
-    return rig.read(n)
+    """The default readings (v1, v2) with the jaw clear of everything, V: the middle of three readings of
+    ``n`` samples each, channel by channel, so that one spike of the DAQ does not shift every place read
+    after it."""
+    three = np.array([rig.read(n) for _ in range(3)], dtype=float)
+    return float(np.median(three[:, 0])), float(np.median(three[:, 1]))
 
 
 def delta_voltages(rig: Rig, baseline, n: int) -> tuple:

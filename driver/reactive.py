@@ -41,7 +41,7 @@ Works on any :class:`driver.rig.Rig` (simulated or serial).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -64,6 +64,11 @@ __all__ = [
 CONFIRM = 1
 #: Probability within the success radius that stops the rolling.
 CONFIDENCE = 0.95
+#: A bridge the belief gave less than this probability is one the part's model does not explain.
+UNEXPLAINED_BRIDGE = 0.01
+#: How many times a run rolls through such a jump to leave what the jaw sat on (module notes, rule 8):
+#: once, off the thing under the start; a second would be a real concavity the belief misjudged.
+MAX_LEAVES = 1
 #: Budget of rolled rotation, both directions counted, rad (the command line's and the studies' too).
 MAX_ROTATION = math.radians(240.0)
 
@@ -195,6 +200,9 @@ class ReactivePolicy:
         three times this (0: never turn round by choice).
     confirm : int
         Checks in a row at which the belief must reach ``confidence`` before the rolling stops.
+    reread_jump : float, mm
+        A reading whose contact moved more than this on the jaw in one step is read twice more and the
+        middle of the three kept (a spike of the wrist's DAQ is one reading; a real jump reads the same).
     """
 
     step: float = ROLL_STEP
@@ -209,6 +217,7 @@ class ReactivePolicy:
     backoff: float = 2.0
     min_spread: float = 0.05
     confirm: int = CONFIRM
+    reread_jump: float = 1.0
 
     def __post_init__(self):
         if not (math.isfinite(self.step) and self.step > 0):
@@ -294,11 +303,44 @@ class _Roller:
         self.direction = 1 if policy.direction is None else policy.direction
         self.belief: Belief | None = None
         self.sure = 0  # checks in a row at or above the confidence
+        # a jump no place of the model explains since the filter last started, and the jumps the jaw
+        # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
+        self.unexplained = False
+        self.left: list[tuple[int, float]] = []
+        self.segment_base = 0  # segments of the filters before a restart
+        self.rereads = 0  # readings taken again because one jumped
 
     # ------------------------------------------------------------------ sensing
     def read(self) -> float:
         """The contact's place on the jaw now, mm (logs the reading)."""
         return _location(self.rig, self.baseline, self.calibration, self.policy.n, self.readings, self.truth, self.hand)
+
+    def read_or_inf(self) -> float:
+        """:meth:`read`, or inf where the place read lies outside the calibrated span (a bridge, or a spike)."""
+        try:
+            return self.read()
+        except DEVICE_FAULTS:
+            raise
+        except RigError:
+            return math.inf
+
+    def read_again(self, d: float) -> float:
+        """A reading ``d`` (mm) that jumped (or fell outside the calibrated span: inf): read twice more at the
+        same pose and keep the middle of the three, so that one spike of the wrist's DAQ is not taken for the
+        contact's move (a real jump reads the same again)."""
+        self.rereads += 1
+        three = sorted([d, self.read_or_inf(), self.read_or_inf()])
+        return float(three[1])
+
+    def read_base(self) -> float:
+        """A reading the next steps count from (the first contact, after a regrasp or a bridge undone): read
+        twice, and a third time if the two differ by more than ``reread_jump``, keeping the middle, so that
+        a spike does not shift every step after it."""
+        a, b = self.read(), self.read()
+        if abs(a - b) <= self.policy.reread_jump:
+            return a
+        self.rereads += 1
+        return float(np.median([a, b, self.read()]))
 
     def pressed(self) -> bool:
         """Press back to the force; False when the press was refused (overload, no contact)."""
@@ -333,7 +375,7 @@ class _Roller:
         )
         self.offset = edge_offset(rig, self.hand, self.baseline)
         self.jaw_limit = float(np.max(np.abs(self.calibration.positions))) - p.end_margin
-        self.d_prev = self.read()
+        self.d_prev = self.read_base()
         flt.touch(self.d_prev)  # the first contact's place on the jaw: where the jaw could have been laid
         self.phi0 = self.hand.measured_angle()
         self.true_arcs = [self.true_arc()]
@@ -347,8 +389,12 @@ class _Roller:
         if belief is None or belief.steps != flt.steps:
             belief = flt.belief()
             self.history.append((self.rotation, belief.map_arc, belief.mass, self.true_arc()))
-        if belief.mismatch is not None or not belief.consistent:
-            stopped = "mismatch"
+        if stopped != "mismatch":
+            where = self._verdict(belief) if belief.consistent else None
+            if where is not None:
+                belief = replace(belief, mismatch=where[0], mismatch_mm=where[1])
+            if where is not None or not belief.consistent:
+                stopped = "mismatch"
         return ReactiveRun(
             belief=belief,
             rotation=self.rotation,
@@ -371,18 +417,20 @@ class _Roller:
         self.hand.rotate_by(s)
         self.rotation += p.step
         try:
-            d = self.read() if self.pressed() else math.inf
+            d = self.read_or_inf() if self.pressed() else math.inf
+            if math.isfinite(self.d_prev) and not abs(d - self.d_prev) <= p.reread_jump:
+                d = self.read_again(d)
         except DEVICE_FAULTS:
             raise
         except RigError:
-            d = math.inf  # left the calibrated span, or the press was refused: treated as a bridge
+            d = math.inf  # the press was refused: treated as a bridge
         bridged = not math.isfinite(d) or (abs(d - self.d_prev) > p.bridge_jump and not self._crossed_face(d, s))
         regrasped = slid_off = False
         if not bridged and abs(d) > self.jaw_limit:
             d, regrasped, slid_off = self._regrasp(d)
             bridged = slid_off
         if bridged:
-            return self._undo_bridge(s, slid_off)
+            return self._undo_bridge(s, slid_off, d)
         if regrasped:
             turn = self.turn
         else:
@@ -394,7 +442,7 @@ class _Roller:
         self.arcs.append(self.z)
         self.turns.append(turn)
         self.true_arcs.append(self.true_arc())
-        self.segments.append(flt.segment)
+        self.segments.append(self.segment_base + flt.segment)
         self.d_prev = d
         self.steps += 1
         if self.steps % p.check_every == 0:
@@ -432,7 +480,7 @@ class _Roller:
         self.hand.press_by(-p.backoff)
         self.hand.slide_by(slide)
         try:
-            d_new = self.read() if self.pressed() else math.inf
+            d_new = self.read_base() if self.pressed() else math.inf
         except DEVICE_FAULTS:
             raise
         except RigError:
@@ -449,20 +497,22 @@ class _Roller:
         self.pressed()
         return d, False, True
 
-    def _undo_bridge(self, s: float, slid_off: bool) -> str | None:
+    def _undo_bridge(self, s: float, slid_off: bool, d: float) -> str | None:
         """The step bridged a concavity: roll back, re-read, and go the other way ("lost" or "blocked"
-        when that is not possible)."""
+        when that is not possible). A jump no place of the belief predicted, once both ways are blocked,
+        is rolled through instead (:meth:`_leave`): the jaw sits on something the model does not have."""
         p, flt = self.policy, self.flt
         self.bridges += 1
         if not slid_off:
             # evidence: the starts under which this turn keeps the jaw clear are less likely
-            flt.bridged(self.turn_now(), jump=p.bridge_jump)
+            predicted = flt.bridged(self.turn_now(), jump=p.bridge_jump)
+            self.unexplained |= predicted < UNEXPLAINED_BRIDGE
         self.hand.rotate_by(-s)
         self.rotation += p.step
         try:
             if not self.pressed():
                 raise RigError("the press back was refused")
-            self.d_prev = self.read()
+            self.d_prev = self.read_base()
         except DEVICE_FAULTS:
             raise
         except RigError:
@@ -471,9 +521,80 @@ class _Roller:
         flt.regrasp(self.z, self.turn_now(), self.d_prev)
         self.blocked[self.direction] = True
         if self.blocked[-self.direction]:
+            if self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
+                return self._leave(s, d - self.d_prev)
             return "blocked"
         self.direction = -self.direction
         self.reversals += 1
+        return None
+
+    def _leave(self, s: float, jump: float) -> str | None:
+        """Blocked both ways by jumps the model does not explain (the jaw sits on a burr, or between a dent's
+        rims): roll through the jump of ``jump`` mm on the jaw and localize afresh from where it lands. The
+        readings so far came from something that is not the part's model; the filter starts again there,
+        and the run ends "mismatch" whatever it finds (:meth:`_verdict`)."""
+        p, flt = self.policy, self.flt
+        if abs(self.d_prev + jump) > self.jaw_limit:
+            # the contact would land beyond the jaw's calibrated span: slide the jaw along itself first
+            d_new, regrasped, _ = self._regrasp(self.d_prev)
+            if not regrasped:
+                return "blocked"
+            self.d_prev = d_new
+        self.hand.rotate_by(s)
+        self.rotation += p.step
+        try:
+            if not self.pressed():
+                raise RigError("the press beyond the jump was refused")
+            d = self.read_base()
+        except DEVICE_FAULTS:
+            raise
+        except RigError:
+            return "lost"
+        self.left.append((self.direction, float(jump)))
+        self.segment_base += flt.segment + 1
+        flt.reset()
+        flt.touch(d)
+        self.phi0 = self.hand.measured_angle()
+        self.z = self.turn = 0.0
+        self.d_prev = d
+        self.explored = [0.0, 0.0]
+        self.blocked = {1: False, -1: False}
+        self.unexplained = False
+        self.belief = None
+        self.arcs.append(self.z)
+        self.turns.append(self.turn)
+        self.true_arcs.append(self.true_arc())
+        self.segments.append(self.segment_base)
+        return None
+
+    def _verdict(self, belief: Belief) -> tuple[tuple[float, float], float] | None:
+        """Where the part seems to differ from its model and by how much (mm), or None: the filter's misfit,
+        the stretch the jaw left (behind where the present filter started, by the jump), or a jump the most
+        probable start does not explain (ahead of its contact then). NaN ends where it cannot be told (the
+        belief has no place holding half of it)."""
+        flt = self.flt
+        if belief.mismatch is not None or not belief.consistent or flt.ruled_out:
+            return None if belief.mismatch is None else (belief.mismatch, belief.mismatch_mm)
+        start = int(np.argmax(flt.posterior()))
+        part = flt.part
+        if self.left:
+            direction, jump = self.left[-1]
+            s0 = float(flt.grid[start])
+            ends = (s0 - direction * (abs(jump) + 1.0), s0)
+            lo = ends[0] if direction > 0 else ends[1]
+            if belief.mass < 0.5:  # left, but not localized since: where it left is not known
+                return (math.nan, math.nan), abs(jump)
+            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
+        missed = flt.unexplained_bridges(start)
+        if self.unexplained and belief.mass < 0.5:
+            # jumps nothing on the model explains, and no place known well enough to say where
+            return (math.nan, math.nan), math.nan
+        if missed and belief.mass >= 0.5:
+            before, turn, _, jump = missed[0]
+            at = float(flt.tracks.step(np.array([start]), before)[0][0])
+            width = abs(self.policy.bridge_jump) + 2.0
+            lo = at if turn > before else at - width
+            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), math.nan
         return None
 
     def _check(self) -> str | None:
@@ -494,10 +615,17 @@ class _Roller:
                     "direction": self.direction,
                 }
             )
-        if belief.mismatch is not None or not belief.consistent:
-            return "mismatch"  # the readings do not fit the part: never sure, say where
-        self.sure = self.sure + 1 if belief.sure(p.confidence) else 0
+        if not belief.consistent:
+            return "mismatch"  # nothing on the part fits the readings: never sure
+        self.sure = self.sure + 1 if belief.mass >= p.confidence else 0
         if self.sure >= p.confirm:
+            # sure where it is, but never "sure" on a part that showed something its model does not have
+            # (a stretch of readings that fit nowhere, a jump the jaw left, or one the belief's place does
+            # not explain): that is reported instead, with where
+            where = self._verdict(belief)
+            if where is not None:
+                self.belief = replace(belief, mismatch=where[0], mismatch_mm=where[1])
+                return "mismatch"
             return "confident"
         direction = self.direction
         # a concavity ahead for most of the belief: turn round before bridging it, if the other way

@@ -4,8 +4,28 @@ from ._belief import Belief, Mode
 from ._bound import TrialNoise, roll_bound, trial_bound
 from ._boundary import Boundary
 from ._cad import CAD_SUFFIXES, load_outline
-from ._contact_filter import BRIDGE_MISS, CONTRADICTION, ENCODER_SD, NOISE_SCALES, SLOPE_ENVELOPE, TEMPER, ContactFilter
-from ._defaults import FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, ROLL_STEP, SUCCESS_RADIUS, TURN_TOL
+from ._contact_filter import (
+    BRIDGE_MISS,
+    CONTRADICTION,
+    DEFECT_WINDOW,
+    ENCODER_SD,
+    NOISE_SCALES,
+    SCALE_SD,
+    SLOPE_ENVELOPE,
+    TEMPER,
+    ContactFilter,
+    Misfit,
+)
+from ._defaults import (
+    CALIBRATION_SCALE_SD,
+    FIT_ALPHA,
+    LENGTH_TOL,
+    MIN_SEPARATION,
+    PART_SCALE_SD,
+    ROLL_STEP,
+    SUCCESS_RADIUS,
+    TURN_TOL,
+)
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._files import load_part
@@ -49,6 +69,11 @@ __all__ = [
     "SUCCESS_RADIUS",
     "ROLL_STEP",
     "FIT_ALPHA",
+    "PART_SCALE_SD",
+    "CALIBRATION_SCALE_SD",
+    "SCALE_SD",
+    "DEFECT_WINDOW",
+    "Misfit",
     "MAX_PART_BYTES",
     "check_size",
     "ContactFilter",

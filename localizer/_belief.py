@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -57,7 +58,11 @@ class Belief:
     mismatch : (float, float) or None
         Where on the model (arc positions, mm, counter-clockwise from the first to the second) the
         readings stopped fitting the part under the most probable start: a burr, a dent, debris, a
-        part that is not its model. None while they fit. A belief with a mismatch is never sure.
+        part that is not its model. None while they fit; NaN ends where a mismatch was found but not
+        where. A belief with a mismatch is never sure.
+    mismatch_mm : float, mm
+        How much the part seems to differ there: the readings' RMS distance from what the model
+        predicts over that stretch, or the jump the jaw made where the model has none (NaN: unknown).
     """
 
     map_arc: float
@@ -69,6 +74,7 @@ class Belief:
     steps: int
     consistent: bool = True
     mismatch: tuple[float, float] | None = None
+    mismatch_mm: float = math.nan
 
     def sure(self, confidence: float) -> bool:
         """Whether the belief may be acted on at ``confidence``: its mass reaches it, something fits, and

@@ -120,12 +120,12 @@ from scipy.stats import f as f_dist
 
 from ._belief import Belief, Mode, belief_flags, find_modes
 from ._boundary import Boundary
-from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
+from ._defaults import CALIBRATION_SCALE_SD, FIT_ALPHA, PART_SCALE_SD, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._filter_kernels import add_row
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._tracks import tracks_for
-from ._types import ArrayLike, FloatArray, IntArray
+from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = [
     "ContactFilter",
@@ -137,6 +137,7 @@ __all__ = [
     "ENCODER_SD",
     "TURN_MARGIN",
     "DEFECT_WINDOW",
+    "SCALE_SD",
     "Misfit",
 ]
 
@@ -174,6 +175,9 @@ TURN_MARGIN = 0.02
 #: The rolled arc, mm, of a stretch of readings the belief must not rest on alone (module notes, "A part
 #: that is not its model"): a burr or dent of up to 8 mm and the readings at its edges.
 DEFECT_WINDOW = 12.0
+#: The prior standard deviation of the scale of every measured arc against the model's: the
+#: calibration's and the part's own (module notes, "A part that is not its model").
+SCALE_SD = math.hypot(CALIBRATION_SCALE_SD, PART_SCALE_SD)
 #: Readings a fit test needs outside the stretch it judges (fewer cannot tell misfit from noise).
 FIT_MIN_READINGS = 20
 #: Readings between two fit tests while the belief is not sure (a test before every sure stop too).
@@ -185,6 +189,9 @@ FIT_RATIO = 6.0
 #: The most probable starts a fit test judges the readings under (besides each strong mode's best): a
 #: misfit is the part's only if none of them fits.
 FIT_STARTS = 8
+#: How many stretches that do not fit a filter takes out of its likelihood (one burr and the edge of
+#: another, or both rims of a dent); it stops testing after that.
+MAX_QUARANTINE = 3
 
 
 def _quad(s: dict[str, Any], t2: float) -> FloatArray:
@@ -212,12 +219,19 @@ class Misfit(NamedTuple):
         number of stretches tried).
     start : float, mm
         The start of the rolling under which it was judged.
+    rows : tuple of int
+        The readings of the stretch (in the order given, 0 the first).
+    rms_mm : float, mm
+        How far off the model the stretch's readings are, root mean square (as the noise the filter was
+        told would put them).
     """
 
     arcs: tuple[float, float]
     travel: tuple[float, float]
     p_value: float
     start: float
+    rows: tuple[int, ...] = ()
+    rms_mm: float = math.nan
 
 
 class _Sums(NamedTuple):
@@ -266,7 +280,8 @@ class ContactFilter:
     sd_position : float, mm
         Standard deviation of one contact-location reading, as arc.
     sd_scale : float
-        Standard deviation of the calibration's relative scale error (0: none).
+        Standard deviation of the relative scale of the measured arcs against the model's: the
+        calibration's and the part's own size (default :data:`SCALE_SD`, 1.04%; 0: none).
     sd_slope : float, rad
         Standard deviation of the B-spline coefficients of the part's slope error
         against its model (0: a perfect part). :func:`sim2d.machining_slope` gives it for
@@ -341,7 +356,7 @@ class ContactFilter:
         *,
         spacing: float = 0.02,
         sd_position: float = 0.035,
-        sd_scale: float = 0.003,
+        sd_scale: float = SCALE_SD,
         sd_slope: float = 0.001,
         shape_spacing: float = 5.0,
         radius: float = SUCCESS_RADIUS,
@@ -473,10 +488,11 @@ class ContactFilter:
         # predictions, its arc and turn; and the readings taken out again (quarantine)
         self._readings: list[_Reading] = []
         self._out: set[int] = set()
-        self._misfit: Misfit | None = None
+        self._misfits: list[Misfit] = []  # stretches found not to fit, quarantined (the first MAX_QUARANTINE)
         self._fit_next = FIT_EVERY
         self._last_map = math.nan
         self._last_span: tuple[float, float] | None = None
+        self._bridges: list[tuple[float, float, float, float]] = []  # (turn before, turn, jaw, jump)
         self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
@@ -559,7 +575,7 @@ class ContactFilter:
             self._penalty[idx[~ok]] += math.log(CONTRADICTION)
             self._version += 1
 
-    def bridged(self, turn: float, jaw: float | None = None, jump: float = 3.0) -> None:
+    def bridged(self, turn: float, jaw: float | None = None, jump: float = 3.0) -> float:
         """The jaw, turned to net rotation ``turn`` (rad), touched the part somewhere else (a bridge).
 
         The rig calls a step a bridge when the contact moves more than ``jump`` mm along the jaw
@@ -570,26 +586,56 @@ class ContactFilter:
         is made :data:`BRIDGE_MISS` times less likely; the others predicted it (a concavity, or a
         flat stretch where one step moves the contact far) or cannot tell. No reading is added:
         call :meth:`regrasp` with the next one.
+
+        Returns
+        -------
+        float
+            The probability, before this evidence, that the part's model predicted the bridge: near 0
+            where no place the belief holds has a concavity there (a burr or debris the jaw met, not the
+            part the model describes: :meth:`bridge_predicted` asks it again for any start later).
         """
         if not (math.isfinite(turn) and math.isfinite(jump) and jump > 0):
             raise QueryError(f"turn={turn!r} rad and jump={jump!r} mm must be finite, jump positive")
         d0 = self.jaw_position if jaw is None else float(jaw)
-        if not math.isfinite(d0):
-            return
+        if not math.isfinite(d0) or self.ruled_out:
+            return 1.0
         idx = self._live_idx
-        # surely clear: still so a little further on (the real part's convex stretch may end up to
-        # TURN_MARGIN before the model's)
-        further = turn + math.copysign(TURN_MARGIN, turn - self.turn)
-        clear = np.ones(idx.size, dtype=bool)
-        for t in (turn, further):
-            land, node, ok = self.tracks.step(idx, t)
-            moved = land - self.current[idx]
-            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin, sure=True, node=node)
-            if t == turn:
-                clear &= np.abs(moved) < 0.5 * jump
+        w = self.posterior()[idx]
+        clear = self._surely_clear(idx, self.turn, float(turn), d0, float(jump), at=self.current[idx])
+        self._bridges.append((self.turn, float(turn), d0, float(jump)))
         if clear.any():
             self._penalty[idx[clear]] += math.log(BRIDGE_MISS)
             self._version += 1
+        return float(w[~clear].sum())
+
+    def unexplained_bridges(self, start: int) -> list[tuple[float, float, float, float]]:
+        """The bridges reported so far (:meth:`bridged`) that the start ``start`` (a grid index) did not
+        predict, each as (net rotation before it, rad; the turn it came at, rad; the contact's place on
+        the jaw, mm; the jump, mm): none where the model explains every jump the rig saw."""
+        idx = np.array([int(start)], dtype=np.int64)
+        return [b for b in self._bridges if bool(self._surely_clear(idx, *b)[0])]
+
+    def _surely_clear(
+        self, idx: IntArray, before: float, turn: float, d0: float, jump: float, at: FloatArray | None = None
+    ) -> BoolArray:
+        """Whether, for each start ``idx``, turning from net rotation ``before`` to ``turn`` (rad) with the
+        contact at ``d0`` mm on the jaw surely keeps the jaw on its convex stretch, the contact moving less
+        than half of ``jump`` (mm): a bridge there was not to be expected. ``at``: the starts' contacts at
+        ``before`` (mm; default: where the tracks put them)."""
+        if at is None:
+            at, _, _ = self.tracks.step(idx, before)
+        # surely clear: still so a little further on (the real part's convex stretch may end up to
+        # TURN_MARGIN before the model's)
+        further = turn + math.copysign(TURN_MARGIN, turn - before)
+        clear = np.ones(idx.size, dtype=bool)
+        for t in (turn, further):
+            land, node, ok = self.tracks.step(idx, t)
+            moved = land - at
+            clear &= ok & self.tracks.touches(land, d0 + moved, -self.jaw_margin, sure=True, node=node)
+            if t == turn:
+                clear &= np.abs(moved) < 0.5 * jump
+        out: BoolArray = clear
+        return out
 
     def regrasp(self, arc: float, turn: float, jaw: float | None = None) -> None:
         """The jaw was lifted and put back (e.g. slid along itself at the end of its span).
@@ -851,6 +897,7 @@ class ContactFilter:
         expect = self._expected_misfit(rows, hyps)  # (len(rows), hyps)
         e_all = expect.sum(axis=0)
         best_p = np.ones(hyps.size)
+        best_size = np.zeros(hyps.size)
         best_w: list[tuple[float, IntArray] | None] = [None] * hyps.size
         for a, inside in windows:
             chosen = [rows[i] for i in inside]
@@ -866,27 +913,42 @@ class ContactFilter:
             pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, 1.0), f_dist.sf(f_stat, kw, kr), 1.0)
             better = pv < best_p
             best_p = np.where(better, pv, best_p)
+            best_size = np.where(better, stretch, best_size)
             for i in np.flatnonzero(better):
                 best_w[i] = (a, inside)
         level = FIT_ALPHA / len(windows)
         if not np.all(best_p < level):
             return None
         a, inside = best_w[0]  # type: ignore[misc]
-        h = int(hyps[0])
-        present = []
-        for i in inside:
-            r = self._readings[rows[i]]
-            pos = int(np.searchsorted(r.live, h))
-            present.append(self.grid[h] + r.p[pos] / r.weight)
-        first = present[0]
-        rel = np.asarray(self.part.arc_offset(np.array(present), first))
-        lo, hi = first + float(rel.min()), first + float(rel.max())
+        chosen = [rows[i] for i in inside]
         return Misfit(
-            arcs=(float(self.part.wrap_arc(lo)), float(self.part.wrap_arc(hi))),
+            arcs=self._where(chosen, int(hyps[0])),
             travel=(float(a), float(a + self.defect_window)),
             p_value=float(best_p[0]),
-            start=float(self.grid[h]),
+            start=float(self.grid[int(hyps[0])]),
+            rows=tuple(chosen),
+            rms_mm=float(self.sd_position * math.sqrt(best_size[0])),
         )
+
+    def _best_stretch(self) -> tuple[int, ...]:
+        """The stretch (readings) whose absence most improves the best start's likelihood beyond what taking
+        out as many readings that fit would (half a unit of the quadratic form each, tempered)."""
+        rows = self._trusted()
+        best = -math.inf
+        s = self._solved(1.0)
+        top = float(np.max(s["ll"][s["live"]])) if s["live"].size else -math.inf
+        lam2 = float(np.median(s["lam2"])) if s["live"].size else 1.0
+        out: tuple[int, ...] = ()
+        for _, inside in self._windows(rows):
+            if inside.size < 3 or len(rows) - inside.size < FIT_MIN_READINGS:
+                continue
+            chosen = [rows[i] for i in inside]
+            sw = self._solve(1.0, without=self._stretch_sums(chosen))
+            ll = self._log_likelihood(sw, prune=False)
+            excess = float(np.max(ll)) - top - self.temper * 0.5 * inside.size * lam2
+            if excess > best:
+                best, out = excess, tuple(chosen)
+        return out
 
     def _expected_misfit(self, rows: list[int], hyps: IntArray) -> FloatArray:
         """Each reading's expected weighted misfit (in units of the told reading variance) under each start
@@ -1070,7 +1132,7 @@ class ContactFilter:
                 informative=True,
                 steps=self.steps,
                 consistent=False,
-                mismatch=self._misfit.arcs if self._misfit is not None else self._last_span,
+                mismatch=self._misfits[-1].arcs if self._misfits else self._last_span,
             )
         w = self.posterior()
         mean, sd = self.shift()
@@ -1087,18 +1149,27 @@ class ContactFilter:
             self._prune_under_every_prior()
         modes = self._modes(w, present, radius)
         # do the readings still fit the part? Tested every FIT_EVERY readings and before any sure stop,
-        # under the most probable start of each strong mode; a misfit, once found, stays
-        if self._misfit is None and (mass >= self.confidence or self.steps >= self._fit_next):
+        # under the most probable starts: a stretch that fits none of them is taken out of the
+        # likelihood (quarantined: it costs its readings, not the answer) and the belief asked again
+        if len(self._misfits) < MAX_QUARANTINE and (mass >= self.confidence or self.steps >= self._fit_next):
             self._fit_next = self.steps + FIT_EVERY
             # the most probable starts, and each strong mode's best: all of them must misfit
             strong = [m for m in modes if m.mass >= self.mode_floor][:3]
             top = np.argsort(w)[::-1][:FIT_STARTS]
             reps = [i] + [int(self.tracks.node_at(m.start_arc)) for m in strong[1:]]
             reps += [int(h) for h in top if w[h] > 0 and int(h) not in reps]
-            self._misfit = self.fit_test(reps)
+            found = self.fit_test(reps)
+            if found is not None:
+                # which stretch to take out: the one whose absence lets some start fit best, not
+                # necessarily the one the most probable start misfits (a wrong start that the stretch
+                # made probable would otherwise keep it and drop the rest)
+                rows = self._best_stretch()
+                self._misfits.append(found._replace(rows=rows) if rows else found)
+                self.set_quarantine(self._out | set(rows or found.rows))
+                return self.belief(radius)
         # sure only if sure without any one short stretch of the readings (a burr, a dent, debris):
         # asked only where it would decide, at the confidence
-        if mass >= self.confidence and self.defect_window > 0 and self._misfit is None:
+        if mass >= self.confidence and self.defect_window > 0:
             mass = min(mass, self.stretch_mass(map_arc, radius)[0])
         self._last_map = map_arc
         self._last_span = (map_arc, map_arc)
@@ -1113,7 +1184,8 @@ class ContactFilter:
             ambiguous=ambiguous,
             informative=informative,
             steps=self.steps,
-            mismatch=self._misfit.arcs if self._misfit is not None else None,
+            mismatch=self._where(list(self._misfits[0].rows), i) if self._misfits else None,
+            mismatch_mm=self._misfits[0].rms_mm if self._misfits else math.nan,
         )
 
     @property
@@ -1122,10 +1194,26 @@ class ContactFilter:
         return not bool(self._live.any())
 
     @property
-    def misfit(self) -> Misfit | None:
-        """Where the readings stopped fitting the part (:meth:`fit_test`), found by :meth:`belief`; None
-        while they fit."""
-        return self._misfit
+    def misfits(self) -> tuple[Misfit, ...]:
+        """The stretches of readings found not to fit the part (:meth:`fit_test`, asked by :meth:`belief`),
+        in the order found; the readings of each are quarantined (out of the likelihood)."""
+        return tuple(self._misfits)
+
+    def _where(self, rows: list[int], start: int) -> tuple[float, float]:
+        """The stretch of the model (arc positions, mm, counter-clockwise from first to last) the contact
+        covered over the readings ``rows`` if the rolling started at grid point ``start``."""
+        present = []
+        for j in rows:
+            r = self._readings[j]
+            pos = int(np.searchsorted(r.live, start))
+            if pos < r.live.size and r.live[pos] == start:
+                present.append(self.grid[start] + r.p[pos] / r.weight)
+        if not present:
+            return (math.nan, math.nan)
+        first = present[0]
+        rel = np.asarray(self.part.arc_offset(np.array(present), first))
+        lo, hi = first + float(rel.min()), first + float(rel.max())
+        return float(self.part.wrap_arc(lo)), float(self.part.wrap_arc(hi))
 
     def _mass_near(self, w: FloatArray, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> float:
         """Probability that the present contact is within ``radius`` mm of ``arc``: each start's (weight

@@ -7,7 +7,16 @@ experiments and the rolling step of its arm (0.2°, §IV).
 
 import math
 
-__all__ = ["LENGTH_TOL", "TURN_TOL", "MIN_SEPARATION", "SUCCESS_RADIUS", "ROLL_STEP", "FIT_ALPHA"]
+__all__ = [
+    "LENGTH_TOL",
+    "TURN_TOL",
+    "MIN_SEPARATION",
+    "SUCCESS_RADIUS",
+    "ROLL_STEP",
+    "FIT_ALPHA",
+    "PART_SCALE_SD",
+    "CALIBRATION_SCALE_SD",
+]
 
 #: The paper's tolerance on a segment's contact travel, mm.
 LENGTH_TOL = 0.004
@@ -23,3 +32,11 @@ ROLL_STEP = math.radians(0.2)
 #: χ² test's level (a real fit fails it once in 10 000 chains; a stuck encoder or a misread turn of
 #: degrees as radians fails it by hundreds of standard deviations).
 FIT_ALPHA = 1e-4
+#: The relative error of the straight jaw's contact-place calibration's scale (measured 0.1–0.5% on the
+#: simulated rig), one standard deviation.
+CALIBRATION_SCALE_SD = 0.003
+#: How much larger or smaller than its model a real part may be, relative, one standard deviation: a
+#: uniform scale of the part is a scale of every arc the rolling measures, which the filters carry with
+#: the calibration's as one nuisance (a part 2% off its drawing at two standard deviations: a worn
+#: die, a part cast to another shrinkage, a drawing at another revision's size).
+PART_SCALE_SD = 0.01

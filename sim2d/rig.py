@@ -19,7 +19,7 @@ from .noise import NoiseModel, load_noise
 from .quasistatic import QuasiStaticWorld
 from .sampled import SampledPart
 from .world import World
-from .world_part import Spikes, WorldChange, world_part
+from .world_part import Spikes, WorldChange, outstanding, world_part
 from .wrist import Wrist
 
 __all__ = ["SimRig"]
@@ -249,5 +249,8 @@ class SimRig(SimulatedArm):
         phi = float(self.model.tangent_angle(t)) + float(tilt)
         e = np.array([math.cos(phi), math.sin(phi)])
         m = np.array([-math.sin(phi), math.cos(phi)])
+        # off the real part, not the model: an operator jogs the jaw clear of what is there (a part made
+        # large, a burr under the start)
+        standoff = standoff + outstanding(self.model, self.part, arc)
         d = c - jaw_position * e - standoff * m
         return float(d[0]), float(d[1]), phi

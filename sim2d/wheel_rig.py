@@ -21,7 +21,7 @@ from ._errors import SimError
 from .arm import SimulatedArm
 from .noise import NoiseModel, load_noise
 from .wheel_world import WheelWorld
-from .world_part import Spikes, WorldChange, world_part
+from .world_part import Spikes, WorldChange, outstanding, world_part
 from .wrist import Wrist
 
 if TYPE_CHECKING:
@@ -88,7 +88,7 @@ class WheelRig(SimulatedArm):
         self.noise: NoiseModel = load_noise(noise)
         self.rng = np.random.default_rng(seed)
         self.change = WorldChange() if change is None else change
-        real = world_part(part, self.change, self.noise, self.rng)
+        real = self.part = world_part(part, self.change, self.noise, self.rng)
         self.spikes = Spikes(self.change, self.noise.v2_noise, seed)
         radius = wheel.radius if true_radius is None else float(true_radius)
         self.world: WheelWorld | PymunkWheelWorld
@@ -154,5 +154,6 @@ class WheelRig(SimulatedArm):
         than the wheel's radius off the part, the hand's axis pointing at that point."""
         p = np.asarray(self.model.point_at_arc(arc), dtype=float)
         theta = float(self.model.tangent_angle_at_arc(arc))
+        standoff = standoff + outstanding(self.model, self.part, arc)  # off the real part, not the model
         c = p + (self.wheel.radius + standoff) * np.array([math.sin(theta), -math.cos(theta)])
         return float(c[0]), float(c[1]), theta

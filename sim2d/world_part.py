@@ -49,6 +49,7 @@ __all__ = [
     "load_world",
     "world_part",
     "Spikes",
+    "outstanding",
     "MAX_WORLD_BYTES",
 ]
 
@@ -461,3 +462,15 @@ class Spikes:
             return 0.0
         self.count += 1
         return self.size if self._rng.uniform() < 0.5 else -self.size
+
+
+def outstanding(model: Part | Outline, real: Part | SampledPart, arc: float) -> float:
+    """How far the real part stands out of its model along the model's outward normal at ``arc`` (mm; 0
+    where the real part is the model machined, whose microns a rig's standoffs allow for): an operator
+    jogs the jaw clear of what is there (a part made large, a burr under the start)."""
+    if not (isinstance(real, SampledPart) and real.altered):
+        return 0.0
+    k = int(np.argmin(np.abs(np.asarray(model.arc_offset(real.arcs, arc)))))
+    theta = float(model.tangent_angle_at_arc(arc))
+    normal = np.array([math.sin(theta), -math.cos(theta)])
+    return float((real.xy[k] - np.asarray(model.point_at_arc(arc), dtype=float)) @ normal)

@@ -25,6 +25,8 @@ __all__ = [
     "emit_run",
     "print_run",
     "no_fit_line",
+    "mismatch_line",
+    "exit_status",
 ]
 
 
@@ -84,8 +86,51 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
 
 
 def belief_fields(b) -> dict:
-    """``estimate_arc``, ``mass``, ``ambiguous`` and ``informative`` of a belief, for a rolling's JSON object."""
-    return {"estimate_arc": b.map_arc, "mass": b.mass, "ambiguous": b.ambiguous, "informative": b.informative}
+    """``estimate_arc``, ``mass``, ``ambiguous``, ``informative``, ``consistent`` and ``mismatch`` of a belief,
+    for a rolling's JSON object. ``mismatch`` is null, or where on the model the part seems to differ from
+    it: ``{"from_arc", "to_arc"}`` (mm, counter-clockwise) and ``size_mm`` (how far the readings there are
+    off the model, or the jump the jaw made where the model has none; null if unknown)."""
+    mismatch = None
+    if b.mismatch is not None:
+        size = float(b.mismatch_mm)
+        lo, hi = (float(v) for v in b.mismatch)
+        mismatch = {
+            "from_arc": lo if math.isfinite(lo) else None,
+            "to_arc": hi if math.isfinite(hi) else None,
+            "size_mm": size if math.isfinite(size) else None,
+        }
+    return {
+        "estimate_arc": b.map_arc,
+        "mass": b.mass,
+        "ambiguous": b.ambiguous,
+        "informative": b.informative,
+        "consistent": bool(b.consistent),
+        "mismatch": mismatch,
+    }
+
+
+def mismatch_line(doc) -> str | None:
+    """The ending's line when the part seems not to be its model (``doc["mismatch"]``), else None."""
+    m = doc.get("mismatch")
+    if m is None:
+        if doc.get("consistent", True):
+            return None
+        return "MODEL MISMATCH: nothing on the part's model fits the readings; not localized"
+    size = "" if m.get("size_mm") is None else f", readings {m['size_mm']:.2f} mm off the model there"
+    where = (
+        f"near arc {m['from_arc']:.1f}–{m['to_arc']:.1f} mm"
+        if m["from_arc"] is not None
+        else "(where on the model could not be told: nothing fitted long enough)"
+    )
+    return (
+        f"MODEL MISMATCH {where}{size}: the part differs from its model "
+        "(a burr, a dent, debris, or another revision); the estimate is not to be trusted as sure"
+    )
+
+
+def exit_status(doc) -> int:
+    """2 when a rolling found the part not to be its model (:func:`mismatch_line`), else 0."""
+    return 2 if mismatch_line(doc) is not None else 0
 
 
 def truth_fields(part, b, rig) -> dict:
@@ -106,7 +151,8 @@ def print_reactive(doc) -> None:
 
 
 def print_belief(doc) -> None:
-    """The verdict, the other modes and the truth of a rolling's JSON object (either finger)."""
+    """The verdict, the other modes and the truth of a rolling's JSON object (either finger); a model
+    mismatch last, as the ending."""
     verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
     print(f"{verdict}: contact now at arc {doc['estimate_arc']:.3f} mm, {doc['mass']:.1%} within {SUCCESS_RADIUS} mm")
     for m in doc["modes"][1:3]:
@@ -117,6 +163,9 @@ def print_belief(doc) -> None:
             f"truth: {doc['true_arc']:.3f} mm, error {err:.3f} mm "
             f"({'success' if err < SUCCESS_RADIUS else 'failure'} at {SUCCESS_RADIUS} mm)"
         )
+    line = mismatch_line(doc)
+    if line is not None:
+        print(line)
 
 
 def run_summary(part, trace, loc) -> dict:

@@ -12,7 +12,15 @@ from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_fo
 from ..rig import RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
-from ._output import CONNECTING, RELEASED, belief_fields, ending_progress_line, print_belief, truth_fields
+from ._output import (
+    CONNECTING,
+    RELEASED,
+    belief_fields,
+    ending_progress_line,
+    exit_status,
+    print_belief,
+    truth_fields,
+)
 
 __all__ = [
     "wheel_policy",
@@ -85,7 +93,7 @@ def _emit(args, doc, part, run, out: str | None) -> int:
         print_wheel(doc)
         if out:
             print(f"readings written to {out}")
-    return 0
+    return exit_status(doc)
 
 
 def simulate_wheel(args, part, wheel: WheelJaw) -> int:
@@ -106,7 +114,10 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     noise = load_noise(args.noise)
     cal_rig = WheelRig(part, wheel, noise=noise, seed=args.seed + 1, engine=args.engine)
     calibration = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
-    rig = WheelRig(part, wheel, noise=noise, seed=args.seed, engine=args.engine)
+    from .simulated import world_change, world_fields
+
+    change = world_change(args, part)
+    rig = WheelRig(part, wheel, noise=noise, seed=args.seed, engine=args.engine, change=change)
     run = localize_with_wheel(
         rig,
         part,
@@ -117,6 +128,7 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
         pressing=pressing(args),
     )
     doc = wheel_doc(part, run, rig, calibration)
+    doc.update(world_fields(change, rig))
     trace = WheelTrace.from_run(
         run,
         calibration,

@@ -25,7 +25,16 @@ from ._options import (
     servo_arguments,
     step_degrees,
 )
-from ._output import CONNECTING, RELEASED, emit_run, ending_progress_line, print_reactive, run_reactive, run_summary
+from ._output import (
+    CONNECTING,
+    RELEASED,
+    emit_run,
+    ending_progress_line,
+    exit_status,
+    print_reactive,
+    run_reactive,
+    run_summary,
+)
 from ._wheel import calibrate_wheel_here, run_wheel
 
 __all__ = ["register", "calibrate_command", "run_command"]
@@ -223,4 +232,4 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
         print(json.dumps(doc, indent=2))
     else:
         print_reactive(doc)
-    return 0
+    return exit_status(doc)

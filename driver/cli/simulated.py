@@ -29,7 +29,7 @@ from ._options import (
     step_degrees,
     tcp_port,
 )
-from ._output import emit_run, print_reactive, run_reactive, run_summary
+from ._output import emit_run, exit_status, print_reactive, run_reactive, run_summary
 from ._wheel import simulate_wheel, wheel_rig
 
 __all__ = ["register", "simulate_command", "emulate_command"]
@@ -76,6 +76,18 @@ def register(sub) -> None:
         "roll on a drawing takes several times longer in pymunk)",
     )
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    world = sim.add_mutually_exclusive_group()
+    world.add_argument(
+        "--world",
+        metavar="FILE.toml",
+        help="a world whose part is not its model: a [world] table (defects, scale, spikes; as a study's, "
+        "drawn from --seed, defects near --start unless it says anywhere)",
+    )
+    world.add_argument(
+        "--world-part",
+        metavar="FILE",
+        help="the world's own part (a scan of the part, in the model's frame); the model is PART",
+    )
     sim.add_argument(
         "--step", type=step_degrees, default=STEP_DEG, metavar="DEG", help=f"rolling step, degrees (default {STEP_DEG})"
     )
@@ -139,13 +151,15 @@ def simulate_command(args) -> int:
     if not 0 <= args.start < part.perimeter:
         raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
     calibration = calibrate_simulated(part, noise, seed=args.seed + 1, engine=args.engine)
-    rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine)
+    change = world_change(args, part)
+    rig = SimRig(part, noise=noise, seed=args.seed, engine=args.engine, change=change)
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
     _check_reach(part, args.start, jaw_start)
     if args.reactive:
         doc, res = run_reactive(
             args, rig, part, calibration, rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0)
         )
+        doc.update(world_fields(change, rig))
         np.savez(
             args.out,
             arcs=np.array(res.arcs),
@@ -162,6 +176,7 @@ def simulate_command(args) -> int:
                         "seed": args.seed,
                         "engine": args.engine,
                         "start_arc": args.start,
+                        **world_fields(change, rig),
                     }
                 )
             ),
@@ -176,7 +191,7 @@ def simulate_command(args) -> int:
         if not args.json:
             print_reactive(doc)
             print(f"readings written to {args.out}")
-        return 0
+        return exit_status(doc)
     run = localize_by_rolling(
         rig,
         part,
@@ -204,11 +219,43 @@ def simulate_command(args) -> int:
         start_arc=args.start,
         rolls_deg=list(args.roll),
         step_deg=args.step,
+        **world_fields(change, rig),
     )
     trace.save(args.out)
     doc = run_summary(part, trace, run.localization)
+    doc.update(world_fields(change, rig))
     doc["trace"] = str(args.out)
     return emit_run(args, doc, part, trace, run.localization)
+
+
+def world_change(args, part):
+    """The world ``--world`` or ``--world-part`` describes for this run (None: the model as machined)."""
+    from localizer import load_part
+    from sim2d import WorldChange, load_world
+
+    if getattr(args, "world_part", None):
+        return WorldChange(part=load_part(args.world_part))
+    if getattr(args, "world", None):
+        spec = load_world(args.world)
+        if spec.world_parts:
+            raise UsageError(f"--world {args.world}: world_parts is a study's; give one part with --world-part")
+        return spec.draw(part, float(args.start), np.random.default_rng([int(args.seed) & 0xFFFFFFFF, 2]))
+    return None
+
+
+def world_fields(change, rig) -> dict:
+    """How the simulated world differed from its model, for a trace's metadata and the JSON output."""
+    if change is None:
+        return {}
+    return {
+        "world": {
+            "describe": change.describe(),
+            "defects": [{"arc": d.arc, "height_mm": d.height, "length_mm": d.length} for d in change.defects],
+            "scale": change.scale,
+            "part": None if change.part is None else change.part.name,
+            "spikes": rig.spikes.count,
+        }
+    }
 
 
 def _check_reach(part, start: float, jaw: float) -> None:

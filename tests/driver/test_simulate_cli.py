@@ -235,3 +235,25 @@ def test_the_two_roll_rule_runs_on_outlines(capsys, tmp_path):
     doc = json.loads(capsys.readouterr().out)
     ends = [c["end_arc"] for c in doc["candidates"]]
     assert rc == 0 and min(abs(bracket.arc_offset(e, pos[-1] % bracket.perimeter)) for e in ends) < 0.5
+
+
+def test_a_world_that_is_not_its_model_ends_in_a_mismatch(tmp_path, capsys):
+    # issue 29: --world draws a burr near --start; the ending names where and exits 2; the JSON says it too
+    world = tmp_path / "burr.toml"
+    world.write_text("[world]\ndefects = 1\ndefect_height_mm = 0.3\ndefect_length_mm = 4.0\ndefect_near_mm = 5.0\n")
+    out = tmp_path / "r.npz"
+    args = ["simulate", str(PARTS / "kidney.csv"), "--start", "40", "--reactive", "--noise", "paper"]
+    args += ["--engine", "kinematic", "--seed", "1", "--world", str(world), "--out", str(out)]
+    assert main(args) == 2
+    text = capsys.readouterr().out
+    assert "MODEL MISMATCH" in text
+    assert main([*args, "--json"]) == 2
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["stopped"] == "mismatch" and doc["mismatch"] is not None
+    assert doc["world"]["defects"][0]["height_mm"] == 0.3 and abs(doc["world"]["defects"][0]["arc"] - 40) <= 5
+    meta = json.loads(str(np.load(out)["metadata"]))
+    assert meta["world"]["describe"].startswith("a 0.3 mm bump")
+    # the world's own part, and the two flags together refused by argparse
+    with pytest.raises(SystemExit):
+        main([*args, "--world-part", str(PARTS / "kidney.csv")])
+    capsys.readouterr()

@@ -1,0 +1,139 @@
+"""A part that is not its model (issue 29): the grid filter's quarantine, fit test and stretch envelope."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from localizer import ContactFilter, load_part
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+STEP = math.radians(0.2)
+
+
+@pytest.fixture(scope="module")
+def cam():
+    return load_part(PARTS / "cam.json")
+
+
+@pytest.fixture(scope="module")
+def kidney():
+    return load_part(PARTS / "kidney.csv")
+
+
+def exact(flt, start_arc, turns):
+    """The cumulative arc a true start would give, from the filter's own tracks."""
+    i = int(round(start_arc / flt.tracks.h)) % flt.grid.size
+    arcs, ok = flt.tracks.advance(np.full(len(turns), i), np.asarray(turns))
+    assert ok.all()
+    return arcs - flt.grid[i], arcs
+
+
+def noisy(z, rng, sd):
+    e = sd * rng.standard_normal(len(z) + 1)
+    return z + e[1:] - e[0]
+
+
+def test_a_quarantined_reading_is_as_if_never_taken(cam):
+    # without the terms whose weights depend on the order of the readings (drift, the rotation reading's
+    # error) a filter given all readings and then told to distrust some holds exactly the likelihood of
+    # one that never saw them
+    plain = {"sd_turn": 0.0, "sd_drift": 0.0, "sd_slope": 0.0, "prune": math.inf, "defect_window": 0.0}
+    rng = np.random.default_rng(1)
+    turns = STEP * np.arange(1, 121)
+    a = ContactFilter(cam, **plain)
+    z, _ = exact(a, 80.0, turns)
+    z = noisy(z, rng, 0.035)
+    for k in range(turns.size):
+        a.update(float(z[k]), float(turns[k]))
+    before = a.log_likelihood()
+    out = set(range(40, 61))
+    a.set_quarantine(out)
+    b = ContactFilter(cam, **plain)
+    for k in range(turns.size):
+        if k + 1 not in out:  # reading 0 is the start; update k is reading k + 1
+            b.update(float(z[k]), float(turns[k]))
+    la, lb = a.log_likelihood(), b.log_likelihood()
+    live = np.isfinite(lb)
+    np.testing.assert_allclose(la[live] - la[live].max(), lb[live] - lb[live].max(), atol=1e-7)
+    a.set_quarantine(set())  # and trusted again: back to the first
+    np.testing.assert_allclose(a.log_likelihood()[live], before[live], atol=1e-7)
+
+
+def test_clean_readings_fit(kidney):
+    # 20 noisy rolls of 60° over the kidney's convex lobe at the noise the filter was told, and at
+    # twice it not told: the fit test finds nothing
+    turns = -STEP * np.arange(1, 301)
+    for seed in range(20):
+        for sd in (0.035, 0.07):
+            flt = ContactFilter(kidney, spacing=0.05)
+            z, _ = exact(flt, 29.3, turns)
+            z = noisy(z, np.random.default_rng(seed), sd)
+            for k in range(turns.size):
+                flt.update(float(z[k]), float(turns[k]))
+            truth = int(round(29.3 / flt.tracks.h))
+            assert flt.fit_test([truth]) is None, (seed, sd)
+
+
+def test_a_stretch_off_the_model_is_found_where_it_is(kidney):
+    # a burr's readings: over 3 mm of the roll the contact lags the model's by up to 0.8 mm and comes
+    # back (the jaw pivots on the crest, then jumps on): the fit test names that stretch, and the
+    # belief quarantines it and says where, never sure
+    turns = -STEP * np.arange(1, 301)
+    flt = ContactFilter(kidney, spacing=0.05)
+    z, arcs = exact(flt, 29.3, turns)
+    z = noisy(z, np.random.default_rng(7), 0.035)
+    travel = np.abs(z)
+    lag = np.where((travel > 12.0) & (travel < 15.0), 0.8 * np.sin(np.pi * (travel - 12.0) / 3.0), 0.0)
+    z = z + lag  # rolling clockwise: z falls, a lag raises it
+    for k in range(turns.size):
+        flt.update(float(z[k]), float(turns[k]))
+    truth = int(round(29.3 / flt.tracks.h))
+    found = flt.fit_test([truth])
+    assert found is not None and found.p_value < 1e-6 and found.rms_mm > 0.1
+    on_burr = arcs[lag != 0]
+    lo, hi = found.arcs
+    assert lo - 2.0 <= float(np.mean(on_burr)) <= hi + 2.0
+    b = flt.belief()
+    assert b.mismatch is not None and flt.misfits and not b.sure(0.95)
+
+
+def test_no_belief_rests_on_one_short_stretch(cam):
+    # 30 readings over one millimetre of the cam: sure by the readings alone, but a burr's crest would read
+    # the same anywhere, so without that stretch nothing is known
+    turns = STEP * np.arange(1, 31)
+    flt = ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0)
+    z, _ = exact(flt, 57.3, turns)
+    for k in range(turns.size):
+        flt.update(float(z[k]), float(turns[k]))
+    ungarded = ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0, defect_window=0.0)
+    for k in range(turns.size):
+        ungarded.update(float(z[k]), float(turns[k]))
+    assert ungarded.belief().mass > 0.95
+    mass, (lo, hi) = flt.stretch_mass(ungarded.belief().map_arc)
+    assert mass < 0.5 and lo <= 0.0 <= hi
+    assert flt.belief().mass < 0.95
+
+
+def test_when_nothing_fits_the_belief_says_so(cam):
+    flt = ContactFilter(cam)
+    flt.update(0.1, STEP)
+    flt.feasible[:] = False
+    flt._live[:] = False  # every start ruled out (a turn no convex stretch takes)
+    flt._live_idx = np.flatnonzero(flt._live)
+    b = flt.belief()
+    assert flt.ruled_out and not b.consistent and b.mass == 0.0 and not b.sure(0.5)
+
+
+def test_a_bridge_no_place_predicts_is_unexplained(kidney):
+    # rolling clockwise from the convex lobe: a bridge after 10° is predicted by no start the readings
+    # leave (the lobe goes on), and the true start does not explain it
+    turns = -STEP * np.arange(1, 51)
+    flt = ContactFilter(kidney, spacing=0.05)
+    z, _ = exact(flt, 29.3, turns)
+    for k in range(turns.size):
+        flt.update(float(z[k]), float(turns[k]), jaw=-40.0 - float(z[k]))
+    predicted = flt.bridged(float(turns[-1] - STEP))
+    truth = int(round(29.3 / flt.tracks.h))
+    assert predicted < 0.01 and len(flt.unexplained_bridges(truth)) == 1
