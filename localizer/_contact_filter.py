@@ -178,6 +178,9 @@ DEFECT_WINDOW = 12.0
 #: The prior standard deviation of the scale of every measured arc against the model's: the
 #: calibration's and the part's own (module notes, "A part that is not its model").
 SCALE_SD = math.hypot(CALIBRATION_SCALE_SD, PART_SCALE_SD)
+#: How far below the best start, nats, a start is still weighed when a stretch of the readings is left
+#: out (:meth:`ContactFilter.stretch_mass`).
+STRETCH_SPAN = 30.0
 #: Readings a fit test needs outside the stretch it judges (fewer cannot tell misfit from noise).
 FIT_MIN_READINGS = 20
 #: Readings between two fit tests while the belief is not sure (a test before every sure stop too).
@@ -488,6 +491,8 @@ class ContactFilter:
         # predictions, its arc and turn; and the readings taken out again (quarantine)
         self._readings: list[_Reading] = []
         self._out: set[int] = set()
+        self._stretch_cache: tuple[Any, float] = (None, 1.0)  # (state, least mass without a stretch)
+        self._fit_version = -1  # the state of the readings the last fit test judged
         self._misfits: list[Misfit] = []  # stretches found not to fit, quarantined (the first MAX_QUARANTINE)
         self._fit_next = FIT_EVERY
         self._last_map = math.nan
@@ -834,9 +839,12 @@ class ContactFilter:
         at = np.arange(live.size)
         touched = np.zeros(m, dtype=bool)
         szz = 0.0
+        where: dict[int, IntArray] = {}  # the live hypotheses' places in each set of hypotheses live then
         for j in rows:
             r = self._readings[j]
-            pos = np.searchsorted(r.live, live)
+            pos = where.get(id(r.live))
+            if pos is None:
+                pos = where[id(r.live)] = np.searchsorted(r.live, live)
             add_row(out.up, out.uu, out.uz, out.spp, out.szp, touched, r.cols, r.vals, at, r.p[pos], r.z)
             szz += r.z * r.z
         return out._replace(szz=szz)
@@ -954,14 +962,19 @@ class ContactFilter:
         """Each reading's expected weighted misfit (in units of the told reading variance) under each start
         ``hyps``: the reading's own error and the rotation reading's, ρ·sd_turn with ρ the start's radius
         of curvature at its contact then, times the weight the reading was given."""
-        out = np.empty((len(rows), hyps.size))
+        here = np.empty((len(rows), hyps.size))
+        weight = np.empty(len(rows))
+        where: dict[int, IntArray] = {}
         for n, j in enumerate(rows):
             r = self._readings[j]
-            pos = np.searchsorted(r.live, hyps)
-            here = self.grid[hyps] + r.p[pos] / r.weight
-            kappa = self.tracks.kappa[self.tracks.node_at(here)]
-            rho = np.where(kappa > 0, 1.0 / np.maximum(kappa, 1.0 / RHO_MAX), RHO_MAX)
-            out[n] = r.weight**2 * (1.0 + (rho * self.sd_turn / self.sd_position) ** 2)
+            pos = where.get(id(r.live))
+            if pos is None:
+                pos = where[id(r.live)] = np.searchsorted(r.live, hyps)
+            here[n] = r.p[pos] / r.weight
+            weight[n] = r.weight
+        kappa = self.tracks.kappa[self.tracks.node_at(self.grid[hyps][None, :] + here)]
+        rho = np.where(kappa > 0, 1.0 / np.maximum(kappa, 1.0 / RHO_MAX), RHO_MAX)
+        out: FloatArray = weight[:, None] ** 2 * (1.0 + (rho * self.sd_turn / self.sd_position) ** 2)
         return out
 
     def stretch_mass(self, arc: float, radius: float | None = None) -> tuple[float, tuple[float, float]]:
@@ -974,23 +987,32 @@ class ContactFilter:
         readings of a short stretch alone can look like another place of the part. The belief is sure
         only where it stays sure without any one such stretch (module notes, "A part that is not its
         model"). Each stretch is taken out exactly (the marginalisation without its sums); the windows
-        overlap by three quarters, so a stretch up to three quarters of a window lies inside one.
+        overlap by three quarters, so a stretch up to three quarters of a window lies inside one. The
+        starts weighed are those within :data:`STRETCH_SPAN` nats of the best (a stretch's readings
+        that some start misfits by more are not what made the belief sure); the stretches are tried
+        fullest first, and the search stops at the first that leaves less than the confidence (the
+        mass returned is then that one's: the belief is not sure, which is what the least decides).
         """
         radius = self.radius if radius is None else float(radius)
         rows = self._trusted()
         if not rows or self.defect_window <= 0:
             return 1.0, (math.nan, math.nan)
+        ll_all = self._solved(1.0)["ll"]
+        hyps = np.flatnonzero(ll_all >= np.max(ll_all) - STRETCH_SPAN)
         worst, where = 1.0, (math.nan, math.nan)
-        for a, inside in self._windows(rows):
-            s = self._solve(1.0, without=self._stretch_sums([rows[i] for i in inside]))
+        for a, inside in sorted(self._windows(rows), key=lambda w: -w[1].size):
+            s = self._solve(1.0, without=self._stretch_sums([rows[i] for i in inside], hyps), hyps=hyps)
             s["ll"] = self._log_likelihood(s, prune=False)
-            ll = s["ll"]
+            ll = s["ll"][hyps]
             wts = np.exp(ll - ll.max())
             wts /= wts.sum()
             mean, sd = self._shift_of(s)
-            mass = self._mass_near(wts, self.part.wrap_arc(self.current + mean), sd, arc, radius)
+            present = self.part.wrap_arc(self.current[hyps] + mean[hyps])
+            mass = self._mass_near(wts, present, sd[hyps], arc, radius)
             if mass < worst:
                 worst, where = mass, (a, a + self.defect_window)
+            if worst < self.confidence:
+                break
         return worst, where
 
     def _log_likelihood(self, s: dict[str, Any], prune: bool = True) -> FloatArray:
@@ -1148,11 +1170,21 @@ class ContactFilter:
         if self.slope_envelope:
             self._prune_under_every_prior()
         modes = self._modes(w, present, radius)
-        # do the readings still fit the part? Tested every FIT_EVERY readings and before any sure stop,
+        # sure only if sure without any one short stretch of the readings (a burr, a dent, debris):
+        # asked only where it would decide, at the confidence, once per state of the readings
+        if mass >= self.confidence and self.defect_window > 0:
+            key = (self._version, radius, map_arc)
+            if self._stretch_cache[0] != key:
+                self._stretch_cache = (key, self.stretch_mass(map_arc, radius)[0])
+            mass = min(mass, self._stretch_cache[1])
+        # do the readings still fit the part? Tested every FIT_EVERY readings and before a sure stop,
         # under the most probable starts: a stretch that fits none of them is taken out of the
         # likelihood (quarantined: it costs its readings, not the answer) and the belief asked again
-        if len(self._misfits) < MAX_QUARANTINE and (mass >= self.confidence or self.steps >= self._fit_next):
+        if len(self._misfits) < MAX_QUARANTINE and (
+            (mass >= self.confidence and self._fit_version != self._version) or self.steps >= self._fit_next
+        ):
             self._fit_next = self.steps + FIT_EVERY
+            self._fit_version = self._version
             # the most probable starts, and each strong mode's best: all of them must misfit
             strong = [m for m in modes if m.mass >= self.mode_floor][:3]
             top = np.argsort(w)[::-1][:FIT_STARTS]
@@ -1167,10 +1199,6 @@ class ContactFilter:
                 self._misfits.append(found._replace(rows=rows) if rows else found)
                 self.set_quarantine(self._out | set(rows or found.rows))
                 return self.belief(radius)
-        # sure only if sure without any one short stretch of the readings (a burr, a dent, debris):
-        # asked only where it would decide, at the confidence
-        if mass >= self.confidence and self.defect_window > 0:
-            mass = min(mass, self.stretch_mass(map_arc, radius)[0])
         self._last_map = map_arc
         self._last_span = (map_arc, map_arc)
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
