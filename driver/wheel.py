@@ -213,8 +213,9 @@ class WheelRun:
         Arc rolled, both ways counted.
     steps : int
     stopped : str
-        "confident", "max_rotation", "max_arc" or "blocked" (jumps both ways, or nothing fitting
-        after :data:`MAX_RESTARTS` fresh starts); slip beyond the
+        "confident", "max_rotation", "max_arc", "blocked" (jumps both ways) or "mismatch" (a stretch of the
+        readings fits no probable place, or nothing fits after :data:`MAX_RESTARTS` fresh starts: the part
+        is not its model, ``belief.mismatch`` says where when it can); slip beyond the
         policy's limit raises :class:`WheelSlip` instead.
     reversals, jumps : int
     slip : float, mm
@@ -569,6 +570,9 @@ def localize_with_wheel(
             history.append((rotation, belief.map_arc, belief.mass, truths[-1]))
             if observer is not None:
                 observer({"event": "belief", "rotation": rotation, "arc": arc, "belief": belief})
+            if belief.mismatch is not None:
+                stopped = "mismatch"  # a stretch of the readings fits no probable place: never sure
+                break
             if belief.mass >= pol.confidence:
                 stopped = "confident"
                 break
@@ -599,8 +603,11 @@ def localize_with_wheel(
         if arc >= max_arc:
             stopped = "max_arc"
             break
+    final = flt.belief()
+    if stopped != "confident" and (final.mismatch is not None or not final.consistent):
+        stopped = "mismatch"
     return WheelRun(
-        belief=flt.belief(),
+        belief=final,
         rotation=rotation,
         arc=arc,
         steps=steps,

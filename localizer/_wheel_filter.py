@@ -52,9 +52,18 @@ import math
 import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.stats import chi2
+from scipy.stats import f as f_dist
 
 from ._belief import Belief, belief_flags, find_modes
-from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
+from ._contact_filter import (
+    BRIDGE_MISS,
+    CONTRADICTION,
+    DEFECT_WINDOW,
+    FIT_MIN_READINGS,
+    FIT_RATIO,
+    FIT_STARTS,
+    TEMPER,
+)
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
@@ -82,6 +91,8 @@ WHEEL_NOISE_SCALES = (1.0, 2.0)
 #: The error model's factor under which some start must fit the readings for any belief to be stated:
 #: the noisiest level the filter is meant to be trusted at (four times the `paper` preset).
 WHEEL_FIT_SCALE = 4.0
+#: Readings used (one a millimetre) between two fit tests while the belief is not sure.
+WHEEL_FIT_EVERY = 10
 
 
 class WheelFilter:
@@ -197,6 +208,9 @@ class WheelFilter:
         self.current = 0.0
         self.span = (0.0, 0.0)
         self.steps = 0
+        self._zz: list[FloatArray] = []
+        self._misfit: tuple[tuple[float, float], float] | None = None  # (stretch on the model, p-value)
+        self._fit_at = 0  # readings used at the last fit test
 
     def _cov(self, a: FloatArray, b: FloatArray) -> FloatArray:
         """Covariance of the shared errors of residuals at arcs ``a`` and ``b`` (mm) rolled from the start."""
@@ -232,6 +246,7 @@ class WheelFilter:
         var = d2 + extra
         z = (rho - self._z @ ell) / np.sqrt(var)
         self._quad += z**2
+        self._zz.append(z**2)  # each start's misfit of this reading, for the fit test
         self._logdet += np.log(var)
         self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
         self._z = np.column_stack([self._z, z * np.sqrt(var / d2)])  # whitened by the shared part alone
@@ -303,6 +318,20 @@ class WheelFilter:
         consistent = self.consistent()
         if not consistent:
             mass = 0.0
+        # do the readings still fit? Before a sure stop, and every FIT_EVERY readings used: a stretch of
+        # the rolled arc that no probable start explains is a part that is not its model (a burr the wheel
+        # rode over, a dent it dipped into): said where, and never sure
+        used = len(self.L_used)
+        if (
+            consistent
+            and self._misfit is None
+            and used > self._fit_at
+            and (mass >= self.confidence or used >= self._fit_at + WHEEL_FIT_EVERY)
+        ):
+            self._fit_at = used
+            top = [int(h) for h in np.argsort(w)[::-1][:FIT_STARTS] if w[h] > 0]
+            self._misfit = self.fit_test(top)
+        mismatch = self._misfit[0] if self._misfit is not None else None
         modes = find_modes(self.part, w, present, self.grid, radius)
         prior = self.prior / self.prior.sum()
         informative, ambiguous = belief_flags(w, prior, modes, self.mode_floor, self.confidence)
@@ -315,7 +344,46 @@ class WheelFilter:
             informative=informative,
             steps=self.steps,
             consistent=consistent,
+            mismatch=mismatch,
         )
+
+    def fit_test(self, starts: list[int]) -> tuple[tuple[float, float], float] | None:
+        """Whether the readings used still fit the part under each of the starts (grid indices): for each
+        stretch of :data:`~localizer.DEFECT_WINDOW` mm of rolled arc, its readings' whitened misfit per
+        reading against the rest's (an F ratio, as the straight jaw's :meth:`ContactFilter.fit_test`: at
+        least FIT_RATIO times the rest and the told noise, Bonferroni-corrected at FIT_ALPHA). None when
+        some start fits every stretch; else the stretch on the model under the first start, and its
+        p-value."""
+        k = len(self.L_used)
+        if k < FIT_MIN_READINGS or not starts:
+            return None
+        zz = np.array(self._zz)[:, starts]  # (readings, starts)
+        rolled = np.array(self.L_used)
+        w = DEFECT_WINDOW
+        windows = []
+        for a in np.arange(float(rolled.min()) - 0.75 * w, float(rolled.max()) + 1e-9, 0.25 * w):
+            inside = (rolled >= a) & (rolled <= a + w)
+            if 3 <= inside.sum() <= k - FIT_MIN_READINGS:
+                windows.append((float(a), inside))
+        if not windows:
+            return None
+        best = np.ones(len(starts))
+        where: list[float] = [math.nan] * len(starts)
+        for a, inside in windows:
+            kw = int(inside.sum())
+            stretch = zz[inside].mean(axis=0)
+            rest = np.maximum(zz[~inside].mean(axis=0), 1e-12)
+            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, 1.0), f_dist.sf(stretch / rest, kw, k - kw), 1.0)
+            better = pv < best
+            best = np.where(better, pv, best)
+            for i in np.flatnonzero(better):
+                where[i] = a
+        if not np.all(best < FIT_ALPHA / len(windows)):
+            return None
+        s0 = float(self.grid[starts[0]])
+        lo = s0 + max(where[0], float(rolled.min()))
+        hi = s0 + min(where[0] + w, float(rolled.max()))
+        return (float(self.part.wrap_arc(lo)), float(self.part.wrap_arc(hi))), float(best[0])
 
     def consistent(self) -> bool:
         """Whether some start the wheel can touch fits the readings used, under :data:`WHEEL_FIT_SCALE`
