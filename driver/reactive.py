@@ -45,7 +45,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from localizer import ROLL_STEP, Belief, Boundary, ContactFilter, arc_from_jaw_positions
+from localizer import ROLL_STEP, UNEXPLAINED, Belief, Boundary, ContactFilter, arc_from_jaw_positions
 
 from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
 from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
@@ -64,8 +64,6 @@ __all__ = [
 CONFIRM = 1
 #: Probability within the success radius that stops the rolling.
 CONFIDENCE = 0.95
-#: A bridge the belief gave less than this probability is one the part's model does not explain.
-UNEXPLAINED_BRIDGE = 0.01
 #: How many times a run rolls through such a jump to leave what the jaw sat on (module notes, rule 8):
 #: once, off the thing under the start; a second would be a real concavity the belief misjudged.
 MAX_LEAVES = 1
@@ -306,6 +304,7 @@ class _Roller:
         # a jump no place of the model explains since the filter last started, and the jumps the jaw
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
+        self.unexplained_way = {1: False, -1: False}
         self.left: list[tuple[int, float]] = []
         self.segment_base = 0  # segments of the filters before a restart
         self.rereads = 0  # readings taken again because one jumped
@@ -506,7 +505,9 @@ class _Roller:
         if not slid_off:
             # evidence: the starts under which this turn keeps the jaw clear are less likely
             predicted = flt.bridged(self.turn_now(), jump=p.bridge_jump)
-            self.unexplained |= predicted < UNEXPLAINED_BRIDGE
+            if predicted < UNEXPLAINED:
+                self.unexplained_way[self.direction] = True
+                self.unexplained = True
         self.hand.rotate_by(-s)
         self.rotation += p.step
         try:
@@ -521,7 +522,11 @@ class _Roller:
         flt.regrasp(self.z, self.turn_now(), self.d_prev)
         self.blocked[self.direction] = True
         if self.blocked[-self.direction]:
-            if self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
+            # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else (on
+            # a spline: a drawing's corners and faces make jumps of their own that the belief judges less
+            # well, issue 30)
+            spline = not flt.tracks.has_faces and not flt.part.corners
+            if spline and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
                 return self._leave(s, d - self.d_prev)
             return "blocked"
         self.direction = -self.direction
@@ -560,6 +565,7 @@ class _Roller:
         self.explored = [0.0, 0.0]
         self.blocked = {1: False, -1: False}
         self.unexplained = False
+        self.unexplained_way = {1: False, -1: False}
         self.belief = None
         self.arcs.append(self.z)
         self.turns.append(self.turn)
@@ -582,11 +588,18 @@ class _Roller:
             s0 = float(flt.grid[start])
             ends = (s0 - direction * (abs(jump) + 1.0), s0)
             lo = ends[0] if direction > 0 else ends[1]
+            # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
+            # explains it (a bridge the belief of the time misjudged), a convex stretch does not
+            between = flt.tracks.node_at(np.linspace(lo, lo + abs(jump) + 1.0, 32))
+            if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
+                return None
             if belief.mass < 0.5:  # left, but not localized since: where it left is not known
                 return (math.nan, math.nan), abs(jump)
             return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
         missed = flt.unexplained_bridges(start)
-        if self.unexplained and belief.mass < 0.5:
+        if flt.tracks.has_faces or flt.part.corners:
+            missed = []  # a drawing's corners and faces jump of their own (issue 30): not judged here
+        elif self.unexplained and belief.mass < 0.5:
             # jumps nothing on the model explains, and no place known well enough to say where
             return (math.nan, math.nan), math.nan
         if missed and belief.mass >= 0.5:

@@ -13,6 +13,7 @@ from ._contact_filter import (
     SCALE_SD,
     SLOPE_ENVELOPE,
     TEMPER,
+    UNEXPLAINED,
     ContactFilter,
     Misfit,
 )
@@ -73,6 +74,7 @@ __all__ = [
     "CALIBRATION_SCALE_SD",
     "SCALE_SD",
     "DEFECT_WINDOW",
+    "UNEXPLAINED",
     "Misfit",
     "MAX_PART_BYTES",
     "check_size",

@@ -348,7 +348,7 @@ class WheelFilter:
         )
 
     def fit_test(self, starts: list[int]) -> tuple[tuple[float, float], float] | None:
-        """Whether the readings used still fit the part under each of the starts (grid indices): for each
+        """Whether the readings used still fit the part under each of the ``starts`` (grid indices): for each
         stretch of :data:`~localizer.DEFECT_WINDOW` mm of rolled arc, its readings' whitened misfit per
         reading against the rest's (an F ratio, as the straight jaw's :meth:`ContactFilter.fit_test`: at
         least FIT_RATIO times the rest and the told noise, Bonferroni-corrected at FIT_ALPHA). None when

