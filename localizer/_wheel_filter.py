@@ -62,6 +62,7 @@ from ._contact_filter import (
     FIT_MIN_READINGS,
     FIT_RATIO,
     FIT_STARTS,
+    FIT_WIDTH,
     TEMPER,
 )
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
@@ -349,7 +350,7 @@ class WheelFilter:
 
     def fit_test(self, starts: list[int]) -> tuple[tuple[float, float], float] | None:
         """Whether the readings used still fit the part under each of the ``starts`` (grid indices): for each
-        stretch of :data:`~localizer.DEFECT_WINDOW` mm of rolled arc, its readings' whitened misfit per
+        stretch of twice :data:`~localizer.DEFECT_WINDOW` mm of rolled arc, its readings' whitened misfit per
         reading against the rest's (an F ratio, as the straight jaw's :meth:`ContactFilter.fit_test`: at
         least FIT_RATIO times the rest and the told noise, Bonferroni-corrected at FIT_ALPHA). None when
         some start fits every stretch; else the stretch on the model under the first start, and its
@@ -359,7 +360,7 @@ class WheelFilter:
             return None
         zz = np.array(self._zz)[:, starts]  # (readings, starts)
         rolled = np.array(self.L_used)
-        w = DEFECT_WINDOW
+        w = DEFECT_WINDOW * FIT_WIDTH
         windows = []
         for a in np.arange(float(rolled.min()) - 0.75 * w, float(rolled.max()) + 1e-9, 0.25 * w):
             inside = (rolled >= a) & (rolled <= a + w)
