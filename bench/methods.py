@@ -157,19 +157,24 @@ def _mass(part, candidates, best, radius: float) -> float:
     )
 
 
+def broken_rule(text: str) -> dict:
+    """The study's own columns of a localizer rule that failed, or had no rolls to take: ``text`` why."""
+    return {
+        "estimate_arc": math.nan,
+        "error_mm": math.inf,
+        "candidates": 0,
+        "probability": 0.0,
+        "ambiguous": 0,
+        "mass": "",
+        "failure": text,
+    }
+
+
 def score_rule(study, part, rolls, rule: str, true_arc: float, cache: dict) -> dict:
     """The localizer's ``rule`` on the fixed rolls: the study's own columns, and a method's cells."""
     loc = _localize(study, part, rolls, rule, cache)
     if isinstance(loc, Exception):
-        return {
-            "estimate_arc": math.nan,
-            "error_mm": math.inf,
-            "candidates": 0,
-            "probability": 0.0,
-            "ambiguous": 0,
-            "mass": "",
-            "failure": f"{type(loc).__name__}: {loc}"[:200],
-        }
+        return broken_rule(f"{type(loc).__name__}: {loc}"[:200])
     best = loc.best
     if best is None:
         return {

@@ -602,7 +602,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
     from driver.rig import RigError
     from sim2d import SimRig
 
-    from .methods import JAW_START, score_methods, score_rule
+    from .methods import JAW_START, broken_rule, score_methods, score_rule
 
     s = spec.study
     t0 = time.perf_counter()
@@ -615,20 +615,24 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
         candidates, tracks = start_sampler(part, rolls, jaw_start)
         if candidates.size == 0:
             raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")
+
+        def roll_fixed(rig, start: float):
+            return roll_sequence(
+                rig,
+                rolls,
+                calibration=cal,
+                step=math.radians(s.step_deg),
+                approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0),
+                faces=part.faces if isinstance(part, Outline) else (),
+            )
+
         run = None
         for restarts in range(20):  # noqa: B007 (the count is reported after the loop)
             start = float(part.wrap_arc(tracks.sigma[int(rng.choice(candidates))] + rng.uniform(-0.5, 0.5) * tracks.h))
             rig_seed = int(rng.integers(1 << 31))
             rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine)
             try:
-                run = roll_sequence(
-                    rig,
-                    rolls,
-                    calibration=cal,
-                    step=math.radians(s.step_deg),
-                    approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0),
-                    faces=part.faces if isinstance(part, Outline) else (),
-                )
+                run = roll_fixed(rig, start)
             except RigError:
                 continue
             if laid_off(part, run[0].truth[0].contact_arc, start):
@@ -644,14 +648,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
         if change is not None and change.differs:
             rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine, change=change)
             try:
-                run = roll_sequence(
-                    rig,
-                    rolls,
-                    calibration=cal,
-                    step=math.radians(s.step_deg),
-                    approach_pose=rig.approach_pose(start, jaw_position=jaw_start, standoff=1.0),
-                    faces=part.faces if isinstance(part, Outline) else (),
-                )
+                run = roll_fixed(rig, start)
             except RigError as exc:
                 run, fixed_failure = None, f"the fixed rolls on the world's part: {type(exc).__name__}: {exc}"[:200]
     except Exception as exc:  # the trial broke before any method could run: every method's failure
@@ -702,7 +699,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
         }
     )
     rules: dict = {}
-    own = score_rule(s, part, run, rule, true_arc, rules) if run is not None else _broken(fixed_failure)
+    own = score_rule(s, part, run, rule, true_arc, rules) if run is not None else broken_rule(fixed_failure)
     row.update(
         {
             "estimate_arc": own["estimate_arc"],
@@ -750,17 +747,4 @@ def world_cells(change, spikes: int | str = "") -> dict:
         "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
         "world_scale": change.scale,
         "world_spikes": spikes,
-    }
-
-
-def _broken(text: str) -> dict:
-    """The study's own columns of a localizer rule that had no rolls to take."""
-    return {
-        "estimate_arc": math.nan,
-        "error_mm": math.inf,
-        "candidates": 0,
-        "probability": 0.0,
-        "ambiguous": 0,
-        "mass": "",
-        "failure": text,
     }

@@ -197,7 +197,27 @@ def plot_reactive(part, run, path, *, true_arcs=None) -> None:
         ax.plot(xy[:, 0], xy[:, 1], ".", color="tab:blue", ms=2, label="the contact while rolling (truth)")
         ax.plot(*part.point_at_arc(truth[-1]), "o", color="tab:blue", ms=7, mfc="none", label="true contact now")
     b = run.belief
+    mismatch = getattr(b, "mismatch", None)
+    if mismatch is not None and all(np.isfinite(mismatch)):
+        # where the part seems to differ from its model: the stretch, and a marker that reads at any zoom
+        lo, hi = (float(v) for v in mismatch)
+        span = float(part.arc_offset(hi, lo)) % part.perimeter
+        stretch = part.point_at_arc(part.wrap_arc(lo + np.linspace(0.0, span, 64)))
+        size = getattr(b, "mismatch_mm", float("nan"))
+        how = f", {size:.2f} mm off" if np.isfinite(size) else ""
+        ax.plot(stretch[:, 0], stretch[:, 1], "-", color="tab:orange", lw=6, alpha=0.7, solid_capstyle="round")
+        ax.plot(
+            *stretch[len(stretch) // 2],
+            "X",
+            color="tab:orange",
+            ms=12,
+            mec="black",
+            label=f"model mismatch, arc {lo:.1f}–{hi:.1f} mm{how}",
+        )
     est = part.point_at_arc(b.map_arc)
-    ax.plot(*est, "*", color="tab:red", ms=12, label=f"estimate: {b.mass:.1%} within {b.radius:g} mm ({run.stopped})")
+    if np.all(np.isfinite(est)):
+        ax.plot(
+            *est, "*", color="tab:red", ms=12, label=f"estimate: {b.mass:.1%} within {b.radius:g} mm ({run.stopped})"
+        )
     ax.set_title(f"reactive localization on {part.name}: {np.degrees(run.rotation):.1f} deg rolled", fontsize=9)
     _finish(fig, ax, path)

@@ -33,7 +33,15 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
 6. at the end of the jaw's calibrated span the jaw is lifted, slid along
    itself and put back on the same point (a regrasp; the filter starts a new
    segment with its own offset), and rolling goes on the same way;
-7. stop at ``max_rotation`` of rolled rotation, sure or not.
+7. stop at ``max_rotation`` of rolled rotation, sure or not;
+8. a part that is not its model (issue 29): a reading whose contact jumped more than ``reread_jump``
+   is read twice more and the middle of the three kept (a spike of the wrist's DAQ is one reading),
+   as are the readings every step after counts from; when both ways are blocked and a jump was one no
+   probable place of the model predicted (the jaw sits on a burr, or between a dent's rims), the jaw
+   rolls through that jump once and the filter starts afresh from where it lands (spline parts: a
+   drawing's corners and faces jump of their own); and a run that met something the model does not
+   have (a stretch the filter quarantined, a jump rolled through, one the final place does not
+   explain) ends "mismatch", saying where, never "confident".
 
 Works on any :class:`driver.rig.Rig` (simulated or serial).
 """

@@ -107,6 +107,37 @@ The belief over the *present* contact is the push-forward of the posterior over
 is the corner, which machining moves along its normal only). :meth:`ContactFilter.belief`
 reports its maximum, the probability within the success radius of it, the separate modes, and
 whether the data said anything at all (on a circle every start predicts the same readings).
+
+*A part that is not its model* (issue 29; docs/robustness.md). A burr, a dent, debris, a part made
+large or to another revision: where the jaw rolls over such a thing the readings follow a shape the
+model does not have, and a burr's crest, a tight convex bend, reads like a fillet of the model
+somewhere else. Three things keep the belief honest about it:
+
+- *No belief rests on one short stretch.* Every reading is kept as the sums took it, so that any
+  stretch can be taken out exactly (the marginalisation without its sums). The stated mass is the
+  least, over every stretch of :data:`DEFECT_WINDOW` mm of rolled arc, of the mass without that
+  stretch (:meth:`ContactFilter.stretch_mass`, asked only where the belief would otherwise stop);
+  readings that span no more than one stretch are not enough to be sure of anything. Rolling on a
+  burr's crest, the jaw is sure of nothing until it has read the part beyond it.
+- *A fit test.* Every :data:`FIT_EVERY` readings, and before a sure stop, each stretch of
+  :data:`FIT_WIDTH` windows is judged under the most probable starts: its misfit per reading, against
+  what the error model expects of each reading under that start (the rotation reading's ρ·e is the
+  start's own), over the rest's is an F ratio, scale-free, so that noise of any level fits. A stretch
+  at least :data:`FIT_RATIO` times as far off as the rest and as the told noise, at a Bonferroni-
+  corrected :data:`~localizer.FIT_ALPHA`, under every one of those starts, is a misfit
+  (:meth:`ContactFilter.fit_test`).
+- *Quarantine.* Such a stretch costs its readings, not the answer: the stretch whose absence lets some
+  start fit best (not necessarily the one the most probable start misfits: a wrong start that the
+  stretch made probable would keep it) is taken out of the likelihood (:meth:`set_quarantine`), up to
+  :data:`MAX_QUARANTINE` of them, and the belief is asked again. :attr:`Belief.mismatch` then says where
+  on the model, under the most probable start, the first one lies, and ``mismatch_mm`` how far off the
+  readings were there; a belief with a mismatch is never sure (:meth:`Belief.sure`).
+
+A bridge that no probable start predicted (:meth:`bridged` returns the probability it had) is kept,
+so that the rolling can ask whether the final place explains it (:meth:`unexplained_bridges`). And a
+part uniformly a little larger or smaller than its model scales every measured arc: the scale term
+``sd_scale`` carries it with the calibration's (:data:`SCALE_SD`: 0.3% and 1% in quadrature, a part
+2% off its drawing at two standard deviations).
 """
 
 from __future__ import annotations
@@ -190,6 +221,9 @@ UNEXPLAINED = 0.01
 #: envelope's takes whole (on the tuning family, 60 trials with a 0.3 x 4 mm burr near the start: 23
 #: right at 12 mm, 20 at 6; clean, the same 57 of 60 sure).
 FIT_WIDTH = 2.0
+#: A reading whose arc moved more than this since the one before (mm) came after a jump: the fit test
+#: leaves it out (a face crossed in one step, a dip bridged: the model's approximation of the jump).
+JUMP_READING = 1.0
 #: Readings a fit test needs outside the stretch it judges (fewer cannot tell misfit from noise).
 FIT_MIN_READINGS = 20
 #: Readings between two fit tests while the belief is not sure (a test before every sure stop too).
@@ -890,6 +924,14 @@ class ContactFilter:
             self._spread_at = (len(self._readings), max(arcs) - min(arcs) > self.defect_window)
         return self._spread_at[1]
 
+    def _jumped(self, j: int) -> bool:
+        """Whether reading ``j`` came after a jump of the contact (more than :data:`JUMP_READING` mm of arc
+        since the reading before it, in the same segment)."""
+        if j < 1:
+            return False
+        r, q = self._readings[j], self._readings[j - 1]
+        return r.segment == q.segment and abs(r.arc - q.arc) > JUMP_READING
+
     def _trusted(self) -> list[int]:
         """The readings the likelihood holds (not the first, which only places the start; not quarantined)."""
         return [j for j in range(1, len(self._readings)) if j not in self._out]
@@ -911,12 +953,16 @@ class ContactFilter:
             first start's worst stretch: where on the model (its path's arcs over the stretch), and
             how significant.
         """
-        rows = self._trusted()
+        trusted = self._trusted()
+        # a reading that came after a jump of the contact (a face crossed, a shallow dip bridged in one
+        # step) carries the model's approximation of that jump, one reading's worth: judged by none
+        jumps = [j for j in trusted if self._jumped(j)]
+        rows = [j for j in trusted if not self._jumped(j)]
         hyps = np.asarray([int(h) for h in np.atleast_1d(starts) if self._live[int(h)]], dtype=np.int64)
         if len(rows) < FIT_MIN_READINGS or hyps.size == 0 or self.defect_window <= 0:
             return None
         t2 = self.sd_scale**2
-        q_all = _quad(self._solve(1.0, hyps=hyps), t2)
+        q_all = _quad(self._solve(1.0, without=self._stretch_sums(jumps, hyps) if jumps else None, hyps=hyps), t2)
         k = len(rows)
         nuisance = len({self._readings[j].segment for j in rows})
         windows = [
@@ -937,7 +983,8 @@ class ContactFilter:
         best_w: list[tuple[float, IntArray] | None] = [None] * hyps.size
         for a, inside in windows:
             chosen = [rows[i] for i in inside]
-            q_rest = np.maximum(_quad(self._solve(1.0, without=self._stretch_sums(chosen, hyps), hyps=hyps), t2), 1e-12)
+            without = self._stretch_sums(chosen + jumps, hyps)
+            q_rest = np.maximum(_quad(self._solve(1.0, without=without, hyps=hyps), t2), 1e-12)
             kw, kr = inside.size, k - inside.size - nuisance
             e_w = expect[inside].sum(axis=0)
             stretch = np.maximum(q_all - q_rest, 0.0) / e_w

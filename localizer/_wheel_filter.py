@@ -210,6 +210,7 @@ class WheelFilter:
         self.span = (0.0, 0.0)
         self.steps = 0
         self._zz: list[FloatArray] = []
+        self._logvar: list[FloatArray] = []
         self._misfit: tuple[tuple[float, float], float] | None = None  # (stretch on the model, p-value)
         self._fit_at = 0  # readings used at the last fit test
 
@@ -247,7 +248,8 @@ class WheelFilter:
         var = d2 + extra
         z = (rho - self._z @ ell) / np.sqrt(var)
         self._quad += z**2
-        self._zz.append(z**2)  # each start's misfit of this reading, for the fit test
+        self._zz.append(z**2)  # each start's misfit of this reading, for the fit test and the stretches
+        self._logvar.append(np.log(var))
         self._logdet += np.log(var)
         self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
         self._z = np.column_stack([self._z, z * np.sqrt(var / d2)])  # whitened by the shared part alone
@@ -333,6 +335,10 @@ class WheelFilter:
             top = [int(h) for h in np.argsort(w)[::-1][:FIT_STARTS] if w[h] > 0]
             self._misfit = self.fit_test(top)
         mismatch = self._misfit[0] if self._misfit is not None else None
+        # sure only if sure without any one short stretch of the rolled arc (the straight jaw's rule,
+        # ContactFilter.stretch_mass): a burr the wheel rode over reads like a bend the model has elsewhere
+        if mass >= self.confidence:
+            mass = min(mass, self.stretch_mass(map_arc, radius))
         modes = find_modes(self.part, w, present, self.grid, radius)
         prior = self.prior / self.prior.sum()
         informative, ambiguous = belief_flags(w, prior, modes, self.mode_floor, self.confidence)
@@ -348,11 +354,47 @@ class WheelFilter:
             mismatch=mismatch,
         )
 
+    def stretch_mass(self, arc: float, radius: float | None = None) -> float:
+        """The least probability within ``radius`` of the present contact at ``arc`` (mm) when the readings
+        of any one stretch of :data:`~localizer.DEFECT_WINDOW` mm of rolled arc are left out (their
+        whitened misfits and variances taken off each start's sums: exact for the stretch's own terms, the
+        readings after it still judged given it). Readings that span no more than one stretch are not
+        enough to be sure: 0."""
+        radius = self.radius if radius is None else float(radius)
+        k = len(self.L_used)
+        if k == 0:
+            return 1.0
+        rolled = np.array(self.L_used)
+        w = DEFECT_WINDOW
+        if float(np.ptp(rolled)) <= w:
+            return 0.0
+        zz, logvar = np.array(self._zz), np.array(self._logvar)
+        near = np.abs(np.asarray(self.part.arc_offset(self.present(), arc))) <= radius
+        allowed = self.prior > 0
+        worst, seen = 1.0, set()
+        for a in np.arange(float(rolled.min()) - 0.75 * w, float(rolled.max()) + 1e-9, 0.25 * w):
+            inside = np.flatnonzero((rolled >= a) & (rolled <= a + w))
+            key = (int(inside[0]), int(inside[-1])) if inside.size else (-1, -1)
+            if inside.size == 0 or key in seen:
+                continue
+            seen.add(key)
+            quad = self._quad - zz[inside].sum(axis=0)
+            logdet = self._logdet - logvar[inside].sum(axis=0)
+            for f in self.noise_scales:
+                ll = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty
+                ll = np.where(allowed, ll, -np.inf)
+                wts = np.exp(ll - ll.max())
+                worst = min(worst, float(wts[near].sum() / wts.sum()))
+            if worst < self.confidence:
+                break
+        return worst
+
     def fit_test(self, starts: list[int]) -> tuple[tuple[float, float], float] | None:
         """Whether the readings used still fit the part under each of the ``starts`` (grid indices): for each
         stretch of twice :data:`~localizer.DEFECT_WINDOW` mm of rolled arc, its readings' whitened misfit per
         reading against the rest's (an F ratio, as the straight jaw's :meth:`ContactFilter.fit_test`: at
-        least FIT_RATIO times the rest and the told noise, Bonferroni-corrected at FIT_ALPHA). None when
+        least FIT_RATIO times the rest and the most noise the stated probability allows (the
+        largest of ``noise_scales``), Bonferroni-corrected at FIT_ALPHA). None when
         some start fits every stretch; else the stretch on the model under the first start, and its
         p-value."""
         k = len(self.L_used)
@@ -374,7 +416,11 @@ class WheelFilter:
             kw = int(inside.sum())
             stretch = zz[inside].mean(axis=0)
             rest = np.maximum(zz[~inside].mean(axis=0), 1e-12)
-            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, 1.0), f_dist.sf(stretch / rest, kw, k - kw), 1.0)
+            # the floor is the most noise the stated probability already allows (the largest noise scale):
+            # a noise-free pymunk wheel reads 3-5 sigma off the told model over a few readings on a plain
+            # convex stretch, which the stated mass takes in and no part's defect needs to be told from
+            floor = self.noise_scales[-1] ** 2
+            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, floor), f_dist.sf(stretch / rest, kw, k - kw), 1.0)
             better = pv < best
             best = np.where(better, pv, best)
             for i in np.flatnonzero(better):

@@ -393,13 +393,20 @@ def world_part(
         arcs, _, normal = model_sample(model, spacing)
         xy = np.asarray(machined.point(model.param_at_arc(arcs)), dtype=float)
     P = float(model.perimeter)
+    offset = np.zeros(arcs.size)
     for d in change.defects:
-        xy = xy + d.offset(arcs, P)[:, None] * normal
+        offset += d.offset(arcs, P)
+    xy = xy + offset[:, None] * normal
+    centre = _centroid(np.asarray(model_sample(model, max(spacing, P / 4000))[1]))
     if change.scale != 1.0:
-        centre = _centroid(np.asarray(model_sample(model, max(spacing, P / 4000))[1]))
         xy = centre + change.scale * (xy - centre)
     label = change.describe()
-    crossing = polygon_crossing(np.vstack([xy, xy[:1]]))
+    # does the change make the part cross itself? Judged on the model with the change alone: the
+    # machining's micron offsets along the two normals of a drawing's concave corner overlap there
+    # whatever the change (the worlds take the deepest point, so that does not matter)
+    changed = np.asarray(model.point_at_arc(arcs), dtype=float) + offset[:, None] * normal
+    changed = centre + change.scale * (changed - centre)
+    crossing = polygon_crossing(np.vstack([changed, changed[:1]]))
     if crossing is not None:
         where = xy[crossing[0]]
         raise SimError(

@@ -123,6 +123,12 @@ def test_dask_local_cluster_gives_the_same_table(reference):
             'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2',
             r"unknown key\(s\) \['speed'\]",
         ),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[world]\nburrs = 1', r"\[world\] unknown key\(s\) \['burrs'\]"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[world]\nscale = 3.0', r"\[world\] scale=3.0 must be within"),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\n[world]\nworld_parts = ["{cam}", "{cam}"]',
+            r"world_parts has 2 file\(s\) for 1 part\(s\)",
+        ),
     ],
 )
 def test_bad_study_files(tmp_path, text, match):
@@ -431,3 +437,33 @@ def test_an_absent_scheduler_is_named_quickly(reference, monkeypatch):
     with pytest.raises(StudyError, match="no Dask scheduler answered within 1 s"):
         run_study(study, tmp / "nosched", scheduler="tcp://127.0.0.1:1", progress=False)
     assert time.monotonic() - t0 < 10
+
+
+def test_a_world_study_writes_how_each_trials_world_differs_and_counts_mismatches(tmp_path):
+    # issue 29: a [world] table adds the world's columns; the trials are the same as without it (the same
+    # start and noise), and a run that met the defect says so in <m>_stopped, <m>_mismatch_arc and the
+    # summary's mismatch count
+    from bench.study import WORLD_COLUMNS
+
+    world = "[world]\ndefects = 1\ndefect_height_mm = 0.3\ndefect_length_mm = 4.0\n[reactive]\nmax_rotation_deg = 60.0"
+    base = 'methods = ["reactive"]\n[reactive]\nmax_rotation_deg = 60.0'
+    f = study_file(tmp_path, trials=2, extra=world.replace("[world]", 'methods = ["reactive"]\n[world]'))
+    f.write_text(f.read_text().replace('method = "paper"\n', ""))
+    study = load_study(f)
+    assert study.world is not None and set(WORLD_COLUMNS) <= set(study.columns)
+    assert "reactive_mismatch_arc" in study.columns
+    run_study(study, tmp_path / "w", workers=1, progress=False)
+    rows = table(tmp_path / "w")
+    clean = tmp_path / "clean.toml"
+    clean.write_text(f.read_text().split("[world]")[0].replace('methods = ["reactive"]\n', "") + base)
+    run_study(load_study(clean), tmp_path / "c", workers=1, progress=False)
+    for r, c in zip(rows, table(tmp_path / "c")):
+        assert r["start_arc"] == c["start_arc"] and r["part"] == c["part"]
+        assert abs(float(r["world_defect_arc"]) - float(r["start_arc"])) <= 5.0
+        assert float(r["world_defect_height_mm"]) == 0.3 and float(r["world_scale"]) == 1.0
+        assert r["reactive_stopped"] in ("confident", "mismatch", "budget", "ambiguous")
+        assert bool(r["reactive_mismatch_arc"]) == (r["reactive_stopped"] == "mismatch")
+        assert not (r["reactive_stopped"] == "confident" and r["reactive_success"] == "0")
+    summary = json.loads((tmp_path / "w" / "summary.json").read_text())
+    d = summary["method_details"]["reactive"]
+    assert d["mismatch"] == sum(r["reactive_stopped"] == "mismatch" for r in rows)
