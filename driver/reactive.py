@@ -548,11 +548,12 @@ class _Roller:
         and the run ends "mismatch" whatever it finds (:meth:`_verdict`)."""
         p, flt = self.policy, self.flt
         if abs(self.d_prev + jump) > self.jaw_limit:
-            # the contact would land beyond the jaw's calibrated span: slide the jaw along itself first
+            # the contact would land beyond the jaw's calibrated span: slide the jaw along itself first. On a
+            # burr's crest the slid jaw's longer reach may touch the part beyond it instead (the slide is then
+            # undone): roll through as it is, and slide the jaw from where the contact lands
             d_new, regrasped, _ = self._regrasp(self.d_prev)
-            if not regrasped:
-                return "blocked"
-            self.d_prev = d_new
+            if regrasped:
+                self.d_prev = d_new
         self.hand.rotate_by(s)
         self.rotation += p.step
         try:
@@ -563,6 +564,23 @@ class _Roller:
             raise
         except RigError:
             return "lost"
+        if abs(d) > self.jaw_limit:
+            # landed at the jaw's end (its tip may be what touches): slide the jaw along itself and start
+            # afresh from whatever point of the part it then touches (the filter starts again anyway)
+            target = -math.copysign(self.jaw_limit - 2 * p.end_margin, d)
+            self.hand.press_by(-p.backoff)
+            self.hand.slide_by(d - target)
+            try:
+                d = self.read_base() if self.pressed() else math.inf
+            except DEVICE_FAULTS:
+                raise
+            except RigError:
+                d = math.inf
+            if not abs(d) <= self.jaw_limit:
+                return "lost"
+            # the contact moved on along the part by about as much as it moved from the target on the jaw:
+            # where the jaw left the model behind is that much further back
+            jump = math.copysign(abs(jump) + abs(d - target), jump)
         self.left.append((self.direction, float(jump)))
         self.segment_base += flt.segment + 1
         flt.reset()

@@ -490,6 +490,7 @@ class ContactFilter:
         self.mode_floor = float(mode_floor)
         self.confidence = float(confidence)
         self.index = np.arange(self.tracks.sigma.size)
+        self._replaying = 0  # > 0 while a call is made by the filter itself (not logged)
         self.reset()
 
     @property
@@ -544,6 +545,12 @@ class ContactFilter:
         self._last_map = math.nan
         self._last_span: tuple[float, float] | None = None
         self._bridges: list[tuple[float, float, float, float]] = []  # (turn before, turn, jaw, jump)
+        # every call that changed the state since the reset, so that the filter can be rebuilt with a
+        # stretch quarantined from the start (:meth:`_rebuild`)
+        self._calls: list[tuple[str, tuple]] = []
+        # the rolled arc (mm, from, to) of each quarantined stretch: a reading taken there later (the jaw
+        # rolled back onto a burr's crest, where it may stay for tens of degrees) is quarantined as it comes
+        self._zones: list[tuple[float, float]] = []
         self._add_row(0.0, np.zeros(n))  # the first reading: z_0 = 0, p_0 = 0
         self.steps = 0
         self.turn = 0.0
@@ -566,6 +573,7 @@ class ContactFilter:
         """
         if not (math.isfinite(arc) and math.isfinite(turn)):
             raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
+        self._log("update", arc, turn, jaw)
         # only the hypotheses still in the running are moved and summed (the pruned ones are
         # never evaluated again)
         idx = self._live_idx
@@ -589,10 +597,18 @@ class ContactFilter:
         self.node[idx] = np.where(ok, node, self.node[idx])
         z = float(arc)
         self._add_row(z, p, idx, jaw, float(turn))
+        if any(lo <= z <= hi for lo, hi in self._zones):
+            j = len(self._readings) - 1
+            self._take([j], -1.0)
+            self._out.add(j)
         self.steps += 1
         self.turn, self.arc = float(turn), z
         if jaw is not None:
-            self.touch(jaw)
+            self._replaying += 1
+            try:
+                self.touch(jaw)
+            finally:
+                self._replaying -= 1
         if self.steps % self.refresh == 0:
             self._ref = int(np.argmax(self.log_likelihood()))
             self._slope_priors()
@@ -607,6 +623,7 @@ class ContactFilter:
         """
         if not math.isfinite(jaw):
             raise QueryError(f"jaw={jaw!r} mm must be finite")
+        self._log("touch", jaw)
         self.jaw_position = float(jaw)
         if self._rows == 1 and self.sd_jaw > 0:
             # the first reading (z = 0, p = 0) is where the jaw was laid: it carries the calibration's
@@ -650,6 +667,7 @@ class ContactFilter:
         d0 = self.jaw_position if jaw is None else float(jaw)
         if not math.isfinite(d0) or self.ruled_out:
             return 1.0
+        self._log("bridged", turn, d0, jump)
         idx = self._live_idx
         w = self.posterior()[idx]
         clear = self._surely_clear(idx, self.turn, float(turn), d0, float(jump), at=self.current[idx])
@@ -704,8 +722,42 @@ class ContactFilter:
         """
         if self._segment + 1 >= self._segments:
             raise QueryError(f"more than {self._segments - 1} regrasps in one localization")
+        self._log("regrasp", arc, turn, jaw)
         self._segment += 1
-        self.update(arc, turn, jaw)
+        self._replaying += 1
+        try:
+            self.update(arc, turn, jaw)
+        finally:
+            self._replaying -= 1
+
+    def _log(self, name: str, *args: Any) -> None:
+        """Keep a call that changes the state (not one the filter makes of itself, nor a replay's)."""
+        if not self._replaying:
+            self._calls.append((name, args))
+
+    def _rebuild(self, out: set[int]) -> None:
+        """Take every reading in ``out`` (indices, as :meth:`set_quarantine`) out of the likelihood *from the
+        start*: the filter is reset and its calls made again, each such reading taken out as it comes.
+
+        Taking readings out of the sums afterwards (:meth:`set_quarantine`) reaches only the starts still
+        live: a burr's readings may have pruned the true start long before the fit test found them (40
+        nats is a few readings 5 sigma off), and nothing then brings it back. The calls' own records (the
+        bridges and whether they were explained when they came, the fit tests' state) are kept."""
+        calls, misfits, bridges, fit_next = self._calls, self._misfits, self._bridges, self._fit_next
+        zones = self._zones
+        self.reset()
+        self._zones = zones
+        self._replaying += 1
+        try:
+            for name, args in calls:
+                getattr(self, name)(*args)
+                j = len(self._readings) - 1
+                if name in ("update", "regrasp") and j in out and j not in self._out:
+                    self._take([j], -1.0)
+                    self._out.add(j)
+        finally:
+            self._replaying -= 1
+        self._calls, self._misfits, self._bridges, self._fit_next = calls, misfits, bridges, fit_next
 
     def _basis(self, z: float, jaw: float | None = None) -> tuple[IntArray, FloatArray]:
         """(columns, values) of the basis for a reading at cumulative arc z (mm) and place ``jaw`` (mm)
@@ -1276,7 +1328,13 @@ class ContactFilter:
                 # made probable would otherwise keep it and drop the rest)
                 rows = self._best_stretch()
                 self._misfits.append(found._replace(rows=rows) if rows else found)
-                self.set_quarantine(self._out | set(rows or found.rows))
+                taken = list(rows or found.rows)
+                # the zone: the stretch's readings, and at least one defect window around their middle (on a
+                # burr's crest the contact creeps on a fraction of a millimetre per 25 readings)
+                arcs = [self._readings[j].arc for j in taken]
+                mid, half = 0.5 * (min(arcs) + max(arcs)), 0.5 * self.defect_window
+                self._zones.append((min(min(arcs), mid - half), max(max(arcs), mid + half)))
+                self._rebuild(self._out | set(taken))
                 return self.belief(radius)
         self._last_map = map_arc
         self._last_span = (map_arc, map_arc)

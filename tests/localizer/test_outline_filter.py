@@ -129,7 +129,8 @@ DATA = Path(__file__).resolve().parent / "data"
 def replay_checks(name, **settings):
     """A recorded reactive rolling on a held-out drawing (bench.replay, cad-heldout.toml, `paper` noise)
     fed to a filter: at every fifth reading, (stated mass, error of its most probable contact against
-    the true start's present contact on the model, mm, whether that contact sits on a pivot)."""
+    the true start's present contact on the model, mm, whether that contact sits on a pivot, the readings
+    of each stretch quarantined so far)."""
     rec = json.loads((DATA / name).read_text())
     part = load_outline(DATA / rec["part"])
     flt = ContactFilter(part, **{**rec["settings"], **settings})
@@ -141,7 +142,8 @@ def replay_checks(name, **settings):
             b = flt.belief()
             truth = float(part.wrap_arc(flt.current[true]))
             pivot = bool(flt.tracks.pivot[flt.node[true]])
-            out.append((b.mass, abs(float(part.arc_offset(b.map_arc, truth))), pivot))
+            taken = tuple(m.rows for m in flt.misfits)
+            out.append((b.mass, abs(float(part.arc_offset(b.map_arc, truth))), pivot, taken))
     return out
 
 
@@ -152,7 +154,7 @@ def test_pivoting_on_a_corner_the_contact_is_the_corner():
     checks = replay_checks("cad-heldout-dee06-t36.json")
     on_pivot = [c for c in checks if c[2]]
     assert len(on_pivot) > 20
-    assert max(error for _, error, _ in on_pivot) < 0.05
+    assert max(c[1] for c in on_pivot) < 0.05
     assert not [c for c in checks if c[0] >= 0.95 and c[1] > 0.3]
 
 
@@ -163,5 +165,10 @@ def test_pruning_does_not_raise_the_stated_probability():
     pruned = replay_checks("cad-heldout-dee10-t62.json")
     full = replay_checks("cad-heldout-dee10-t62.json", prune=math.inf)
     assert len(pruned) == len(full) > 100
-    assert max(abs(a[0] - b[0]) for a, b in zip(pruned, full)) < 1e-3
+    # the same as long as both took the same stretches out (which stretch to take out is chosen among the
+    # starts still live: the pruned filter may choose another, issue 29)
+    same = [(a, b) for a, b in zip(pruned, full) if a[3] == b[3]]
+    assert len(same) > 100
+    assert max(abs(a[0] - b[0]) for a, b in same) < 1e-3
+    assert not [c for c in full if c[0] >= 0.95 and c[1] > 0.3]
     assert not [c for c in pruned if c[0] >= 0.95 and c[1] > 0.3]
