@@ -83,7 +83,6 @@ from __future__ import annotations
 
 import math
 import time
-import tomllib
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
@@ -91,7 +90,7 @@ import numpy as np
 
 from driver.procedures import STEP_RANGE_DEG
 from driver.reactive import CONFIDENCE, MAX_ROTATION
-from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, check_size, load_part
+from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part, read_toml
 from sim2d import WorldSpec
 
 from .part_cache import cached_part
@@ -323,15 +322,7 @@ def load_study(path) -> Study:
         Unreadable or invalid TOML, unknown keys, missing parts, bad values.
     """
     path = Path(path)
-    try:
-        check_size(path, MAX_STUDY_BYTES, "study file", StudyError)
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise StudyError(f"study {path}: not a text file (a study is TOML)") from None
-    except OSError as exc:
-        raise StudyError(f"study {path}: cannot read ({exc.strerror or exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"study {path}: not valid TOML ({exc})") from None
+    data = read_toml(path, MAX_STUDY_BYTES, "study", StudyError)
     unknown = sorted(set(data) - _KEYS)
     if unknown:
         raise StudyError(f"study {path}: unknown key(s) {unknown}; valid keys: {sorted(_KEYS)}")

@@ -30,7 +30,7 @@ from ._defaults import (
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._files import load_part
-from ._limits import MAX_PART_BYTES, check_size
+from ._limits import MAX_PART_BYTES, check_size, read_toml
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
 from ._outline_solver import outline_segments
@@ -78,6 +78,7 @@ __all__ = [
     "Misfit",
     "MAX_PART_BYTES",
     "check_size",
+    "read_toml",
     "ContactFilter",
     "ParticleFilter",
     "Belief",

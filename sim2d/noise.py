@@ -7,11 +7,15 @@ encoder, millimetres for machining error.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
+from localizer import read_toml
+
 from ._errors import SimError
+
+#: The largest noise file read, bytes: a noise model is a few lines of TOML.
+MAX_NOISE_BYTES = 2**16
 
 __all__ = ["NoiseModel", "PRESETS", "load_noise"]
 
@@ -143,12 +147,7 @@ def load_noise(spec) -> NoiseModel:
     path = Path(text)
     if path.suffix.lower() != ".toml":
         raise SimError(f"noise {text!r}: use a preset {sorted(PRESETS)} or a .toml file")
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise SimError(f"noise file {text}: cannot read ({exc.strerror or exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SimError(f"noise file {text}: not valid TOML ({exc})") from None
+    data = read_toml(path, MAX_NOISE_BYTES, "noise file", SimError)
     base = data.pop("preset", "none")
     if base not in PRESETS:
         raise SimError(f"noise file {text}: unknown preset {base!r}; use one of {sorted(PRESETS)}")

@@ -27,13 +27,12 @@ refused by name.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from localizer import Outline, Part, RolltouchError, load_part, polygon_crossing
+from localizer import Outline, Part, RolltouchError, load_part, polygon_crossing, read_toml
 
 from ._errors import SimError
 from .machining import machined_outline, machined_part
@@ -345,16 +344,7 @@ def load_world(path: str | Path, parts: int | None = None) -> WorldSpec:
         Unreadable or invalid TOML, no ``[world]`` table, unknown keys, bad values.
     """
     path = Path(path)
-    try:
-        if path.stat().st_size > MAX_WORLD_BYTES:
-            raise SimError(f"world file {path}: larger than {MAX_WORLD_BYTES} bytes; a world is a few lines of TOML")
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise SimError(f"world file {path}: not a text file (a world is TOML with a [world] table)") from None
-    except OSError as exc:
-        raise SimError(f"world file {path}: cannot read ({exc.strerror or exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SimError(f"world file {path}: not valid TOML ({exc})") from None
+    data = read_toml(path, MAX_WORLD_BYTES, "world file", SimError)
     if set(data) != {"world"}:
         raise SimError(f"world file {path}: give one [world] table (found {sorted(data) or 'nothing'})")
     return WorldSpec.from_table(data["world"], f"world file {path}", path.resolve().parent, parts)

@@ -66,12 +66,21 @@ def test_load_noise_presets_and_toml(tmp_path):
         ('v2_noise = "a"\n', "must be a finite number"),
         ('preset = "lab"\n', "unknown preset 'lab'"),
         ("v2_noise = \n", "not valid TOML"),
+        # every input bounded: a noise file is a few lines, a large one is not read into memory
+        ("# " + "x" * 70_000 + "\n", "a noise file may have"),
     ],
 )
 def test_bad_noise_files(tmp_path, text, match):
     f = tmp_path / "bad.toml"
     f.write_text(text)
     with pytest.raises(SimError, match=match):
+        load_noise(f)
+
+
+def test_a_noise_file_that_is_not_text_is_named(tmp_path):
+    f = tmp_path / "bin.toml"
+    f.write_bytes(b"\xff\xfe\x00 preset")
+    with pytest.raises(SimError, match="bin.toml: not a text file"):
         load_noise(f)
 
 
