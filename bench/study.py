@@ -94,7 +94,7 @@ from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, 
 from sim2d import WorldSpec
 
 from .part_cache import cached_part
-from .trial_draw import draw_trial, draw_world
+from .trial_draw import draw_trial, draw_world, world_cells
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -727,15 +727,3 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
         row.update(world_cells(change, spikes))
     row["time_s"] = time.perf_counter() - t0
     return row
-
-
-def world_cells(change, spikes: int | str = "") -> dict:
-    """The :data:`WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
-    if change is None:
-        return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
-    return {
-        "world_defect_arc": " ".join(f"{d.arc:.3f}" for d in change.defects),
-        "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
-        "world_scale": change.scale,
-        "world_spikes": spikes,
-    }

@@ -11,7 +11,7 @@ import numpy as np
 
 from .part_cache import cached_part
 
-__all__ = ["TrialDraw", "draw_trial", "draw_world"]
+__all__ = ["TrialDraw", "draw_trial", "draw_world", "world_cells"]
 
 
 class TrialDraw(NamedTuple):
@@ -51,3 +51,15 @@ def draw_world(spec, part_file: str, part, start: float):
         return None
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial, 2]))
     return s.world.draw(part, start, rng, s.parts.index(part_file))
+
+
+def world_cells(change, spikes: int | str = "") -> dict:
+    """The :data:`bench.study.WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
+    if change is None:
+        return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
+    return {
+        "world_defect_arc": " ".join(f"{d.arc:.3f}" for d in change.defects),
+        "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
+        "world_scale": change.scale,
+        "world_spikes": spikes,
+    }

@@ -32,8 +32,7 @@ def run_wheel_trial(spec) -> dict:
     from sim2d import WheelRig
 
     from .methods import _curve, _err, mismatch_cell, reactive_stop, rotation_curve
-    from .study import world_cells
-    from .trial_draw import draw_trial, draw_world
+    from .trial_draw import draw_trial, draw_world, world_cells
 
     s = spec.study
     t0 = time.perf_counter()

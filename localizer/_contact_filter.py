@@ -547,7 +547,7 @@ class ContactFilter:
         self._bridges: list[tuple[float, float, float, float]] = []  # (turn before, turn, jaw, jump)
         # every call that changed the state since the reset, so that the filter can be rebuilt with a
         # stretch quarantined from the start (:meth:`_rebuild`)
-        self._calls: list[tuple[str, tuple]] = []
+        self._calls: list[tuple[str, tuple[Any, ...]]] = []
         # the rolled arc (mm, from, to) of each quarantined stretch: a reading taken there later (the jaw
         # rolled back onto a burr's crest, where it may stay for tens of degrees) is quarantined as it comes
         self._zones: list[tuple[float, float]] = []

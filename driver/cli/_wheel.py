@@ -21,6 +21,7 @@ from ._output import (
     print_belief,
     truth_fields,
 )
+from ._world import world_change, world_fields
 
 __all__ = [
     "wheel_policy",
@@ -114,7 +115,6 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     noise = load_noise(args.noise)
     cal_rig = WheelRig(part, wheel, noise=noise, seed=args.seed + 1, engine=args.engine)
     calibration = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
-    from .simulated import world_change, world_fields
 
     change = world_change(args, part)
     rig = WheelRig(part, wheel, noise=noise, seed=args.seed, engine=args.engine, change=change)

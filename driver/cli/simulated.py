@@ -31,6 +31,7 @@ from ._options import (
 )
 from ._output import emit_run, exit_status, print_reactive, run_reactive, run_summary
 from ._wheel import simulate_wheel, wheel_rig
+from ._world import world_change, world_fields
 
 __all__ = ["register", "simulate_command", "emulate_command"]
 
@@ -226,36 +227,6 @@ def simulate_command(args) -> int:
     doc.update(world_fields(change, rig))
     doc["trace"] = str(args.out)
     return emit_run(args, doc, part, trace, run.localization)
-
-
-def world_change(args, part):
-    """The world ``--world`` or ``--world-part`` describes for this run (None: the model as machined)."""
-    from localizer import load_part
-    from sim2d import WorldChange, load_world
-
-    if getattr(args, "world_part", None):
-        return WorldChange(part=load_part(args.world_part))
-    if getattr(args, "world", None):
-        spec = load_world(args.world)
-        if spec.world_parts:
-            raise UsageError(f"--world {args.world}: world_parts is a study's; give one part with --world-part")
-        return spec.draw(part, float(args.start), np.random.default_rng([int(args.seed) & 0xFFFFFFFF, 2]))
-    return None
-
-
-def world_fields(change, rig) -> dict:
-    """How the simulated world differed from its model, for a trace's metadata and the JSON output."""
-    if change is None:
-        return {}
-    return {
-        "world": {
-            "describe": change.describe(),
-            "defects": [{"arc": d.arc, "height_mm": d.height, "length_mm": d.length} for d in change.defects],
-            "scale": change.scale,
-            "part": None if change.part is None else change.part.name,
-            "spikes": rig.spikes.count,
-        }
-    }
 
 
 def _check_reach(part, start: float, jaw: float) -> None:
