@@ -496,7 +496,10 @@ def plot_study(study: Study, rows, out: Path) -> None:
                     ax.plot(p[:, 0], p[:, 1], "o", ms=3, color=colour, alpha=0.6, label=f"{label} ({arcs.size})")
             ax.set_title(f"{name}: final true contacts", fontsize=9)
             ax.set_aspect("equal")
-            ax.legend(fontsize=7)
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(fontsize=7)
+            else:  # no trial's fixed rolls ran on this part (e.g. every world's part made them bridge)
+                ax.text(0.5, 0.5, "no fixed-roll trial", transform=ax.transAxes, ha="center", fontsize=8)
         fig.tight_layout()
         fig.savefig(out / "failures.png", dpi=110)
         plt.close(fig)
@@ -579,7 +582,10 @@ def _plot_bound(study: Study, rows, out: Path) -> None:
     ax.set_ylabel("final error (mm)")
     ax.set_title(f"{study.name}: error against its bound (hollow: failures)", fontsize=10)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    if hi > 0:
+        ax.legend(fontsize=7)
+    else:  # no method stated a bound for any trial (every trial broke, or none had readings to bound)
+        ax.text(0.5, 0.5, "no trial with a bound", transform=ax.transAxes, ha="center", fontsize=9)
     fig.tight_layout()
     fig.savefig(out / "bound.png", dpi=110)
     plt.close(fig)
