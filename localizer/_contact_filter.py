@@ -128,8 +128,14 @@ somewhere else. Three things keep the belief honest about it:
   (:meth:`ContactFilter.fit_test`).
 - *Quarantine.* Such a stretch costs its readings, not the answer: the stretch whose absence lets some
   start fit best (not necessarily the one the most probable start misfits: a wrong start that the
-  stretch made probable would keep it) is taken out of the likelihood (:meth:`set_quarantine`), up to
-  :data:`MAX_QUARANTINE` of them, and the belief is asked again. :attr:`Belief.mismatch` then says where
+  stretch made probable would keep it) is taken out of the likelihood, up to :data:`MAX_QUARANTINE` of
+  them, and the belief is asked again. It is taken out as a *zone* of rolled arc, at least one window
+  wide: a reading taken there later is taken out as it comes (on a burr's crest the jaw lingers for
+  tens of degrees while the contact creeps a fraction of a millimetre). And it is taken out *from the
+  start*: the filter is reset and its logged calls made again without the zone's readings
+  (:meth:`_rebuild`), since the stretch's few readings 5σ off may have pruned the true start long before
+  the test found them, and taking readings out of the sums afterwards (:meth:`set_quarantine`) reaches
+  only the starts still live. :attr:`Belief.mismatch` then says where
   on the model, under the most probable start, the first one lies, and ``mismatch_mm`` how far off the
   readings were there; a belief with a mismatch is never sure (:meth:`Belief.sure`).
 
