@@ -477,6 +477,18 @@ class _Roller:
         fits = ok & (np.abs(step - arc) <= max(1.0, 0.1 * abs(arc)))
         return bool(w[fits].sum() > w[~ok].sum())
 
+    def _slid(self, slide: float) -> float:
+        """Lift the jaw by the policy's backoff, slide it ``slide`` mm along itself, press it back and read
+        where the contact is on it (mm; inf when the press was refused or the place cannot be read)."""
+        self.hand.press_by(-self.policy.backoff)
+        self.hand.slide_by(slide)
+        try:
+            return self.read_base() if self.pressed() else math.inf
+        except DEVICE_FAULTS:
+            raise
+        except RigError:
+            return math.inf
+
     def _regrasp(self, d: float) -> tuple[float, bool, bool]:
         """The contact reached the end of the jaw's span: lift, slide the jaw along itself so that the
         contact comes back near the other end, put it back on the same point. Returns (the new place
@@ -484,14 +496,7 @@ class _Roller:
         p = self.policy
         target_d = -math.copysign(self.jaw_limit - 2 * p.end_margin, d)
         slide = d - target_d
-        self.hand.press_by(-p.backoff)
-        self.hand.slide_by(slide)
-        try:
-            d_new = self.read_base() if self.pressed() else math.inf
-        except DEVICE_FAULTS:
-            raise
-        except RigError:
-            d_new = math.inf
+        d_new = self._slid(slide)
         if abs(d_new - target_d) <= p.bridge_jump:
             self.turn = self.turn_now()
             self.flt.regrasp(self.z, self.turn, d_new)
@@ -568,14 +573,7 @@ class _Roller:
             # landed at the jaw's end (its tip may be what touches): slide the jaw along itself and start
             # afresh from whatever point of the part it then touches (the filter starts again anyway)
             target = -math.copysign(self.jaw_limit - 2 * p.end_margin, d)
-            self.hand.press_by(-p.backoff)
-            self.hand.slide_by(d - target)
-            try:
-                d = self.read_base() if self.pressed() else math.inf
-            except DEVICE_FAULTS:
-                raise
-            except RigError:
-                d = math.inf
+            d = self._slid(d - target)
             if not abs(d) <= self.jaw_limit:
                 return "lost"
             # the contact moved on along the part by about as much as it moved from the target on the jaw:
