@@ -579,7 +579,6 @@ class ContactFilter:
         """
         if not (math.isfinite(arc) and math.isfinite(turn)):
             raise QueryError(f"arc={arc!r} mm and turn={turn!r} rad must be finite")
-        self._log("update", arc, turn, jaw)
         # only the hypotheses still in the running are moved and summed (the pruned ones are
         # never evaluated again)
         idx = self._live_idx
@@ -618,6 +617,7 @@ class ContactFilter:
         if self.steps % self.refresh == 0:
             self._ref = int(np.argmax(self.log_likelihood()))
             self._slope_priors()
+        self._log("update", arc, turn, jaw)  # once it has been taken: a call that failed is not replayed
 
     def touch(self, jaw: float) -> None:
         """The contact is now at place ``jaw`` (mm from the jaw's centre) on the jaw.
@@ -629,7 +629,6 @@ class ContactFilter:
         """
         if not math.isfinite(jaw):
             raise QueryError(f"jaw={jaw!r} mm must be finite")
-        self._log("touch", jaw)
         self.jaw_position = float(jaw)
         if self._rows == 1 and self.sd_jaw > 0:
             # the first reading (z = 0, p = 0) is where the jaw was laid: it carries the calibration's
@@ -648,6 +647,7 @@ class ContactFilter:
         if not ok.all():
             self._penalty[idx[~ok]] += math.log(CONTRADICTION)
             self._version += 1
+        self._log("touch", jaw)
 
     def bridged(self, turn: float, jaw: float | None = None, jump: float = 3.0) -> float:
         """The jaw, turned to net rotation ``turn`` (rad), touched the part somewhere else (a bridge).
@@ -671,9 +671,9 @@ class ContactFilter:
         if not (math.isfinite(turn) and math.isfinite(jump) and jump > 0):
             raise QueryError(f"turn={turn!r} rad and jump={jump!r} mm must be finite, jump positive")
         d0 = self.jaw_position if jaw is None else float(jaw)
+        self._log("bridged", turn, jaw, jump)
         if not math.isfinite(d0) or self.ruled_out:
             return 1.0
-        self._log("bridged", turn, d0, jump)
         idx = self._live_idx
         w = self.posterior()[idx]
         clear = self._surely_clear(idx, self.turn, float(turn), d0, float(jump), at=self.current[idx])
@@ -728,13 +728,13 @@ class ContactFilter:
         """
         if self._segment + 1 >= self._segments:
             raise QueryError(f"more than {self._segments - 1} regrasps in one localization")
-        self._log("regrasp", arc, turn, jaw)
         self._segment += 1
         self._replaying += 1
         try:
             self.update(arc, turn, jaw)
         finally:
             self._replaying -= 1
+        self._log("regrasp", arc, turn, jaw)
 
     def _log(self, name: str, *args: Any) -> None:
         """Keep a call that changes the state (not one the filter makes of itself, nor a replay's)."""

@@ -43,7 +43,7 @@ def _size(n: int) -> str:
     """A file size for a message: MB from 1 MB on, kB below."""
     if n >= 2**20:
         return f"{n // 2**20} MB" if n % 2**20 == 0 else f"{n / 2**20:.1f} MB"
-    return f"{n / 2**10:.0f} kB"
+    return f"{n / 2**10:.1f} kB"
 
 
 def read_toml(path: str | os.PathLike[str], limit: int, what: str, error: type[Exception]) -> dict[str, Any]:
@@ -60,7 +60,11 @@ def read_toml(path: str | os.PathLike[str], limit: int, what: str, error: type[E
     """
     check_size(path, limit, what, error)
     try:
-        return tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        with open(path, "rb") as f:
+            raw = f.read(limit + 1)  # a pipe or a device says size 0: read no more than the limit
+        if len(raw) > limit:
+            raise error(f"{what} {path}: more than the {_size(limit)} a {what} may have; is it the right file?")
+        return tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError:
         raise error(f"{what} {path}: not a text file (TOML expected)") from None
     except OSError as exc:

@@ -419,7 +419,7 @@ class WheelFilter:
             # the floor is the most noise the stated probability already allows (the largest noise scale):
             # a noise-free pymunk wheel reads 3-5 sigma off the told model over a few readings on a plain
             # convex stretch, which the stated mass takes in and no part's defect needs to be told from
-            floor = self.noise_scales[-1] ** 2
+            floor = max(self.noise_scales) ** 2
             pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, floor), f_dist.sf(stretch / rest, kw, k - kw), 1.0)
             better = pv < best
             best = np.where(better, pv, best)

@@ -457,7 +457,9 @@ def test_a_world_study_writes_how_each_trials_world_differs_and_counts_mismatche
     clean = tmp_path / "clean.toml"
     clean.write_text(f.read_text().split("[world]")[0].replace('methods = ["reactive"]\n', "") + base)
     run_study(load_study(clean), tmp_path / "c", workers=1, progress=False)
-    for r, c in zip(rows, table(tmp_path / "c")):
+    clean_rows = table(tmp_path / "c")
+    assert len(rows) == len(clean_rows) == 2
+    for r, c in zip(rows, clean_rows):
         assert r["start_arc"] == c["start_arc"] and r["part"] == c["part"]
         assert abs(float(r["world_defect_arc"]) - float(r["start_arc"])) <= 5.0
         assert float(r["world_defect_height_mm"]) == 0.3 and float(r["world_scale"]) == 1.0
