@@ -1,6 +1,6 @@
 """Procedurally generated part families, fixed by a seed: parts that no setting was chosen on.
 
-Four kinds, as a new user's parts would be (issue 14):
+Four kinds, as a new user's parts would be:
 
 - ``star``: a random star-shaped outline r(a) = R·(1 + Σ a_k cos(k·a + φ_k)) with one dominant
   lobe count (3 to 8) and smaller harmonics, sized so that some concavities are wider than the

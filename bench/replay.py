@@ -12,7 +12,7 @@ variant that would have stopped earlier, or rolled elsewhere, is judged on the s
 Each variant's line gives the stated probability within the success radius, the error of the
 most probable present contact, and how much more likely (natural log, the evidence untempered)
 the best start within 2 mm of the true one is than the best start elsewhere: negative means the
-filter prefers a wrong place. Issue 14's study of the ×4 failures was done this way.
+filter prefers a wrong place. The study of the ×4 failures in docs/robustness.md was done this way.
 """
 
 from __future__ import annotations

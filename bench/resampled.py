@@ -3,7 +3,7 @@
 A part made from a drawing, or scanned and fitted again, is the model's curve sampled again: a spline
 through the model's points at its knots and half-way between them differs from the model by less than
 a micron on smooth stretches and by microns to tens of microns near tight bends, and nowhere else
-(issue 29's "the model resampled"). For
+("the model resampled" in docs/robustness.md). For
 each part file of a family this writes such a world part of the same name, for a study's
 ``[world] world_parts``::
 

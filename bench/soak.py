@@ -3,7 +3,7 @@
 Every run must end, either localized (exit 0) or with one clear error line (exit 2), within its
 deadline, and leave a run log that reads back (:func:`driver.trace.Trace.from_log`). Each run is its
 own process (as a user runs it) against an emulator in this process with its own seed; the faults
-default to issue 18's ``drop=0.05,garble=0.05,delay=0.01``.
+default to ``drop=0.05,garble=0.05,delay=0.01``.
 
 ``python -m bench.soak --runs 50 --out out/soak`` writes ``runs.json`` (one record per run) and
 prints the tally.

@@ -34,7 +34,7 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    itself and put back on the same point (a regrasp; the filter starts a new
    segment with its own offset), and rolling goes on the same way;
 7. stop at ``max_rotation`` of rolled rotation, sure or not;
-8. a part that is not its model (issue 29): a reading whose contact jumped more than ``reread_jump``
+8. a part that is not its model: a reading whose contact jumped more than ``reread_jump``
    is read twice more and the middle of the three kept (a spike of the wrist's DAQ is one reading),
    as are the readings every step after counts from; when both ways are blocked and a jump was one no
    probable place of the model predicted (the jaw sits on a burr, or between a dent's rims), the jaw
@@ -537,7 +537,7 @@ class _Roller:
         if self.blocked[-self.direction]:
             # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else (on
             # a spline: a drawing's corners and faces make jumps of their own that the belief judges less
-            # well, issue 30)
+            # well)
             spline = not flt.tracks.has_faces and not flt.part.corners
             if spline and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
                 return self._leave(s, d - self.d_prev)
@@ -622,7 +622,7 @@ class _Roller:
             return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
         missed = flt.unexplained_bridges(start)
         if flt.tracks.has_faces or flt.part.corners:
-            missed = []  # a drawing's corners and faces jump of their own (issue 30): not judged here
+            missed = []  # a drawing's corners and faces jump of their own: not judged here
         elif self.unexplained and belief.mass < 0.5:
             # jumps nothing on the model explains, and no place known well enough to say where
             return (math.nan, math.nan), math.nan

@@ -1,4 +1,4 @@
-"""Rolling a wheel finger and localizing with it (issue 17; the physics in docs/wheel.md).
+"""Rolling a wheel finger and localizing with it (the physics in docs/wheel.md).
 
 The hand pose (x, y, φ) is the axle's place and the hand's angle; the hand's axis m = (−sin φ, cos φ)
 points at the part, as the straight jaw's normal does, so :func:`driver.procedures.press` presses a

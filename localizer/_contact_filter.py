@@ -108,7 +108,7 @@ is the corner, which machining moves along its normal only). :meth:`ContactFilte
 reports its maximum, the probability within the success radius of it, the separate modes, and
 whether the data said anything at all (on a circle every start predicts the same readings).
 
-*A part that is not its model* (issue 29; docs/robustness.md). A burr, a dent, debris, a part made
+*A part that is not its model* (docs/robustness.md). A burr, a dent, debris, a part made
 large or to another revision: where the jaw rolls over such a thing the readings follow a shape the
 model does not have, and a burr's crest, a tight convex bend, reads like a fillet of the model
 somewhere else. Three things keep the belief honest about it:

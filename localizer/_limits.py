@@ -1,5 +1,5 @@
 """How large a file the package reads: checked before reading, so that a huge or crafted file is a
-clear error and not the machine's memory (issue 18)."""
+clear error and not the machine's memory."""
 
 from __future__ import annotations
 

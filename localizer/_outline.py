@@ -8,7 +8,7 @@ jaw pivots; negative: a concave one, which a straight jaw cannot touch). At a co
 θ is the value after the corner; :meth:`Outline.tangent_angle_at_arc` with ``side="before"`` gives
 the value before it. Over one lap θ grows by 2π, jumps included.
 
-This is the geometry only; issue 16 plugs it into the solver, the filter and the rigs.
+This is the geometry only; the solver, the filter and the rigs take it from here.
 """
 
 from __future__ import annotations

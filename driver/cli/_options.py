@@ -114,7 +114,7 @@ def positive(text: str) -> float:
     return _number(text, lambda v: v > 0, "a positive number")
 
 
-#: What one command may ask the arm to do, checked before anything moves (issue 18): a rolling step in
+#: What one command may ask the arm to do, checked before anything moves: a rolling step in
 #: :data:`driver.procedures.STEP_RANGE_DEG`; a fixed roll of at most half a turn; a reactive budget of
 #: at most two turns; and at most MAX_STEPS rolling steps in all (at the paper's 0.2° and about 0.3 s a
 #: step on a real arm, 20 000 steps is under two hours; with every command's reply deadline this

@@ -1,4 +1,4 @@
-"""The simulated world a run rolls on when it is not the model as machined (issue 29): ``--world`` and
+"""The simulated world a run rolls on when it is not the model as machined: ``--world`` and
 ``--world-part``, and what the run's JSON and trace say of it."""
 
 from __future__ import annotations
