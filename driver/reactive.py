@@ -312,8 +312,10 @@ class _Roller:
         # a jump no place of the model explains since the filter last started, and the jumps the jaw
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
-        self.unexplained_way = {1: False, -1: False}
         self.left: list[tuple[int, float]] = []
+        # a drawing's corners and faces make jumps of their own, which the belief judges less well: jumps
+        # are neither left nor reported as a mismatch there
+        self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
         self.segment_base = 0  # segments of the filters before a restart
         self.rereads = 0  # readings taken again because one jumped
 
@@ -519,7 +521,6 @@ class _Roller:
             # evidence: the starts under which this turn keeps the jaw clear are less likely
             predicted = flt.bridged(self.turn_now(), jump=p.bridge_jump)
             if predicted < UNEXPLAINED:
-                self.unexplained_way[self.direction] = True
                 self.unexplained = True
         self.hand.rotate_by(-s)
         self.rotation += p.step
@@ -535,11 +536,8 @@ class _Roller:
         flt.regrasp(self.z, self.turn_now(), self.d_prev)
         self.blocked[self.direction] = True
         if self.blocked[-self.direction]:
-            # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else (on
-            # a spline: a drawing's corners and faces make jumps of their own that the belief judges less
-            # well)
-            spline = not flt.tracks.has_faces and not flt.part.corners
-            if spline and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
+            # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else
+            if self.judges_jumps and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
                 return self._leave(s, d - self.d_prev)
             return "blocked"
         self.direction = -self.direction
@@ -589,7 +587,6 @@ class _Roller:
         self.explored = [0.0, 0.0]
         self.blocked = {1: False, -1: False}
         self.unexplained = False
-        self.unexplained_way = {1: False, -1: False}
         self.belief = None
         self.arcs.append(self.z)
         self.turns.append(self.turn)
@@ -621,8 +618,8 @@ class _Roller:
                 return (math.nan, math.nan), abs(jump)
             return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
         missed = flt.unexplained_bridges(start)
-        if flt.tracks.has_faces or flt.part.corners:
-            missed = []  # a drawing's corners and faces jump of their own: not judged here
+        if not self.judges_jumps:
+            missed = []
         elif self.unexplained and belief.mass < 0.5:
             # jumps nothing on the model explains, and no place known well enough to say where
             return (math.nan, math.nan), math.nan

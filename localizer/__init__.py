@@ -7,15 +7,12 @@ from ._cad import CAD_SUFFIXES, load_outline
 from ._contact_filter import (
     BRIDGE_MISS,
     CONTRADICTION,
-    DEFECT_WINDOW,
     ENCODER_SD,
     NOISE_SCALES,
     SCALE_SD,
     SLOPE_ENVELOPE,
     TEMPER,
-    UNEXPLAINED,
     ContactFilter,
-    Misfit,
 )
 from ._defaults import (
     CALIBRATION_SCALE_SD,
@@ -41,6 +38,7 @@ from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._segment import DIRECTIONS, Segment
 from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
+from ._stretches import DEFECT_WINDOW, UNEXPLAINED, Misfit
 from ._tracks import BRIDGE_EXCESS, PIVOT_KAPPA, ModeTracks, tracks_for
 from ._wheel import Finger, WheelJaw, WheelReach, parse_jaw, wheel_reach_for
 from ._wheel_filter import (

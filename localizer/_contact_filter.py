@@ -161,6 +161,19 @@ from ._defaults import CALIBRATION_SCALE_SD, FIT_ALPHA, PART_SCALE_SD, SUCCESS_R
 from ._errors import QueryError
 from ._filter_kernels import add_row
 from ._reach import DEFAULT_JAW, StraightJaw
+from ._stretches import (
+    DEFECT_WINDOW,
+    FIT_EVERY,
+    FIT_MIN_READINGS,
+    FIT_RATIO,
+    FIT_STARTS,
+    FIT_WIDTH,
+    JUMP_READING,
+    MAX_QUARANTINE,
+    UNEXPLAINED,
+    Misfit,
+    stretch_windows,
+)
 from ._tracks import tracks_for
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
@@ -173,10 +186,7 @@ __all__ = [
     "BRIDGE_MISS",
     "ENCODER_SD",
     "TURN_MARGIN",
-    "DEFECT_WINDOW",
-    "UNEXPLAINED",
     "SCALE_SD",
-    "Misfit",
 ]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
@@ -210,40 +220,9 @@ SLOPE_RHO_MAX = 1000.0
 #: at that end: the machined part's slope differs from the model's by 0.6 mrad RMS at the `paper`
 #: preset, peaks of 10 mrad at five times that.
 TURN_MARGIN = 0.02
-#: The rolled arc, mm, of a stretch of readings the belief must not rest on alone, and of the stretches
-#: the fit test judges (module notes, "A part that is not its model"): the straight jaw reads a burr's
-#: crest or a dent's rims over a few millimetres (it jumps across the rest). Chosen on the tuning family
-#: (60 trials, `paper`): 12 mm made 15 of 57 clean sure stops run out of budget, 6 mm none (median 66°
-#: of rolling against 52° at 4 mm and 31° without); none sure and wrong with a 0.3 × 4 mm burr at any.
-DEFECT_WINDOW = 6.0
 #: The prior standard deviation of the scale of every measured arc against the model's: the
 #: calibration's and the part's own (module notes, "A part that is not its model").
 SCALE_SD = math.hypot(CALIBRATION_SCALE_SD, PART_SCALE_SD)
-#: A bridge the belief gave less than this probability when it came is one the part's model does not
-#: explain (:meth:`ContactFilter.bridged`).
-UNEXPLAINED = 0.01
-#: The stretches the fit test judges and quarantines, in units of ``defect_window``: a burr's misfit
-#: goes on past its crest (the slope term and the offset carry it a little), which a stretch twice the
-#: envelope's takes whole (on the tuning family, 60 trials with a 0.3 x 4 mm burr near the start: 23
-#: right at 12 mm, 20 at 6; clean, the same 57 of 60 sure).
-FIT_WIDTH = 2.0
-#: A reading whose arc moved more than this since the one before (mm) came after a jump: the fit test
-#: leaves it out (a face crossed in one step, a dip bridged: the model's approximation of the jump).
-JUMP_READING = 1.0
-#: Readings a fit test needs outside the stretch it judges (fewer cannot tell misfit from noise).
-FIT_MIN_READINGS = 20
-#: Readings between two fit tests while the belief is not sure (a test before every sure stop too).
-FIT_EVERY = 25
-#: How many times the rest's misfit per reading (against its expectation) a stretch's must be to count
-#: as not fitting: on clean machined parts at the `paper` preset the worst stretch of 60 tuning trials
-#: was 4.8 times off (a glyph's nearly straight stroke), the next 2.6.
-FIT_RATIO = 6.0
-#: The most probable starts a fit test judges the readings under (besides each strong mode's best): a
-#: misfit is the part's only if none of them fits.
-FIT_STARTS = 8
-#: How many stretches that do not fit a filter takes out of its likelihood (one burr and the edge of
-#: another, or both rims of a dent); it stops testing after that.
-MAX_QUARANTINE = 3
 
 
 def _quad(s: dict[str, Any], t2: float) -> FloatArray:
@@ -254,36 +233,6 @@ def _quad(s: dict[str, Any], t2: float) -> FloatArray:
     qpr = qpz - qpp
     out: FloatArray = s["qzz"] - 2 * qpz + qpp - t2 * qpr**2 / (1 + t2 * qpp)
     return out
-
-
-class Misfit(NamedTuple):
-    """Where the readings stopped fitting the part (:meth:`ContactFilter.fit_test`).
-
-    Attributes
-    ----------
-    arcs : (float, float), mm
-        The stretch on the model, from the first to the last arc position (counter-clockwise), of the
-        contact under the most probable start over the readings that do not fit.
-    travel : (float, float), mm
-        The same stretch in the rolled arc the readings were given with.
-    p_value : float
-        How likely a misfit this large is from readings that do fit (before the correction for the
-        number of stretches tried).
-    start : float, mm
-        The start of the rolling under which it was judged.
-    rows : tuple of int
-        The readings of the stretch (in the order given, 0 the first).
-    rms_mm : float, mm
-        How far off the model the stretch's readings are, root mean square (as the noise the filter was
-        told would put them).
-    """
-
-    arcs: tuple[float, float]
-    travel: tuple[float, float]
-    p_value: float
-    start: float
-    rows: tuple[int, ...] = ()
-    rms_mm: float = math.nan
 
 
 class _Sums(NamedTuple):
@@ -603,9 +552,7 @@ class ContactFilter:
         z = float(arc)
         self._add_row(z, p, idx, jaw, float(turn))
         if any(lo <= z <= hi for lo, hi in self._zones):
-            j = len(self._readings) - 1
-            self._take([j], -1.0)
-            self._out.add(j)
+            self._take_out(len(self._readings) - 1)
         self.steps += 1
         self.turn, self.arc = float(turn), z
         if jaw is not None:
@@ -759,8 +706,7 @@ class ContactFilter:
                 getattr(self, name)(*args)
                 j = len(self._readings) - 1
                 if name in ("update", "regrasp") and j in out and j not in self._out:
-                    self._take([j], -1.0)
-                    self._out.add(j)
+                    self._take_out(j)
         finally:
             self._replaying -= 1
         self._calls, self._misfits, self._bridges, self._fit_next = calls, misfits, bridges, fit_next
@@ -872,6 +818,11 @@ class ContactFilter:
             self._szz += sign * r.z * r.z
         self._version += 1
 
+    def _take_out(self, j: int) -> None:
+        """Quarantine reading ``j``, just added (its sums are those of the starts live now)."""
+        self._take([j], -1.0)
+        self._out.add(j)
+
     def set_quarantine(self, rows: set[int] | list[int]) -> None:
         """Trust all readings but ``rows`` (indices of the readings in the order given, 0 the first): those
         are taken out of the likelihood, as if never taken; readings quarantined before and not in
@@ -961,15 +912,7 @@ class ContactFilter:
         readings ``rows``: (where each begins, mm, and the positions in ``rows`` of its readings), each
         set of readings once."""
         arcs = np.array([self._readings[j].arc for j in rows])
-        w = self.defect_window if width is None else width
-        out, seen = [], set()
-        for a in np.arange(float(arcs.min()) - 0.75 * w, float(arcs.max()) + 1e-9, 0.25 * w):
-            inside = np.flatnonzero((arcs >= a) & (arcs <= a + w))
-            key = (int(inside[0]), int(inside[-1])) if inside.size else (-1, -1)
-            if inside.size and key not in seen:
-                seen.add(key)
-                out.append((float(a), inside))
-        return out
+        return stretch_windows(arcs, self.defect_window if width is None else width)
 
     def _spread(self) -> bool:
         """Whether the trusted readings span more rolled arc than :attr:`defect_window`: else one stretch

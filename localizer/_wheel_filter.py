@@ -55,19 +55,11 @@ from scipy.stats import chi2
 from scipy.stats import f as f_dist
 
 from ._belief import Belief, belief_flags, find_modes
-from ._contact_filter import (
-    BRIDGE_MISS,
-    CONTRADICTION,
-    DEFECT_WINDOW,
-    FIT_MIN_READINGS,
-    FIT_RATIO,
-    FIT_STARTS,
-    FIT_WIDTH,
-    TEMPER,
-)
+from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._part import Part
+from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 from ._types import BoolArray, FloatArray
 from ._wheel import WheelJaw, wheel_reach_for
 
@@ -371,13 +363,8 @@ class WheelFilter:
         zz, logvar = np.array(self._zz), np.array(self._logvar)
         near = np.abs(np.asarray(self.part.arc_offset(self.present(), arc))) <= radius
         allowed = self.prior > 0
-        worst, seen = 1.0, set()
-        for a in np.arange(float(rolled.min()) - 0.75 * w, float(rolled.max()) + 1e-9, 0.25 * w):
-            inside = np.flatnonzero((rolled >= a) & (rolled <= a + w))
-            key = (int(inside[0]), int(inside[-1])) if inside.size else (-1, -1)
-            if inside.size == 0 or key in seen:
-                continue
-            seen.add(key)
+        worst = 1.0
+        for _, inside in stretch_windows(rolled, w):
             quad = self._quad - zz[inside].sum(axis=0)
             logdet = self._logdet - logvar[inside].sum(axis=0)
             for f in self.noise_scales:
