@@ -149,6 +149,7 @@ part uniformly a little larger or smaller than its model scales every measured a
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -159,7 +160,7 @@ from ._belief import Belief, Mode, belief_flags, find_modes
 from ._boundary import Boundary
 from ._defaults import CALIBRATION_SCALE_SD, FIT_ALPHA, PART_SCALE_SD, SUCCESS_RADIUS
 from ._errors import QueryError
-from ._filter_kernels import add_row
+from ._filter_kernels import add_row, weigh_scales
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._stretches import (
     DEFECT_WINDOW,
@@ -224,6 +225,10 @@ TURN_MARGIN = 0.02
 #: calibration's and the part's own (module notes, "A part that is not its model").
 SCALE_SD = math.hypot(CALIBRATION_SCALE_SD, PART_SCALE_SD)
 
+#: How many stretches of readings are left out at once (one batched solve; its arrays are this many
+#: times the filter's own, so early in a rolling, with every start live, a few tens of MB at most).
+STRETCH_BATCH = 8
+
 
 def _quad(s: dict[str, Any], t2: float) -> FloatArray:
     """Each hypothesis' quadratic form of a :meth:`ContactFilter._solve` (the readings' misfit in units of
@@ -236,15 +241,46 @@ def _quad(s: dict[str, Any], t2: float) -> FloatArray:
 
 
 class _Sums(NamedTuple):
-    """Sums of some readings: UᵀU, Uᵀz, zᵀz, and Uᵀp, pᵀp, zᵀp over the hypotheses live now; how many."""
+    """Sums of some stretches of readings, one per leading index: UᵀU, Uᵀz, zᵀz, and Uᵀp, pᵀp, zᵀp over some
+    hypotheses; how many readings. The basis terms over the columns ``cols`` only (those any reading has
+    touched)."""
 
+    cols: IntArray
     uu: FloatArray
     uz: FloatArray
-    szz: float
+    szz: FloatArray
     up: FloatArray
     spp: FloatArray
     szp: FloatArray
-    readings: int
+    readings: FloatArray
+
+
+class _Stack(NamedTuple):
+    """Some readings, weighted: their basis rows over the columns ``cols`` (k, c), values (k,) and predictions
+    at some hypotheses (k, n)."""
+
+    cols: IntArray
+    a: FloatArray
+    z: FloatArray
+    p: FloatArray
+
+
+def _sums(stack: _Stack, stretches: Sequence[IntArray]) -> _Sums:
+    """The sums of each stretch of readings (their positions in ``stack``), along a leading axis."""
+    mask = np.zeros((len(stretches), stack.z.size))
+    for n, at in enumerate(stretches):
+        mask[n, at] = 1.0
+    masked = np.swapaxes(mask[:, :, None] * stack.a, 1, 2)  # (stretches, c, k)
+    return _Sums(
+        cols=stack.cols,
+        uu=masked @ stack.a,
+        uz=masked @ stack.z,
+        szz=mask @ stack.z**2,
+        up=masked @ stack.p,
+        spp=mask @ stack.p**2,
+        szp=mask @ (stack.z[:, None] * stack.p),
+        readings=mask.sum(axis=1),
+    )
 
 
 class _Reading(NamedTuple):
@@ -849,7 +885,8 @@ class ContactFilter:
 
     def _solve(self, factor: float = 1.0, without: _Sums | None = None, hyps: IntArray | None = None) -> dict[str, Any]:
         """The closed-form marginalisation over the live hypotheses (see the module notes), or over
-        ``hyps``, with the sums of the readings ``without`` taken out (summed over the same hypotheses)."""
+        ``hyps``; with ``without``, once without each of its stretches of readings (summed over the same
+        hypotheses), every array then with a leading axis over the stretches."""
         cols = np.flatnonzero(self._touched)
         s2 = self.sd_position**2
         prior = self._slope_var[cols] * factor**2  # the contact's offset ρ·η: (ρ·sd_slope)²
@@ -857,55 +894,51 @@ class ContactFilter:
         prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw**2
         prior[cols == self._drift] = self.sd_drift**2
         live = np.flatnonzero(self._live) if hyps is None else np.asarray(hyps, dtype=np.int64)
-        uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], self._szz
+        uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
         v, spp, szp = self._up[np.ix_(cols, live)], self._spp[live], self._szp[live]  # v: (m, n_live)
         if without is not None:
-            uu, uz, szz = uu - without.uu[np.ix_(cols, cols)], uz - without.uz[cols], szz - without.szz
-            v, spp, szp = v - without.up[cols], spp - without.spp, szp - without.szp
+            uu, uz, szz = uu - without.uu, uz - without.uz, szz - without.szz
+            v, spp, szp = v - without.up, spp - without.spp, szp - without.szp
         g = uu + np.diag(s2 / prior)
-        gi_v = np.linalg.solve(g, v)
-        wz = uz
-        gi_wz = np.linalg.solve(g, wz)
+        # an inverse and products, not a solve: with ten thousand starts live a solve for each was most of
+        # a belief. Inverted with its diagonal scaled to 1 (its flat offsets' small terms beside the slope
+        # terms' large ones make g's condition 10⁸; scaled, 10⁴ on the benchmark's rolling)
+        d = 1.0 / np.sqrt(np.diagonal(g, axis1=-2, axis2=-1))
+        g_inv = d[..., :, None] * np.linalg.inv(d[..., :, None] * g * d[..., None, :]) * d[..., None, :]
+        gi_v, gi_wz = g_inv @ v, np.einsum("...ij,...j->...i", g_inv, uz)
         # ≥ 0 in exact arithmetic (a squared norm after projection); rounding must not make it less
-        qpp = np.maximum(spp - np.einsum("ij,ij->j", v, gi_v), 0.0) / s2
-        qpz = (szp - gi_wz @ v) / s2
-        qzz = (szz - wz @ gi_wz) / s2
+        qpp = np.maximum(spp - np.einsum("...ij,...ij->...j", v, gi_v), 0.0) / s2
+        qpz = (szp - np.einsum("...i,...ij->...j", gi_wz, v)) / s2
+        qzz = (szz - np.einsum("...i,...i->...", uz, gi_wz))[..., None] / s2  # one per stretch, as the others
         return {
             "cols": cols,
-            "g": g,
+            "g_inv": g_inv,
             "live": live,
             "gi_v": gi_v,
             "gi_wz": gi_wz,
             "qpp": qpp,
             "qpz": qpz,
             "qzz": qzz,
-            "k_less": 0 if without is None else without.readings,
+            "k_less": np.zeros(()) if without is None else without.readings,
         }
 
-    def _stretch_sums(self, rows: list[int], hyps: IntArray | None = None) -> _Sums:
-        """The sums of the readings ``rows`` alone, over the hypotheses live now (or ``hyps``, live)."""
-        m, live = self._m, self._live_idx if hyps is None else np.asarray(hyps, dtype=np.int64)
-        out = _Sums(
-            np.zeros((m, m)),
-            np.zeros(m),
-            0.0,
-            np.zeros((m, live.size)),
-            np.zeros(live.size),
-            np.zeros(live.size),
-            len(rows),
-        )
-        at = np.arange(live.size)
-        touched = np.zeros(m, dtype=bool)
-        szz = 0.0
+    def _stack(self, rows: list[int], hyps: IntArray | None = None) -> _Stack:
+        """The readings ``rows`` as rows of a matrix over the basis, their values and their predictions at
+        the hypotheses live now (or ``hyps``, live): the sums of any stretch of them are then products
+        (:func:`_sums`), each reading gathered once however many stretches hold it."""
+        live = self._live_idx if hyps is None else np.asarray(hyps, dtype=np.int64)
+        cols = np.flatnonzero(self._touched)
+        a, z, p = np.zeros((len(rows), cols.size)), np.zeros(len(rows)), np.zeros((len(rows), live.size))
         where: dict[int, IntArray] = {}  # the live hypotheses' places in each set of hypotheses live then
-        for j in rows:
+        for n, j in enumerate(rows):
             r = self._readings[j]
             pos = where.get(id(r.live))
             if pos is None:
                 pos = where[id(r.live)] = np.searchsorted(r.live, live)
-            add_row(out.up, out.uu, out.uz, out.spp, out.szp, touched, r.cols, r.vals, at, r.p[pos], r.z)
-            szz += r.z * r.z
-        return out._replace(szz=szz)
+            a[n, np.searchsorted(cols, r.cols)] = r.vals
+            z[n] = r.z
+            p[n] = r.p[pos]
+        return _Stack(cols, a, z, p)
 
     def _windows(self, rows: list[int], width: float | None = None) -> list[tuple[float, IntArray]]:
         """The stretches of :attr:`defect_window` mm of rolled arc, overlapping by three quarters, over the
@@ -963,7 +996,10 @@ class ContactFilter:
         if len(rows) < FIT_MIN_READINGS or hyps.size == 0 or self.defect_window <= 0:
             return None
         t2 = self.sd_scale**2
-        q_all = _quad(self._solve(1.0, without=self._stretch_sums(jumps, hyps) if jumps else None, hyps=hyps), t2)
+        # the judged readings first, then the jumps': a stretch's positions in the stack are its own
+        stack = self._stack(rows + jumps, hyps)
+        at_jumps = np.arange(len(rows), len(rows) + len(jumps))
+        q_all = _quad(self._solve(1.0, without=_sums(stack, [at_jumps]), hyps=hyps), t2)[0]
         k = len(rows)
         nuisance = len({self._readings[j].segment for j in rows})
         windows = [
@@ -982,10 +1018,9 @@ class ContactFilter:
         best_p = np.ones(hyps.size)
         best_size = np.zeros(hyps.size)
         best_w: list[tuple[float, IntArray] | None] = [None] * hyps.size
-        for a, inside in windows:
-            chosen = [rows[i] for i in inside]
-            without = self._stretch_sums(chosen + jumps, hyps)
-            q_rest = np.maximum(_quad(self._solve(1.0, without=without, hyps=hyps), t2), 1e-12)
+        without = _sums(stack, [np.concatenate([inside, at_jumps]) for _, inside in windows])
+        q_rests = np.maximum(_quad(self._solve(1.0, without=without, hyps=hyps), t2), 1e-12)
+        for (a, inside), q_rest in zip(windows, q_rests):
             kw, kr = inside.size, k - inside.size - nuisance
             e_w = expect[inside].sum(axis=0)
             stretch = np.maximum(q_all - q_rest, 0.0) / e_w
@@ -1023,15 +1058,16 @@ class ContactFilter:
         top = float(np.max(s["ll"][s["live"]])) if s["live"].size else -math.inf
         lam2 = float(np.median(s["lam2"])) if s["live"].size else 1.0
         out: tuple[int, ...] = ()
-        for _, inside in self._windows(rows, self._fit_width):
-            if inside.size < 3 or len(rows) - inside.size < FIT_MIN_READINGS:
-                continue
-            chosen = [rows[i] for i in inside]
-            sw = self._solve(1.0, without=self._stretch_sums(chosen))
-            ll = self._log_likelihood(sw, prune=False)
-            excess = float(np.max(ll)) - top - self.temper * 0.5 * inside.size * lam2
-            if excess > best:
-                best, out = excess, tuple(chosen)
+        windows = [
+            inside
+            for _, inside in self._windows(rows, self._fit_width)
+            if inside.size >= 3 and len(rows) - inside.size >= FIT_MIN_READINGS
+        ]
+        for first, sw in self._without_each(self._stack(rows), windows):
+            for inside, ll in zip(windows[first:], sw["ll"]):
+                excess = float(np.max(ll)) - top - self.temper * 0.5 * inside.size * lam2
+                if excess > best:
+                    best, out = excess, tuple(rows[i] for i in inside)
         return out
 
     def _expected_misfit(self, rows: list[int], hyps: IntArray) -> FloatArray:
@@ -1079,41 +1115,53 @@ class ContactFilter:
                 float(max(self._readings[j].arc for j in rows)),
             )
         hyps = self._live_idx
+        stack = self._stack(rows, hyps)
         worst, where = 1.0, (math.nan, math.nan)
-        for a, inside in sorted(self._windows(rows), key=lambda w: -w[1].size):
-            s = self._solve(1.0, without=self._stretch_sums([rows[i] for i in inside], hyps), hyps=hyps)
-            s["ll"] = self._log_likelihood(s, prune=False)
-            ll = s["ll"][hyps]
-            wts = np.exp(ll - ll.max())
-            wts /= wts.sum()
+        windows = sorted(self._windows(rows), key=lambda w: -w[1].size)
+        for first, s in self._without_each(stack, [inside for _, inside in windows], hyps):
             mean, sd = self._shift_of(s)
-            present = self.part.wrap_arc(self.current[hyps] + mean[hyps])
-            mass = self._mass_near(wts, present, sd[hyps], arc, radius)
-            if mass < worst:
-                worst, where = mass, (a, a + self.defect_window)
-            if worst < self.confidence:
-                break
+            for n, ll in enumerate(s["ll"][:, hyps]):
+                wts = np.exp(ll - ll.max())
+                wts /= wts.sum()
+                present = self.part.wrap_arc(self.current[hyps] + mean[n, hyps])
+                mass = self._mass_near(wts, present, sd[n, hyps], arc, radius)
+                if mass < worst:
+                    a = windows[first + n][0]
+                    worst, where = mass, (a, a + self.defect_window)
+                if worst < self.confidence:
+                    return worst, where
         return worst, where
 
+    def _without_each(
+        self, stack: _Stack, stretches: list[IntArray], hyps: IntArray | None = None
+    ) -> Iterator[tuple[int, dict[str, Any]]]:
+        """The marginalisation (:meth:`_solve`, with its log-likelihood) without each stretch of readings
+        (positions in ``stack``), a few stretches at a time: (the first one's index, their solve). The
+        first batches are small (1, 2, 4, ...): a caller that stops at the first stretch that decides
+        pays for few more."""
+        first, size = 0, 1
+        while first < len(stretches):
+            s = self._solve(1.0, without=_sums(stack, stretches[first : first + size]), hyps=hyps)
+            s["ll"] = self._log_likelihood(s, prune=False)
+            yield first, s
+            first, size = first + size, min(2 * size, STRETCH_BATCH)
+
     def _log_likelihood(self, s: dict[str, Any], prune: bool = True) -> FloatArray:
-        """Log-likelihood of each start from a :meth:`_solve`, the noise scale weighed out; prunes the
-        hopeless ones. Also leaves in ``s`` each live start's posterior mean of the squared scale."""
+        """Log-likelihood of each start from a :meth:`_solve` (over the grid, after its leading axis if any),
+        the noise scale weighed out; prunes the hopeless ones (of a single solve). Also leaves in ``s`` each
+        live start's posterior mean of the squared scale."""
         live, qpp = s["live"], s["qpp"]
         t2 = self.sd_scale**2
         quad = _quad(s, t2)
         # every standard deviation times λ: the quadratic form scales by 1/λ², the determinant by
         # λ^(2k) with k the readings not absorbed by a flat offset; t2·qpp does not change
-        k = max(self._rows - len(self._out) - s.get("k_less", 0) - (self._segment + 1), 0)
-        lam = np.asarray(self.noise_scales)
-        terms = -0.5 * quad[None, :] / lam[:, None] ** 2 - k * np.log(lam)[:, None]
-        top = terms.max(axis=0)
-        post = np.exp(terms - top)
-        total = post.sum(axis=0)
-        s["lam2"] = (post * lam[:, None] ** 2).sum(axis=0) / total
-        ll_live = self.temper * (top + np.log(total / lam.size) - 0.5 * np.log1p(t2 * qpp)) + self._penalty[live]
-        ll = np.full(self.grid.size, -np.inf)
-        ll[live] = ll_live
-        if prune and self.prune > 0 and live.size:
+        k = np.maximum(self._rows - len(self._out) - s["k_less"] - (self._segment + 1), 0).astype(float)
+        log_mean, lam2 = weigh_scales(np.atleast_2d(quad), np.atleast_1d(k), np.asarray(self.noise_scales, dtype=float))
+        s["lam2"] = lam2.reshape(quad.shape)
+        ll_live = self.temper * (log_mean.reshape(quad.shape) - 0.5 * np.log1p(t2 * qpp)) + self._penalty[live]
+        ll = np.full(qpp.shape[:-1] + self.grid.shape, -np.inf)
+        ll[..., live] = ll_live
+        if prune and self.prune > 0 and live.size and qpp.ndim == 1:
             # hypotheses this far below the best are dropped from later evaluations
             drop = live[ll_live < ll_live.max() - self.prune]
             if drop.size:
@@ -1168,15 +1216,16 @@ class ContactFilter:
         return self._shift_of(self._solved(factor))
 
     def _shift_of(self, s: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
-        """:meth:`shift` from the marginalisation ``s`` (:meth:`_solve`, with its log-likelihood)."""
-        n = self.grid.size
-        mean, sd = np.zeros(n), np.zeros(n)
+        """:meth:`shift` from the marginalisation ``s`` (:meth:`_solve`, with its log-likelihood; with a
+        leading axis as it has)."""
+        shape = s["qpp"].shape[:-1] + self.grid.shape
+        mean, sd = np.zeros(shape), np.zeros(shape)
         live = s["live"]
         # the last rotation reading's error moves the present contact by ρ·e
         kappa = self.tracks.kappa[self.tracks.node_at(self.current[live])]
         var_turn = (self.sd_turn / np.maximum(kappa, 1.0 / RHO_MAX)) ** 2
         if self.sd_slope <= 0:
-            sd[live] = np.sqrt(var_turn)
+            sd[..., live] = np.sqrt(var_turn)
             return mean, sd
         cols = s["cols"]
         a = np.zeros(cols.size)
@@ -1188,15 +1237,15 @@ class ContactFilter:
         qpr = s["qpz"] - s["qpp"]
         d_mean = t2 * qpr / (1 + t2 * s["qpp"])  # the scale's posterior, b = 1 + δ
         d_var = t2 / (1 + t2 * s["qpp"])
-        a_v = a @ s["gi_v"]
-        mean[live] = a @ s["gi_wz"] - (1 + d_mean) * a_v
+        a_v = np.einsum("i,...ij->...j", a, s["gi_v"])
+        mean[..., live] = np.einsum("i,...i->...", a, s["gi_wz"])[..., None] - (1 + d_mean) * a_v
         # pivoting on a corner the real contact is the corner: machining moves it along the normal
         # only, so it keeps its arc, whatever the slope term says of the stretch before it
-        mean[live[self.tracks.pivot[self.node[live]]]] = 0.0
-        var0 = self.sd_position**2 * float(a @ np.linalg.solve(s["g"], a))
+        mean[..., live[self.tracks.pivot[self.node[live]]]] = 0.0
+        var0 = self.sd_position**2 * np.einsum("i,...i->...", a, np.einsum("...ij,j->...i", s["g_inv"], a))
         # the evidence is tempered (TEMPER): so is what it says of the slope term, whose spread
         # grows by 1/TEMPER in variance as the start's does
-        sd[live] = np.sqrt(s["lam2"] * (var0 + d_var * a_v**2) / self.temper + var_turn)
+        sd[..., live] = np.sqrt(s["lam2"] * (var0[..., None] + d_var * a_v**2) / self.temper + var_turn)
         return mean, sd
 
     def posterior(self) -> FloatArray:

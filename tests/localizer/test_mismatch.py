@@ -5,8 +5,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.special import logsumexp, softmax
 
 from localizer import ContactFilter, QueryError, load_part
+from localizer._filter_kernels import weigh_scales
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 STEP = math.radians(0.2)
@@ -171,3 +175,60 @@ def test_a_burr_rolled_over_twice_costs_its_readings_once(kidney):
     assert pruned_before and np.isfinite(flt.log_likelihood()[truth])
     assert 1 <= found_out == len(flt.misfits) and b.mismatch is not None and not b.sure(0.95)
     assert abs(float(kidney.arc_offset(b.map_arc, arcs[-1]))) < 0.3
+
+
+def test_each_stretch_left_out_is_a_filter_that_never_saw_it(cam):
+    # the stretch envelope and the fit test leave stretches out of the sums, several in one batched solve;
+    # a filter that never got a stretch's readings is the independent reference (settings without
+    # order-dependent terms, so that the two hold the same likelihood): the same log-likelihood over the
+    # starts, and, where the stretch is not the last (else the reference's contact is not the present
+    # one), the same probability near the contact
+    plain = {"sd_turn": 0.0, "sd_drift": 0.0, "sd_slope": 0.0, "prune": math.inf}
+    turns = STEP * np.arange(1, 151)
+    flt = ContactFilter(cam, **plain)
+    z, _ = exact(flt, 80.0, turns)
+    z = noisy(z, np.random.default_rng(3), 0.035)
+    for k in range(turns.size):
+        flt.update(float(z[k]), float(turns[k]))
+    arc = flt.belief().map_arc
+    rows = flt._trusted()
+    windows = [inside for _, inside in flt._windows(rows)]
+    solves = list(flt._without_each(flt._stack(rows), windows))
+    assert len(windows) >= 8 and len(solves) < len(windows)  # batched
+    compared = 0
+    for first, s in solves:
+        mean, sd = flt._shift_of(s)
+        for n, inside in enumerate(windows[first : first + s["ll"].shape[0]]):
+            out = {rows[i] for i in inside}
+            ref = ContactFilter(cam, defect_window=0.0, **plain)
+            for k in range(turns.size):
+                if k + 1 not in out:  # reading 0 is the start; update k is reading k + 1
+                    ref.update(float(z[k]), float(turns[k]))
+            ll, ll_ref = s["ll"][n], ref.log_likelihood()
+            live = np.isfinite(ll_ref)
+            np.testing.assert_allclose(ll[live] - ll[live].max(), ll_ref[live] - ll_ref[live].max(), atol=1e-7)
+            if max(out) == len(rows):
+                continue
+            w = np.exp(ll - ll.max())
+            mass = flt._mass_near(w / w.sum(), cam.wrap_arc(flt.current + mean[n]), sd[n], arc, flt.radius)
+            m_ref, s_ref = ref.shift()
+            ref_mass = ref._mass_near(ref.posterior(), cam.wrap_arc(ref.current + m_ref), s_ref, arc, ref.radius)
+            assert mass == pytest.approx(ref_mass, abs=1e-9)
+            compared += 1
+    assert compared >= 4
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    quad=st.lists(st.floats(0.0, 1e5), min_size=1, max_size=6),
+    k=st.integers(0, 400),
+    lam=st.lists(st.floats(0.05, 20.0), min_size=1, max_size=30),
+)
+def test_the_noise_scale_is_weighed_out_as_a_log_mean_of_exponentials(quad, k, lam):
+    q, scales = np.array([quad]), np.array(sorted(lam))
+    terms = -0.5 * q[0][None, :] / scales[:, None] ** 2 - k * np.log(scales)[:, None]
+    expected = logsumexp(terms, axis=0) - math.log(scales.size)
+    post = softmax(terms, axis=0)
+    log_mean, lam2 = weigh_scales(q, np.array([float(k)]), scales)
+    np.testing.assert_allclose(log_mean[0], expected, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(lam2[0], (post * scales[:, None] ** 2).sum(axis=0), rtol=1e-12)
