@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
 from localizer import Outline, Part, part_from_points
 
 from .noise import NoiseModel
+from .offset import offset_boundary
 from .sampled import SAMPLE_SPACING, SampledPart, model_sample
 
 __all__ = ["machined_part", "machined_outline", "machining_deviation", "machining_slope"]
@@ -43,14 +45,26 @@ def machining_deviation(sigma: np.ndarray, perimeter: float, noise: NoiseModel, 
 
 
 def machined_outline(
-    outline: Outline, noise: NoiseModel, rng: np.random.Generator, spacing: float = SAMPLE_SPACING
+    outline: Outline,
+    noise: NoiseModel,
+    rng: np.random.Generator,
+    spacing: float = SAMPLE_SPACING,
+    change: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> SampledPart:
     """The ``outline`` as machined under the ``noise`` model (the same deviation as :func:`machined_part`:
-    harmonics of the arc position, drawn from ``rng``), sampled every ``spacing`` mm with its corners."""
-    arcs, xy, normal = model_sample(outline, spacing)
+    harmonics of the arc position, drawn from ``rng``), sampled every ``spacing`` mm with its corners, the
+    pieces joined at each corner as a real part's are (:func:`sim2d.offset.offset_boundary`).
+
+    ``change`` (arc positions, mm → mm outward) adds a deviation of its own along the same normals (a
+    burr, a dent: :func:`sim2d.world_part.world_part`); the result then says it is ``altered``."""
+    arcs, _, normal = model_sample(outline, spacing)
+    offset = np.zeros(arcs.size)
     if noise.machining_error > 0:
-        xy = xy + machining_deviation(arcs, outline.perimeter, noise, rng)[:, None] * normal
-    return SampledPart(outline, arcs, xy)
+        offset += machining_deviation(arcs, outline.perimeter, noise, rng)
+    if change is not None:
+        offset += change(arcs)
+    arcs, xy = offset_boundary(outline, arcs, normal, offset)
+    return SampledPart(outline, arcs, xy, altered=change is not None)
 
 
 def machining_slope(rms: float, wavelength: float, perimeter: float) -> float:

@@ -368,35 +368,37 @@ def world_part(
     SimError
         A defect or scale that makes the part cross itself (the defect named, and where).
     """
+    P = float(model.perimeter)
+
+    def defects(arcs: np.ndarray) -> np.ndarray:
+        offset = np.zeros(np.shape(arcs))
+        for d in change.defects:
+            offset += d.offset(arcs, P)
+        return offset
+
+    moved = change.shape_differs and change.part is None and bool(change.defects)
     machined: Part | SampledPart = (
-        machined_outline(model, noise, rng, spacing) if isinstance(model, Outline) else machined_part(model, noise, rng)
+        machined_outline(model, noise, rng, spacing, defects if moved else None)
+        if isinstance(model, Outline)
+        else machined_part(model, noise, rng)
     )
     if not change.shape_differs:
         return machined
     if change.part is not None:
         return _registered(model, change.part, spacing)
     if isinstance(machined, SampledPart):
-        arcs, xy = machined.arcs, machined.xy.copy()
-        normal = model_sample(model, spacing)[2]
+        arcs, xy = machined.arcs, machined.xy
     else:
         assert isinstance(model, Part)
         arcs, _, normal = model_sample(model, spacing)
-        xy = np.asarray(machined.point(model.param_at_arc(arcs)), dtype=float)
-    P = float(model.perimeter)
-    offset = np.zeros(arcs.size)
-    for d in change.defects:
-        offset += d.offset(arcs, P)
-    xy = xy + offset[:, None] * normal
-    centre = _centroid(np.asarray(model_sample(model, max(spacing, P / 4000))[1]))
+        xy = np.asarray(machined.point(model.param_at_arc(arcs)), dtype=float) + defects(arcs)[:, None] * normal
     if change.scale != 1.0:
+        centre = _centroid(np.asarray(model_sample(model, max(spacing, P / 4000))[1]))
         xy = centre + change.scale * (xy - centre)
     label = change.describe()
-    # does the change make the part cross itself? Judged on the model with the change alone: the
-    # machining's micron offsets along the two normals of a drawing's concave corner overlap there
-    # whatever the change (the worlds take the deepest point, so that does not matter)
-    changed = np.asarray(model.point_at_arc(arcs), dtype=float) + offset[:, None] * normal
-    changed = centre + change.scale * (changed - centre)
-    crossing = polygon_crossing(np.vstack([changed, changed[:1]]))
+    # does the change make the part cross itself? (its pieces' ends at a drawing's corners are joined as a
+    # real part's, so what crosses is the change: a dent deeper than the part is thick, two bumps that meet)
+    crossing = polygon_crossing(np.vstack([xy, xy[:1]]))
     if crossing is not None:
         where = xy[crossing[0]]
         raise SimError(
