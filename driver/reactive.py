@@ -394,10 +394,14 @@ class _Roller:
             if outcome is not None:
                 stopped = outcome
                 break
-        belief = self.belief
-        if belief is None or belief.steps != flt.steps:
-            belief = flt.belief()
+        if self.belief is None or self.belief.steps != flt.steps:
+            belief = self.belief = flt.belief()
             self.history.append((self.rotation, belief.map_arc, belief.mass, self.true_arc()))
+            if stopped == "max_rotation":
+                # the budget ran out between two checks: the readings since the last one are judged as a
+                # check would judge them (a belief that became sure there is sure)
+                stopped = self._decide(belief) or stopped
+        belief = self.belief
         if stopped != "mismatch":
             where = self._verdict(belief) if belief.consistent else None
             if where is not None:
@@ -631,6 +635,23 @@ class _Roller:
             return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), math.nan
         return None
 
+    def _decide(self, belief: Belief) -> str | None:
+        """Whether ``belief`` ends the run: "mismatch" (nothing fits, or sure on a part that showed
+        something its model does not have), "confident", or None (counts the checks sure in a row)."""
+        if not belief.consistent:
+            return "mismatch"  # nothing on the part fits the readings: never sure
+        self.sure = self.sure + 1 if belief.mass >= self.policy.confidence else 0
+        if self.sure >= self.policy.confirm:
+            # sure where it is, but never "sure" on a part that showed something its model does not have
+            # (a stretch of readings that fit nowhere, a jump the jaw left, or one the belief's place does
+            # not explain): that is reported instead, with where
+            where = self._verdict(belief)
+            if where is not None:
+                self.belief = replace(belief, mismatch=where[0], mismatch_mm=where[1])
+                return "mismatch"
+            return "confident"
+        return None
+
     def _check(self) -> str | None:
         """Look at the belief: "confident" to stop; else the direction rules may turn the jaw round."""
         p, flt = self.policy, self.flt
@@ -649,18 +670,9 @@ class _Roller:
                     "direction": self.direction,
                 }
             )
-        if not belief.consistent:
-            return "mismatch"  # nothing on the part fits the readings: never sure
-        self.sure = self.sure + 1 if belief.mass >= p.confidence else 0
-        if self.sure >= p.confirm:
-            # sure where it is, but never "sure" on a part that showed something its model does not have
-            # (a stretch of readings that fit nowhere, a jump the jaw left, or one the belief's place does
-            # not explain): that is reported instead, with where
-            where = self._verdict(belief)
-            if where is not None:
-                self.belief = replace(belief, mismatch=where[0], mismatch_mm=where[1])
-                return "mismatch"
-            return "confident"
+        decided = self._decide(belief)
+        if decided is not None:
+            return decided
         direction = self.direction
         # a concavity ahead for most of the belief: turn round before bridging it, if the other way
         # is clear beyond what has been rolled there (else roll on: a bridge is detected and undone

@@ -604,6 +604,8 @@ def localize_with_wheel(
             stopped = "max_arc"
             break
     final = flt.belief()
+    if stopped in ("max_rotation", "max_arc") and final.sure(pol.confidence):
+        stopped = "confident"  # the budget ran out between two checks, and the readings since made it sure
     if stopped != "confident" and (final.mismatch is not None or not final.consistent):
         stopped = "mismatch"
     return WheelRun(

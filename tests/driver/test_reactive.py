@@ -90,6 +90,33 @@ def test_the_rotation_budget_stops_it(trefoil):
     assert run.steps == 10
 
 
+def test_a_budget_that_runs_out_between_checks_judges_the_last_readings(trefoil):
+    # the same rolling checked every 5 steps, and never until the budget ends a little after that stop:
+    # the readings since the last check are judged as a check would, and a sure belief there is sure
+    part, cal = trefoil
+    runs = []
+    for policy in (
+        ReactivePolicy(confidence=0.95),
+        ReactivePolicy(confidence=0.95, check_every=100_000, max_rotation=math.radians(60.0)),
+    ):
+        rig = SimRig(part, noise="none", seed=1)
+        runs.append(
+            localize_reactively(
+                rig,
+                part,
+                calibration=cal,
+                filter=ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005),
+                approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+                policy=policy,
+            )
+        )
+    checked, unchecked = runs
+    assert checked.stopped == "confident" and checked.rotation < math.radians(60.0) and checked.reversals == 0
+    assert unchecked.rotation == pytest.approx(math.radians(60.0), abs=1e-9) and len(unchecked.history) == 1
+    assert unchecked.stopped == "confident" and unchecked.belief.mass >= 0.95
+    assert abs(part.arc_offset(unchecked.estimate_arc, unchecked.true_arcs[-1])) < 0.3
+
+
 def test_on_an_ellipse_it_stays_ambiguous_and_says_so():
     part = load_part(PARTS / "ellipse.json")
     cal = calibration(part)

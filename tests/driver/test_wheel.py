@@ -225,3 +225,17 @@ def test_the_calibration_stretch_lies_within_the_longest_the_wheel_surely_reache
         assert offset >= 2.0 and offset + CALIBRATION_LENGTH <= longest * reach.h - 2.0 + reach.h
     with pytest.raises(RigError, match="gauge block"):
         wheel_calibration_arc(part, wheel, length=1000.0)
+
+
+def test_a_budget_that_runs_out_between_checks_judges_the_last_readings():
+    # the same noise-free wheel rolling checked every 4 steps, and not until a budget a little beyond that
+    # stop: the readings since the last check decide as a check would
+    part, wheel = load_part("parts/kidney.csv"), WheelJaw(5.0)
+    runs = []
+    for policy in (WheelPolicy(), WheelPolicy(check_every=100_000, max_rotation=math.radians(200.0))):
+        rig = WheelRig(part, wheel)
+        runs.append(localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(65.0), policy=policy))
+    checked, unchecked = runs
+    assert checked.stopped == "confident" and checked.rotation < math.radians(200.0)
+    assert unchecked.stopped == "confident" and not unchecked.history
+    assert abs(part.arc_offset(unchecked.estimate_arc, unchecked.true_arcs[-1])) < 0.3
