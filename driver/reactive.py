@@ -15,7 +15,8 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    noise, and 5 of 21 into 3 of 18 on the tuning family at ×5.6, for 1–6° more
    rolling; on the held-out family (heldout-b, ×4) it made no difference (6 of
    81 against 5 of 82: near misses at 0.3–0.7 mm come as often one check later),
-   so it is not the default;
+   so it is not the default. When the rotation budget runs out between two checks, the
+   readings since the last one are judged as a check would judge them;
 4. the direction rule: while the belief has two or more modes, compare how much
    the next ``lookahead`` of *unexplored* rotation each way separates the two
    leading ones (how much their radii of curvature differ over it,
