@@ -64,8 +64,8 @@ def offset_boundary(
     corners = getattr(model, "corners", ())
     if not corners:
         return arcs, xy
-    n = arcs.size
-    keep = np.ones(n, dtype=bool)
+    keep = np.ones(arcs.size, dtype=bool)
+    spacing = float(np.max(np.diff(arcs)))
     rounds: dict[int, np.ndarray] = {}  # points that stand for a corner's sample, where the pieces part
     at = np.searchsorted(arcs, [c.arc for c in corners])
     P = float(model.perimeter)
@@ -87,7 +87,7 @@ def offset_boundary(
         # is judged against the other piece's nearest point and normal there, not its tangent line at the
         # corner: a dent's overlap at a sharp corner reaches millimetres along curved pieces
         reach = OVERLAP_REACH * abs(o) * math.tan(0.5 * min(abs(corner.angle), 3.1))
-        reach = min(reach + 2.0 * float(np.max(np.diff(arcs))), 0.45 * min(gaps[k], gaps[k - 1]))
+        reach = min(reach + 2.0 * spacing, 0.45 * min(gaps[k], gaps[k - 1]))
         before = np.flatnonzero(((arcs[i] - arcs) % P > 0) & ((arcs[i] - arcs) % P <= reach))
         after = np.flatnonzero((arcs - arcs[i]) % P <= reach)
         sign = math.copysign(1.0, corner.angle)
