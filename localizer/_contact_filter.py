@@ -296,6 +296,7 @@ class _Reading(NamedTuple):
     turn: float
     segment: int
     weight: float
+    radius: float  # the reference's radius of curvature then (mm; 0 on a face or a concave stretch)
 
 
 def _bspline(x: float) -> tuple[IntArray, FloatArray]:
@@ -828,7 +829,9 @@ class ContactFilter:
         live = np.arange(self.grid.size) if idx is None else np.asarray(idx, dtype=np.int64)
         add_row(self._up, self._uu, self._uz, self._spp, self._szp, self._touched, cols, vals, live, p, z)
         self._szz += z * z
-        self._readings.append(_Reading(cols, vals, z, live, p, z / wt, turn, self._segment, wt))
+        self._readings.append(
+            _Reading(cols, vals, z, live, p, z / wt, turn, self._segment, wt, rho if rho < RHO_MAX else 0.0)
+        )
 
     def _take(self, rows: list[int], sign: float) -> None:
         """Take the readings ``rows`` (indices into the readings added) out of the sums (``sign`` -1) or
@@ -964,7 +967,10 @@ class ContactFilter:
         if j < 1:
             return False
         r, q = self._readings[j], self._readings[j - 1]
-        return r.segment == q.segment and abs(r.arc - q.arc) > JUMP_READING
+        # beyond the step the radius then makes of the turn: a plain stretch of 300 mm radius moves a
+        # millimetre every 0.2°
+        expected = r.radius * abs(r.turn - q.turn)
+        return r.segment == q.segment and abs(r.arc - q.arc) - expected > JUMP_READING
 
     def _trusted(self) -> list[int]:
         """The readings the likelihood holds (not the first, which only places the start; not quarantined)."""

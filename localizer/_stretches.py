@@ -39,8 +39,9 @@ UNEXPLAINED = 0.01
 #: envelope's takes whole (on the tuning family, 60 trials with a 0.3 x 4 mm burr near the start: 23
 #: right at 12 mm, 20 at 6; clean, the same 57 of 60 sure).
 FIT_WIDTH = 2.0
-#: A reading whose arc moved more than this since the one before (mm) came after a jump: the fit test
-#: leaves it out (a face crossed in one step, a dip bridged: the model's approximation of the jump).
+#: A reading whose arc moved more than this (mm) beyond what the model's radius there makes of the turn
+#: since the one before came after a jump: the fit test leaves it out (a face crossed in one step, a dip
+#: bridged: the model's approximation of the jump).
 JUMP_READING = 1.0
 #: Readings a fit test needs outside the stretch it judges (fewer cannot tell misfit from noise).
 FIT_MIN_READINGS = 20

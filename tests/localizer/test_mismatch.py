@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.special import logsumexp, softmax
 
-from localizer import ContactFilter, QueryError, load_part
+from localizer import ContactFilter, QueryError, load_part, part_from_points
 from localizer._filter_kernels import weigh_scales
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
@@ -232,3 +232,24 @@ def test_the_noise_scale_is_weighed_out_as_a_log_mean_of_exponentials(quad, k, l
     log_mean, lam2 = weigh_scales(q, np.array([float(k)]), scales)
     np.testing.assert_allclose(log_mean[0], expected, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(lam2[0], (post * scales[:, None] ** 2).sum(axis=0), rtol=1e-12)
+
+
+def test_a_stretch_off_a_large_radius_is_judged_too():
+    # on a 400 mm radius the contact moves 1.4 mm every 0.2°: a jump is a step beyond what the radius
+    # makes of the turn, not any step over a millimetre (which would leave every reading here unjudged)
+    a = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+    r = 400.0 + 6.0 * np.cos(3 * a)
+    big = part_from_points(np.c_[r * np.cos(a), r * np.sin(a)], name="big")
+    turns = STEP * np.arange(1, 121)
+    flt = ContactFilter(big, spacing=0.2)
+    z, _ = exact(flt, 300.0, turns)
+    assert np.median(np.abs(np.diff(z))) > 1.0
+    z = noisy(z, np.random.default_rng(5), 0.035)
+    # a burr's crest: the jaw pivots on it for 6 mm of the model's rolling, the contact held, then goes on
+    hold = np.flatnonzero((np.abs(z) > 60.0) & (np.abs(z) < 66.0))
+    z[hold] = z[hold[0]]
+    for k in range(turns.size):
+        flt.update(float(z[k]), float(turns[k]))
+    truth = int(round(300.0 / flt.tracks.h))
+    found = flt.fit_test([truth])
+    assert found is not None and found.rms_mm > 0.1
