@@ -164,6 +164,11 @@ def cell_pass(
         g[r] = th_e - th0 - turn
         dg[r] = k_e - kac[0, j if i < J else 0]
         ce[r] = c_e
+    # g is periodic: at P it is g at 0, taken once. Evaluated again through the wrap (θ + 2π on both
+    # terms) it differs by a rounding, and a root at the seam itself, where g(0) is a rounding from zero,
+    # fell between the two: neither the last cell nor the first saw a sign change
+    g[m] = g[0]
+    dg[m] = dg[0]
     nz = 0
     zbuf = np.empty(m + 1)
     brackets = np.empty((64, 7))

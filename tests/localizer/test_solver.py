@@ -202,3 +202,17 @@ def test_near_double_roots_are_found_not_skipped(offset):
         assert all(s.residual < 1e-6 for s in near)
     if offset > 1e-8:  # two distinct roots, both found
         assert len(near) == 2 and all(s.kind == "simple" for s in near)
+
+
+def test_a_start_at_the_seam_is_found():
+    # g(σ) is periodic: a root at σ = 0 exactly, where g(0) is a rounding from zero, must be seen by the
+    # first cell or the last, whichever side of zero that rounding fell (it fell between them for 9 of
+    # these 3000 queries when g at P was evaluated again through the wrap)
+    for seed in range(1000):
+        part = part_from_points(random_part_points(np.random.default_rng(seed)))
+        P = part.perimeter
+        for lfrac in (0.01, 0.1, 0.4):
+            L = lfrac * P
+            w = float(part.total_curvature(part.param_at_arc(0.0), part.param_at_arc(L)))
+            starts = [s.start_arc for s in feasible_segments(part, L, w)]
+            assert circular_distance(starts, 0.0, P).min() <= 1e-6, (seed, lfrac)
