@@ -950,6 +950,15 @@ class ContactFilter:
         arcs = np.array([self._readings[j].arc for j in rows])
         return stretch_windows(arcs, self.defect_window if width is None else width)
 
+    def _judged_windows(self, rows: list[int]) -> list[tuple[float, IntArray]]:
+        """The stretches of the fit test's width over the readings ``rows`` that it can judge: three
+        readings at least, and enough outside (:data:`FIT_MIN_READINGS`) to tell misfit from noise."""
+        return [
+            (a, inside)
+            for a, inside in self._windows(rows, self._fit_width)
+            if inside.size >= 3 and len(rows) - inside.size >= FIT_MIN_READINGS
+        ]
+
     def _spread(self) -> bool:
         """Whether the trusted readings span more rolled arc than :attr:`defect_window`: else one stretch
         holds them all, and without it nothing is known."""
@@ -1008,11 +1017,7 @@ class ContactFilter:
         q_all = _quad(self._solve(1.0, without=_sums(stack, [at_jumps]), hyps=hyps), t2)[0]
         k = len(rows)
         nuisance = len({self._readings[j].segment for j in rows})
-        windows = [
-            (a, inside)
-            for a, inside in self._windows(rows, self._fit_width)
-            if inside.size >= 3 and k - inside.size >= FIT_MIN_READINGS
-        ]
+        windows = self._judged_windows(rows)
         if not windows:
             return None
         # what each reading's misfit should be under each start: the row weights were set from one
@@ -1064,11 +1069,7 @@ class ContactFilter:
         top = float(np.max(s["ll"][s["live"]])) if s["live"].size else -math.inf
         lam2 = float(np.median(s["lam2"])) if s["live"].size else 1.0
         out: tuple[int, ...] = ()
-        windows = [
-            inside
-            for _, inside in self._windows(rows, self._fit_width)
-            if inside.size >= 3 and len(rows) - inside.size >= FIT_MIN_READINGS
-        ]
+        windows = [inside for _, inside in self._judged_windows(rows)]
         for first, sw in self._without_each(self._stack(rows), windows):
             for inside, ll in zip(windows[first:], sw["ll"]):
                 excess = float(np.max(ll)) - top - self.temper * 0.5 * inside.size * lam2
