@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from driver.lockfile import LockHeld, hold_lock
+from localizer import fingerprint, load_part
 
 from .study import TRIAL_COLUMNS, Study, StudyError, TrialSpec, run_trial
 
@@ -129,7 +130,7 @@ def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, pr
     table = out / "trials.csv"
     if resume and table.exists():
         _check_same_study(study, out)
-    (out / "study.json").write_text(json.dumps(study.as_dict(), indent=2) + "\n")
+    (out / "study.json").write_text(json.dumps(_study_record(study), indent=2) + "\n")
     done = set()
     if resume and table.exists():
         rows = read_trials(table, warn=True)
@@ -223,8 +224,17 @@ def _write_summary(study: Study, table: Path, out: Path, t0: float) -> dict:
     return summary
 
 
+def _study_record(study: Study) -> dict:
+    """study.json: the study's settings, and the fingerprint (:func:`localizer.fingerprint`) of each of its
+    part files and world part files, by path: a part file edited between runs is another study."""
+    files = list(study.parts) + list(study.world.world_parts if study.world is not None else ())
+    # read afresh, not from the worker's cache: the file as it is now is the question
+    return {**study.as_dict(), "fingerprints": {f: fingerprint(load_part(f)) for f in dict.fromkeys(files)}}
+
+
 def _check_same_study(study: Study, out: Path) -> None:
-    """Refuse to resume a table that another study wrote (its study.json differs, or is missing)."""
+    """Refuse to resume a table that another study wrote (its study.json differs, or is missing), or that
+    was written on part files since edited (their fingerprints differ)."""
     saved = out / "study.json"
     try:
         before = json.loads(saved.read_text())
@@ -233,7 +243,19 @@ def _check_same_study(study: Study, out: Path) -> None:
             f"--resume: {out / 'trials.csv'} has no readable study.json beside it, so whose trials it holds "
             "cannot be told; use another --out or drop --resume"
         ) from None
-    now = json.loads(json.dumps(study.as_dict()))
+    now = json.loads(json.dumps(_study_record(study)))
+    marks = before.get("fingerprints")
+    if isinstance(marks, dict):
+        edited = [f for f, mark in now["fingerprints"].items() if f in marks and marks[f] != mark]
+        if edited:
+            raise StudyError(
+                f"--resume: {out / 'trials.csv'} was written on {edited[0]} as it was before (fingerprint "
+                f"{marks[edited[0]]}, now {now['fingerprints'][edited[0]]}): the part file has changed since, "
+                f"so its trials and new ones would mix two geometries; use another --out, or drop --resume to "
+                "start afresh"
+            )
+    else:  # written before study.json held fingerprints: the settings alone can be compared
+        now.pop("fingerprints")
     # where the study file lies is not what it asks for (a copied study is the same study)
     differ = sorted(k for k in set(before) | set(now) if k != "source" and before.get(k) != now.get(k))
     if differ:

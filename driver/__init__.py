@@ -1,5 +1,6 @@
 """Rig protocol, procedures, pipeline, serial rig and the command line (depends on localizer)."""
 
+from .part_match import PartMismatch, check_same_part, part_record
 from .rig import (
     Clocked,
     ForceServo,
@@ -28,4 +29,7 @@ __all__ = [
     "ProtocolError",
     "TransportError",
     "ImplausibleReading",
+    "PartMismatch",
+    "part_record",
+    "check_same_part",
 ]

@@ -27,6 +27,7 @@ from ._defaults import (
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._files import load_part
+from ._fingerprint import QUANTUM_MM, fingerprint
 from ._limits import MAX_PART_BYTES, check_size, read_toml
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
@@ -113,6 +114,8 @@ __all__ = [
     "QueryError",
     "Part",
     "load_part",
+    "fingerprint",
+    "QUANTUM_MM",
     "part_from_points",
     "polygon_crossing",
     "UNITS_TO_MM",

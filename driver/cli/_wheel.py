@@ -9,6 +9,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_for
 
+from ..part_match import check_same_part, part_record
 from ..rig import RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
@@ -132,7 +133,7 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     trace = WheelTrace.from_run(
         run,
         calibration,
-        part={"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        part=part_record(part, args.part),
         engine=args.engine,
         noise=str(args.noise),
         seed=args.seed,
@@ -220,6 +221,7 @@ def locate_wheel(args, path) -> int:
     if args.jaw is not None and str(args.jaw) != trace.metadata["jaw"]:
         raise RigError(f"trace {path} is of a {trace.metadata['jaw']} finger, not of {args.jaw}")
     part = _spline_only(load_part(args.part), trace.wheel)
+    check_same_part(trace.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
     b = trace.relocalize(part)
     true = trace.true_arc
     doc = {

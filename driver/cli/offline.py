@@ -11,6 +11,7 @@ import numpy as np
 
 from localizer import DEFAULT_JAW, DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
 
+from ..part_match import SAME_PART_FLAG, check_same_part
 from ..rig import RigError
 from ._options import (
     PLOT_SUFFIXES,
@@ -98,6 +99,11 @@ def register(sub) -> None:
     )
     lct.add_argument("trace", help="trace file (.npz) from 'rolltouch simulate'")
     lct.add_argument("--part", required=True, help="part file (the model the localizer is given; a point file)")
+    lct.add_argument(
+        SAME_PART_FLAG,
+        action="store_true",
+        help="score the trace on --part although it was made on another part file (one known to be the same)",
+    )
     jaw_argument(lct, default=None)
     lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
     lct.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -186,6 +192,7 @@ def locate_command(args) -> int:
         raise RigError(f"trace {args.trace} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
     part = load_part(args.part)
     trace = Trace.load(args.trace)
+    check_same_part(trace.metadata.get("part"), part, args.part, f"trace {args.trace}", same=args.same_part)
     estimates = trace.estimates()
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"
     loc = localize(part, estimates, rule=args.rule, direction=direction)

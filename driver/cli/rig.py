@@ -10,6 +10,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, WheelJaw
 
+from ..part_match import part_record
 from ._options import (
     PLOT_SUFFIXES,
     STEP_DEG,
@@ -139,7 +140,7 @@ def run_command(args) -> int:
     calibration = loaded if isinstance(loaded, Calibration) else None
     header = {
         "jaw": str(args.jaw),
-        "part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        "part": part_record(part, args.part),
         "arm": args.arm,
         "daq": args.daq,
         "rolls_deg": rolls,
@@ -192,7 +193,7 @@ def run_command(args) -> int:
 def _wheel_header(args, part, calibration) -> dict:
     header = {
         "jaw": str(args.jaw),
-        "part": {"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        "part": part_record(part, args.part),
         "arm": args.arm,
         "daq": args.daq,
     }

@@ -11,6 +11,7 @@ import numpy as np
 
 from localizer import Outline, QueryError, WheelJaw
 
+from ..part_match import part_record
 from ..rig import RigError
 from ._options import (
     PLOT_SUFFIXES,
@@ -172,6 +173,7 @@ def simulate_command(args) -> int:
                 json.dumps(
                     {
                         **doc,
+                        "part": part_record(part, args.part),
                         "jaw": str(args.jaw),
                         "noise": str(args.noise),
                         "seed": args.seed,
@@ -211,7 +213,7 @@ def simulate_command(args) -> int:
     trace = Trace.from_run(
         run,
         calibration,
-        part={"name": part.name, "file": str(args.part), "perimeter": part.perimeter},
+        part=part_record(part, args.part),
         engine=args.engine,
         jaw=str(args.jaw),
         noise_name=str(args.noise),

@@ -469,3 +469,19 @@ def test_a_world_study_writes_how_each_trials_world_differs_and_counts_mismatche
     summary = json.loads((tmp_path / "w" / "summary.json").read_text())
     d = summary["method_details"]["reactive"]
     assert d["mismatch"] == sum(r["reactive_stopped"] == "mismatch" for r in rows)
+
+
+def test_resume_refuses_a_part_file_edited_since(tmp_path):
+    part = tmp_path / "cam.json"
+    doc = json.loads((ROOT / "parts" / "cam.json").read_text())
+    part.write_text(json.dumps(doc))
+    f = study_file(tmp_path, trials=2)
+    f.write_text(f.read_text().replace(str(ROOT / "parts" / "cam.json"), str(part)))
+    run_study(load_study(f), tmp_path / "out", workers=1, progress=False)
+    saved = json.loads((tmp_path / "out" / "study.json").read_text())
+    assert list(saved["fingerprints"]) == [str(part)]
+    run_study(load_study(f), tmp_path / "out", resume=True, workers=1, progress=False)  # unchanged: resumes
+    doc["points"][3][0] += 3.0  # one knot moved 3 mm
+    part.write_text(json.dumps(doc))
+    with pytest.raises(StudyError, match=r"cam\.json as it was before .* the part file has changed since"):
+        run_study(load_study(f), tmp_path / "out", resume=True, workers=1, progress=False)
