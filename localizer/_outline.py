@@ -36,6 +36,12 @@ JOIN_TOL = 1e-6
 #: (or, turned the other way, a concave corner the jaw cannot touch) in the middle of a smooth
 #: stretch. 1e-3 rad is half of two steps of the arm's 0.03° encoder: a jump the jaw cannot sense.
 SMOOTH_TOL = 1e-3
+#: A corner whose direction turns by more than π less this, rad, is a fold: the outline goes back along
+#: itself (a line drawn twice, a zero-width slot), which no part has.
+FOLD_TOL = 1e-6
+#: An outline enclosing less than this times its perimeter squared has no inside (a sliver; a square
+#: has 1/16, a 1 mm strip 1 m long 2.5e-4).
+AREA_RTOL = 1e-6
 
 
 class Corner(NamedTuple):
@@ -262,6 +268,19 @@ def outline_from_pieces(pieces: list[Piece] | tuple[Piece, ...], *, name: str = 
     if crossing is not None:
         where = poly[crossing[0]]
         raise PartError(f"outline {name!r} crosses itself near ({where[0]:.3f}, {where[1]:.3f}) mm")
+    for corner in outline.corners:
+        if abs(corner.angle) > math.pi - FOLD_TOL:
+            x, y = (float(v) for v in outline.point_at_arc(corner.arc))
+            raise PartError(
+                f"outline {name!r} folds back on itself at ({x:.3f}, {y:.3f}) mm (its direction reverses there): "
+                "a part's outline goes round an inside; is a line drawn twice, or the loop not closed?"
+            )
+    area = 0.5 * float(np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1]))
+    if abs(area) < AREA_RTOL * outline.perimeter**2:
+        raise PartError(
+            f"outline {name!r} encloses {abs(area):.3g} mm² with a perimeter of {outline.perimeter:.3f} mm: it has "
+            "no inside to roll on; is a line drawn twice, or the loop not closed?"
+        )
     turning = outline.turning
     if abs(abs(turning) - 2.0 * math.pi) > 1e-6:
         raise PartError(f"outline {name!r} turns by {turning:.6f} rad, not one full turn: not a simple closed outline")

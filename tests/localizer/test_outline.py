@@ -147,3 +147,27 @@ def test_degenerate_pieces_are_refused():
         CircularArc((0, 0), -1, 0.0, 1.0)
     with pytest.raises(PartError, match="cusp"):
         CubicBezier((0, 0), (0, 0), (0, 0), (10, 0))
+
+
+def test_a_loop_that_folds_back_or_encloses_nothing_is_not_a_part():
+    # (0,0) (50,0) (100,0) closed: a line drawn out and back; once it loaded as a 200 mm outline with two
+    # -pi corners and localize took gigabytes
+    there_and_back = [Line((0, 0), (50, 0)), Line((50, 0), (100, 0)), Line((100, 0), (0, 0))]
+    with pytest.raises(PartError, match=r"folds back on itself at \(0\.000, 0\.000\) mm"):
+        outline_from_pieces(there_and_back)
+    # a stadium 1e-4 mm wide: no corner, a sliver with no inside
+    w, length = 1e-4, 100.0
+    stadium = [
+        Line((0, 0), (length, 0)),
+        CircularArc((length, w / 2), w / 2, -math.pi / 2, math.pi),
+        Line((length, w), (0, w)),
+        CircularArc((0, w / 2), w / 2, math.pi / 2, math.pi),
+    ]
+    with pytest.raises(PartError, match=r"encloses 0\.01 mm² with a perimeter of 200\.000 mm: it has no inside"):
+        outline_from_pieces(stadium)
+    # a knife edge of a real part (a 1° wedge) and a 1 mm strip a metre long are parts
+    narrow = [Line((0, 0), (1000, 0)), Line((1000, 0), (1000, 1)), Line((1000, 1), (0, 1)), Line((0, 1), (0, 0))]
+    assert len(outline_from_pieces(narrow).corners) == 4
+    tip = (100 * math.cos(math.radians(1)), 100 * math.sin(math.radians(1)))
+    wedge = outline_from_pieces([Line((0, 0), (100, 0)), Line((100, 0), tip), Line(tip, (0, 0))])
+    assert max(abs(c.angle) for c in wedge.corners) == pytest.approx(math.radians(179), abs=1e-9)
