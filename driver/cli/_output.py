@@ -7,7 +7,7 @@ import json
 import math
 import sys
 
-from localizer import FIT_ALPHA, SUCCESS_RADIUS, ContactFilter
+from localizer import FIT_ALPHA, SUCCESS_RADIUS
 
 from ..rig import GroundTruth
 from ._options import pressing
@@ -52,8 +52,9 @@ def ending_progress_line(log):
 
 
 def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:
-    """Run the reactive localization on ``rig``: the JSON object of 'simulate|run --reactive' and the
-    :class:`driver.reactive.ReactiveRun`."""
+    """Run the reactive localization on ``rig``: the JSON object of 'simulate|run --reactive', the
+    :class:`driver.reactive.ReactiveRun` and its filter's calls (:meth:`driver.filter_log.LoggedFilter.columns`)."""
+    from driver.filter_log import LoggedFilter
     from driver.reactive import ReactivePolicy, localize_reactively
 
     policy = ReactivePolicy(
@@ -63,7 +64,7 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
         rig,
         part,
         calibration=calibration,
-        filter=ContactFilter(part),
+        filter=(flt := LoggedFilter(part)),
         approach_pose=approach_pose,
         policy=policy,
         pressing=pressing(args),
@@ -82,7 +83,7 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
         "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
         **truth_fields(part, b, rig),
     }
-    return doc, res
+    return doc, res, flt.columns()
 
 
 def belief_fields(b) -> dict:

@@ -9,8 +9,19 @@ import sys
 
 import numpy as np
 
-from localizer import DEFAULT_JAW, DIRECTIONS, LENGTH_TOL, RULES, TURN_TOL, Outline, load_part, localize
+from localizer import (
+    DEFAULT_JAW,
+    DIRECTIONS,
+    LENGTH_TOL,
+    RULES,
+    TURN_TOL,
+    ContactFilter,
+    Outline,
+    load_part,
+    localize,
+)
 
+from ..filter_log import CALLS, LOG_COLUMNS, REACTIVE_FORMAT, replay_log
 from ..part_match import SAME_PART_FLAG, check_same_part
 from ..rig import RigError
 from ._options import (
@@ -22,10 +33,10 @@ from ._options import (
     positive,
     read_part,
 )
-from ._output import emit_run, no_fit_line, run_summary
+from ._output import belief_fields, emit_run, exit_status, no_fit_line, print_belief, run_summary
 from ._wheel import locate_wheel
 
-__all__ = ["register", "localize_command", "locate_command"]
+__all__ = ["register", "localize_command", "locate_command", "locate_reactive"]
 
 
 def register(sub) -> None:
@@ -97,7 +108,10 @@ def register(sub) -> None:
         help="localize from a saved trace",
         description="Recompute the rolls' (L, Ω) from a trace's readings and localize.",
     )
-    lct.add_argument("trace", help="trace file (.npz) from 'rolltouch simulate'")
+    lct.add_argument(
+        "trace",
+        help="trace file (.npz) from 'rolltouch simulate' (fixed rolls or --reactive, either finger), or a run log",
+    )
     lct.add_argument("--part", required=True, help="part file (the model the localizer is given; a point file)")
     lct.add_argument(
         SAME_PART_FLAG,
@@ -188,6 +202,8 @@ def locate_command(args) -> int:
             return locate_wheel(args, args.trace)
     elif trace_format(args.trace) == WHEEL_FORMAT:
         return locate_wheel(args, args.trace)
+    elif trace_format(args.trace) == REACTIVE_FORMAT:
+        return locate_reactive(args, args.trace)
     if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
         raise RigError(f"trace {args.trace} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
     part = load_part(args.part)
@@ -197,3 +213,39 @@ def locate_command(args) -> int:
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"
     loc = localize(part, estimates, rule=args.rule, direction=direction)
     return emit_run(args, run_summary(part, trace, loc), part, trace, loc)
+
+
+def locate_reactive(args, path) -> int:
+    """'locate TRACE --part PART' of a reactive rolling's trace (straight jaw): its filter calls made again
+    on a filter of the default settings, as the run's was, and the belief printed as the run printed it.
+
+    Where the part seemed to differ from its model is the filter's finding, or else the run's own
+    (a jump the jaw left, or one no place explains: what the hand did, which the calls do not hold)."""
+    from driver.trace import read_archive
+
+    if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
+        raise RigError(f"trace {path} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
+    meta, columns = read_archive(path, LOG_COLUMNS)
+    truth = read_archive(path, ("true_arcs",))[1]["true_arcs"]  # one per reading: another length
+    part = load_part(args.part)
+    check_same_part(meta.get("part"), part, args.part, f"trace {path}", same=args.same_part)
+    b = replay_log(ContactFilter(part), columns)
+    doc = {
+        "part": part.name,
+        "method": "reactive",
+        **{k: meta[k] for k in ("stopped", "rotation_deg", "steps", "reversals", "regrasps") if k in meta},
+        **belief_fields(b),
+        "readings": int(np.count_nonzero(columns["call"] == CALLS.index("update"))),
+        "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+    }
+    if doc["mismatch"] is None and isinstance(meta.get("mismatch"), dict):
+        doc["mismatch"] = meta["mismatch"]
+    if truth.size and math.isfinite(truth[-1]):
+        doc["true_arc"] = float(truth[-1])
+        doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, truth[-1])))
+    if args.json:
+        print(json.dumps(doc, indent=2))
+    else:
+        print(f"reactive trace, {doc['readings']} readings replayed")
+        print_belief(doc)
+    return exit_status(doc)

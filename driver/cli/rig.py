@@ -224,7 +224,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
             Hand(rig, here)
         x, y, phi = here
         start = (x + 40.0 * math.cos(phi), y + 40.0 * math.sin(phi), phi)  # as run_from_here: contact at -40 mm
-        doc, _ = run_reactive(args, rig, part, calibration, start, observer=progress)
+        doc, _, _ = run_reactive(args, rig, part, calibration, start, observer=progress)
     args.interrupted = RELEASED
     if log is not None:
         log({"event": "result", **doc})

@@ -11,6 +11,7 @@ import numpy as np
 
 from localizer import Outline, QueryError, WheelJaw
 
+from ..filter_log import REACTIVE_FORMAT
 from ..part_match import part_record
 from ..rig import RigError
 from ._options import (
@@ -158,7 +159,7 @@ def simulate_command(args) -> int:
     jaw_start = -40.0 if rolls[0] > 0 else 40.0
     _check_reach(part, args.start, jaw_start)
     if args.reactive:
-        doc, res = run_reactive(
+        doc, res, calls = run_reactive(
             args, rig, part, calibration, rig.approach_pose(args.start, jaw_position=jaw_start, standoff=1.0)
         )
         doc.update(world_fields(change, rig))
@@ -169,10 +170,12 @@ def simulate_command(args) -> int:
             true_arcs=np.array(res.true_arcs),
             segments=np.array(res.segments),
             history=np.array(res.history, dtype=float).reshape(-1, 4),
+            **calls,
             metadata=np.array(
                 json.dumps(
                     {
                         **doc,
+                        "format": REACTIVE_FORMAT,
                         "part": part_record(part, args.part),
                         "jaw": str(args.jaw),
                         "noise": str(args.noise),
