@@ -87,7 +87,7 @@ class LoggedFilter(ContactFilter):
 
     def belief(self, radius: float | None = None) -> Belief:
         self._keep("belief", value=radius)
-        return self._call(super().belief, radius)  # type: ignore[no-any-return]
+        return self._call(super().belief, radius)
 
     def columns(self) -> dict[str, np.ndarray]:
         """The calls kept so far, as the arrays :data:`LOG_COLUMNS` names (``call``: int8 codes of

@@ -28,7 +28,15 @@ from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
 from ._files import load_part
 from ._fingerprint import QUANTUM_MM, fingerprint
-from ._limits import MAX_PART_BYTES, check_size, read_toml
+from ._limits import (
+    MAX_ARRAY_BYTES,
+    MAX_GRID_POINTS,
+    MAX_PAIRWISE_POINTS,
+    MAX_PART_BYTES,
+    check_grid,
+    check_size,
+    read_toml,
+)
 from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
 from ._outline import Corner, Outline, outline_from_pieces
 from ._outline_solver import outline_segments
@@ -76,7 +84,11 @@ __all__ = [
     "UNEXPLAINED",
     "Misfit",
     "MAX_PART_BYTES",
+    "MAX_GRID_POINTS",
+    "MAX_PAIRWISE_POINTS",
+    "MAX_ARRAY_BYTES",
     "check_size",
+    "check_grid",
     "read_toml",
     "ContactFilter",
     "ParticleFilter",

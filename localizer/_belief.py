@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ._limits import check_grid
 from ._types import FloatArray
 
 __all__ = ["Belief", "Mode", "find_modes", "belief_flags"]
@@ -95,6 +96,7 @@ def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray
     radius : float, mm
     """
     nb = max(8, int(part.perimeter / radius))
+    check_grid(part, "belief", radius, nb, unit="bins", advice=f"is radius={radius!r} mm meant?")
     b = np.minimum((present / part.perimeter * nb).astype(int), nb - 1)
     mass = np.bincount(b, weights=w, minlength=nb)
     live = mass > 1e-4 * mass.max()

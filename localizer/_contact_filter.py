@@ -161,6 +161,7 @@ from ._boundary import Boundary
 from ._defaults import CALIBRATION_SCALE_SD, FIT_ALPHA, PART_SCALE_SD, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._filter_kernels import add_row, weigh_scales
+from ._limits import check_grid
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._stretches import (
     DEFECT_WINDOW,
@@ -175,7 +176,7 @@ from ._stretches import (
     Misfit,
     stretch_windows,
 )
-from ._tracks import tracks_for
+from ._tracks import grid_size, tracks_for
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
 __all__ = [
@@ -444,6 +445,20 @@ class ContactFilter:
             raise QueryError(f"jaw_margin={jaw_margin!r} mm must be ≥ 0")
         if not (math.isfinite(defect_window) and defect_window >= 0):
             raise QueryError(f"defect_window={defect_window!r} mm must be ≥ 0 (0: trust every stretch)")
+        # a part too large for the grid of starts or for the sums over it (8 bytes × the basis columns laid
+        # out below: exact with the slope, jaw and drift terms on, more without) is refused before either is built
+        check_grid(
+            part,
+            "filter",
+            spacing,
+            grid_size(part, spacing),
+            point_bytes=8.0
+            * (
+                2 * math.ceil(part.perimeter / shape_spacing)
+                + math.ceil(2 * (jaw.half + jaw_margin) / jaw_spacing)
+                + 64
+            ),
+        )
         self.defect_window = float(defect_window)
         # the stretches the fit test judges: twice the envelope's (a burr's misfit and its edges)
         self._fit_width = FIT_WIDTH * self.defect_window

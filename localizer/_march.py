@@ -33,6 +33,7 @@ import numpy as np
 from ._cache import per_part
 from ._defaults import LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
+from ._limits import check_grid
 from ._part import Part, _curvature
 from ._segment import Segment
 from ._types import FloatArray
@@ -159,6 +160,19 @@ def _build(part: Part, h: float) -> MarchGrid:
     M = int(round(n / h))
     if 4 * n > M or abs(M * h - n) > 1e-9 * n:
         raise QueryError(f"step={h!r} must divide the parameter period {n} into at least {4 * n} cells")
+    # three numbers a cell, the cells a step of the parameter apart: the paper's grid is as large as the knots
+    # are many (not as the part is long), and meant to be fine
+    check_grid(
+        part,
+        "march",
+        h,
+        M + 1,
+        limit=None,
+        point_bytes=24,
+        unit="cells",
+        per="of a knot",
+        advice=f"it has {n} knots; take a coarser step (MarchOptions.step)",
+    )
     length = np.empty(M + 1)
     turn = np.empty(M + 1)
     kappa = np.empty(M + 1)

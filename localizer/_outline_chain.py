@@ -29,6 +29,7 @@ import math
 
 import numpy as np
 
+from ._limits import _count, check_grid
 from ._outline import Outline
 from ._segment import Segment
 from ._types import FloatArray, IntArray
@@ -59,6 +60,15 @@ def _nodes(outline: Outline, h: float, dpsi: float) -> tuple[FloatArray, FloatAr
     Also returns each corner's states (indices, in rolling order)."""
     P = outline.perimeter
     n = int(math.ceil(P / h))
+    # the states are a point every h and each corner's angles every dpsi; several arrays of them per roll
+    at_corners = sum(max(2, int(math.ceil(abs(c.angle) / dpsi))) - 1 for c in outline.corners)
+    advice = (
+        f"{_count(at_corners)} of them at its {len(outline.corners)} corners, one every {dpsi:.3g} rad of their "
+        "jumps: give a larger sd_turn"
+        if at_corners > n
+        else "is the part in the right units (mm)?"
+    )
+    check_grid(outline, "roll chain", h, n + at_corners, unit="states", advice=advice)
     sig = np.arange(n) * (P / n)
     psi = outline.tangent_angle_at_arc(sig)
     order_key, owner = [np.zeros(n)], [np.full(n, -1)]
@@ -235,6 +245,7 @@ def chain_paper(
     for seg in segs:
         starts = np.array([seg.start_arc])
         if seg.kind == "continuum" and seg.span > 0:
+            check_grid(outline, "paper rule", spacing, seg.span / spacing + 1, unit="starts along a face")
             starts = seg.start_arc + sign * np.linspace(0.0, seg.span, max(2, int(seg.span / spacing) + 1))
         pos = starts[:, None] + sign * np.concatenate([[0.0], np.cumsum(lengths)])[None, :]
         lo, hi = _interval(outline, pos.ravel(), length_tol)

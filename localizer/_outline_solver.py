@@ -36,6 +36,7 @@ from scipy.optimize import brentq
 from ._cache import per_part
 from ._certify import certify_cells
 from ._errors import QueryError
+from ._limits import check_grid
 from ._outline import Outline
 from ._pieces import CubicBezier
 from ._segment import DIRECTIONS, Segment
@@ -103,6 +104,8 @@ def outline_segments(
         raise QueryError(f"length={length!r} mm must be in (0, {P:.6g}) and turn={turn!r} rad finite")
     if not (math.isfinite(spacing) and spacing > 0):
         raise QueryError(f"spacing={spacing!r} mm must be positive")
+    # the certified cells cover the lap once
+    check_grid(outline, "outline solver", spacing, P / spacing, unit="cells")
     omega = turn if direction == "ccw" else -turn
     found = _solve_ccw(outline, float(length), float(omega), spacing)
     segs = []
@@ -256,6 +259,12 @@ def _bezier_slopes(outline: Outline, spacing: float) -> dict[int, tuple[float, n
     """Per Bézier piece: (table step h, mm; bound of |dκ/dσ| on each table cell, 1/mm²), built once."""
 
     def build() -> dict[int, tuple[float, np.ndarray]]:
+        cells = sum(
+            max(8, int(math.ceil(piece.length / (0.5 * spacing))))
+            for piece in outline.pieces
+            if isinstance(piece, CubicBezier)
+        )
+        check_grid(outline, "outline solver's Bézier table", 0.5 * spacing, cells, unit="cells")
         out = {}
         for i, piece in enumerate(outline.pieces):
             if not isinstance(piece, CubicBezier):

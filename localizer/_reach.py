@@ -40,6 +40,7 @@ from scipy.spatial import ConvexHull
 from ._boundary import Boundary
 from ._cache import per_part
 from ._errors import QueryError
+from ._limits import MAX_PAIRWISE_POINTS, check_grid
 from ._outline import Outline
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
 
@@ -125,10 +126,14 @@ class Reach:
             raise QueryError(f"spacing={spacing!r} mm must be a positive number")
         if not (math.isfinite(clearance) and clearance >= 0):
             raise QueryError(f"clearance={clearance!r} mm must be ≥ 0")
-        self.part, self.jaw = part, jaw
-        self.clearance = float(clearance)
         p = part.perimeter
         n = max(64, int(math.ceil(p / spacing)))
+        # each point's interval looks at every other point: the time grows as the square of n
+        check_grid(
+            part, "straight jaw's reach table", spacing, n, limit=MAX_PAIRWISE_POINTS, unit="points (each against all)"
+        )
+        self.part, self.jaw = part, jaw
+        self.clearance = float(clearance)
         self.h = p / n
         self.sigma = np.arange(n) * self.h
         pts = np.asarray(part.point_at_arc(self.sigma))

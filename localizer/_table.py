@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._cache import per_part
+from ._limits import check_grid
 from ._part import _TWO_PI, Part, _curvature, _wrap
 from ._poly import bernstein_bounds, horner
 from ._types import ArrayLike, FloatArray, IntArray
@@ -150,6 +151,10 @@ def _build(part: Part, max_theta_error: float) -> ArcTable:
     while True:
         m = part.cells_per_piece * sub
         J = n * m
+        # a few dozen numbers a cell, and the cells grow with the knots, not the perimeter
+        check_grid(
+            part, "arc table", part.perimeter / J, J, unit="cells", advice=f"it has {n} knots; are they all needed?"
+        )
         j = np.arange(J)
         piece = j // m
         u0 = (j % m) / m

@@ -10,6 +10,7 @@ from scipy.optimize import brentq
 
 from ._boundary import Boundary
 from ._cache import per_part
+from ._limits import check_grid
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 from ._tracks_kernels import step_along
 from ._types import ArrayLike, BoolArray, FloatArray, IntArray
@@ -47,6 +48,13 @@ def tracks_for(part: Boundary, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -
     return per_part("tracks", part, (float(spacing), jaw), lambda: ModeTracks(part, spacing, jaw))
 
 
+def grid_size(part: Boundary, spacing: float) -> int:
+    """How many points :class:`ModeTracks` lays over ``part`` at ``spacing`` mm: the perimeter and each
+    convex corner's :data:`PIVOT_SPREAD`, at least 64 (known before anything is built)."""
+    spread = np.array([PIVOT_SPREAD * c.angle for c in part.corners if c.angle > 0])
+    return max(64, int(math.ceil((part.perimeter + float(spread.sum())) / spacing)))
+
+
 class ModeTracks:
     """Where each of a set of hypotheses' contacts goes under further rotation, and where the jaw reaches.
 
@@ -82,6 +90,7 @@ class ModeTracks:
     """
 
     def __init__(self, part: Boundary, spacing: float, jaw: StraightJaw = DEFAULT_JAW) -> None:
+        check_grid(part, "rolling tracks", spacing, grid_size(part, spacing))
         self.part = part
         self.jaw = jaw
         p = part.perimeter

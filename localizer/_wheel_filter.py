@@ -58,6 +58,7 @@ from ._belief import Belief, belief_flags, find_modes
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
+from ._limits import check_grid
 from ._part import Part
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 from ._types import BoolArray, FloatArray
@@ -168,6 +169,7 @@ class WheelFilter:
         self.noise_scales = tuple(float(f) for f in noise_scales)
         P = float(part.perimeter)
         n = max(64, int(math.ceil(P / spacing)))
+        check_grid(part, "wheel filter", spacing, n)
         self.h = P / n
         self.grid: FloatArray = np.arange(n, dtype=float) * self.h
         self._theta0 = self._theta(self.grid)

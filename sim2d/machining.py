@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from localizer import Outline, Part, part_from_points
+from localizer import Outline, Part, check_grid, part_from_points
 
 from .noise import NoiseModel
 from .offset import offset_boundary
@@ -27,6 +27,16 @@ def machined_part(part: Part, noise: NoiseModel, rng: np.random.Generator) -> Pa
     """
     if noise.machining_error <= 0:
         return part
+    # one harmonic a wavelength of the perimeter, each summed over the knots in turn
+    wavelength = noise.machining_wavelength
+    check_grid(
+        part,
+        "simulated machining",
+        wavelength,
+        part.perimeter / wavelength,
+        unit="harmonics",
+        advice=f"is the part in the right units (mm), and machining_wavelength={wavelength:g} mm meant?",
+    )
     knots = np.arange(part.n_knots, dtype=float)
     dev = machining_deviation(part.arc_at_param(knots), part.perimeter, noise, rng)
     pts = part.points + dev[:, None] * part.normal(knots)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from localizer import Outline, Part
+from localizer import Outline, Part, check_grid
 
 __all__ = ["SampledPart", "SAMPLE_SPACING", "model_sample", "polygon_vertices"]
 
@@ -63,6 +63,7 @@ def model_sample(model: Part | Outline, spacing: float = SAMPLE_SPACING) -> tupl
     """(arcs mm, points mm, outward unit normals) of the ``model`` every ``spacing`` mm of arc, with every
     corner's arc among them (the normal there is the one after the corner)."""
     P = float(model.perimeter)
+    check_grid(model, "simulated part", spacing, P / spacing + len(model.corners))
     arcs = np.unique(np.concatenate([np.arange(0.0, P, spacing), [c.arc for c in model.corners]]))
     xy = np.asarray(model.point_at_arc(arcs), dtype=float)
     theta = np.asarray(model.tangent_angle_at_arc(arcs), dtype=float)

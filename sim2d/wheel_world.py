@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from localizer import Part
+from localizer import Part, check_grid
 
 from ._errors import SimError
 from .sampled import SampledPart
@@ -94,6 +94,7 @@ class WheelWorld:
             self._xy, self._arc = np.asarray(part.xy, dtype=float), np.asarray(part.arcs, dtype=float)
         elif isinstance(part, Part):
             n = max(256, int(math.ceil(part.perimeter / SAMPLE_STEP)))
+            check_grid(part, "wheel world", SAMPLE_STEP, n)
             self._t = np.asarray(part.param_at_arc(np.arange(n) * part.perimeter / n), dtype=float)
             self._xy = np.asarray(part.point(self._t), dtype=float)
             # the machined spline's parameters are the model's (sim2d.machining.machined_part)
