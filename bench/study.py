@@ -47,6 +47,9 @@ Several methods on the same trials (instead of ``method``)::
                                          #   localizer.SLOPE_ENVELOPE; [] the slope prior alone)
     defect_window = 12.0                 # optional: mm of rolled arc no belief may rest on alone,
                                          #   and the stretch the fit test judges (0: neither)
+    lookalike_slope = 8.0                # optional: the factor on sd_slope under which a look-alike
+                                         #   must be ruled out too (default localizer.LOOKALIKE_SLOPE;
+                                         #   0: no such check)
 
     [world]                              # optional: how each trial's world differs from the model
     defects = 1                          #   (sim2d.world_part): defects near the start, or anywhere,
@@ -193,6 +196,7 @@ class ReactiveOptions:
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
     slope_envelope: tuple | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
     defect_window: float | None = None  # None: localizer.DEFECT_WINDOW (mm); 0: trust every stretch, test none
+    lookalike_slope: float | None = None  # None: localizer.LOOKALIKE_SLOPE; 0: no look-alike check
 
 
 @dataclass(frozen=True)
@@ -507,7 +511,7 @@ def _options(path, table, cls, name):
                 raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a list of positive factors")
             values[key] = tuple(float(v) for v in value)
             continue
-        if key == "defect_window" and isinstance(value, (int, float)) and value == 0:
+        if key in ("defect_window", "lookalike_slope") and isinstance(value, (int, float)) and value == 0:
             values[key] = 0.0
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):

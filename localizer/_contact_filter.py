@@ -139,6 +139,21 @@ somewhere else. Three things keep the belief honest about it:
   on the model, under the most probable start, the first one lies, and ``mismatch_mm`` how far off the
   readings were there; a belief with a mismatch is never sure (:meth:`Belief.sure`).
 
+- *A look-alike under a form tolerance.* The slope prior (``sd_slope``, 1 mrad) is the machining's; a
+  part a few hundredths of a millimetre off its drawing where that error changes over a few millimetres
+  (a part made from a re-fitted curve, a scan: the model resampled moves 22 µm and tilts 11 mrad) moves
+  the contact by ρ·η, 0.3 mm at ρ = 30 mm, and the difference that told a star's arm from its look-alike
+  then lay in that error: sure at 0.951, 386 mm off. Which *place* it is must therefore hold under the
+  slope prior :data:`LOOKALIKE_SLOPE` times wider too: where the belief would be sure, the stated mass
+  is at most the probability, under that prior, that the start's nominal present contact is within
+  :data:`LOOKALIKE_RADIUS` of the most probable one's (nominal: the wide prior's offset at the present
+  contact is not the question here, and would make the answer "nowhere" on a flat stretch). Asked at
+  every belief and pruned under, the wide prior kept ten thousand starts live and tripled the cost of a
+  rolling; asked where it decides, it weighs the starts the envelope keeps. Weighing the slope prior's scale by the
+  readings' evidence instead (Occam's factor included) was tried on the tuning family and dropped: the
+  simulated machining itself is up to twice the told prior, so the readings chose 2 to 16 times on
+  clean parts and half the sure stops were lost.
+
 A bridge that no probable start predicted (:meth:`bridged` returns the probability it had) is kept,
 so that the rolling can ask whether the final place explains it (:meth:`unexplained_bridges`). And a
 part uniformly a little larger or smaller than its model scales every measured arc: the scale term
@@ -189,6 +204,8 @@ __all__ = [
     "ENCODER_SD",
     "TURN_MARGIN",
     "SCALE_SD",
+    "LOOKALIKE_SLOPE",
+    "LOOKALIKE_RADIUS",
 ]
 
 #: Factors on the filter's noise settings it weighs when it is not sure of them (module notes): a
@@ -218,6 +235,16 @@ RHO_MAX = 5000.0
 #: (metres times mrad) that it makes the marginalisation ill-conditioned, and it is already wide
 #: enough to leave the contact's place on such a stretch to the other readings.
 SLOPE_RHO_MAX = 1000.0
+#: The factor on ``sd_slope`` under which a look-alike place must be ruled out too (module notes, "A part
+#: that is not its model"): a part a few hundredths of a millimetre off its drawing, where that error
+#: changes over a few millimetres, has slopes several mrad off (the model resampled: 22 µm, 11 mrad),
+#: which at ρ = 30 mm moves the contact 0.3 mm along a roll: more than what told a star's arm from its
+#: look-alike 386 mm away, at a stated 0.951.
+LOOKALIKE_SLOPE = 8.0
+#: How near, mm, a start's nominal present contact must be to the most probable one to count as the same
+#: place in the look-alike check: farther is another feature of the part; nearer, the envelope's
+#: radius judges the spread.
+LOOKALIKE_RADIUS = 3.0
 #: How far, rad, a rotation may run past the model's end of a convex stretch and keep the contact
 #: at that end: the machined part's slope differs from the model's by 0.6 mrad RMS at the `paper`
 #: preset, peaks of 10 mrad at five times that.
@@ -371,6 +398,11 @@ class ContactFilter:
         slope prior and these, of the probability within ``radius`` of the most probable present
         contact (a lower probability over a set of priors; module notes, "Trust"). ``()``: the
         slope prior alone.
+    lookalike_slope : float
+        A factor on ``sd_slope`` under which a sure mass is also at most the probability that the start's
+        nominal present contact is within :data:`LOOKALIKE_RADIUS` of the most probable one's: a look-alike
+        place must be ruled out under a part off its model by a form tolerance, not only by machining
+        (default :data:`LOOKALIKE_SLOPE`; 0: no such check). Module notes, "A part that is not its model".
     noise_scales : sequence of float
         Common factors on ``sd_position``, ``sd_scale``, ``sd_slope`` and ``sd_jaw`` that the filter weighs
         with equal prior probability (the real noise is rarely what the settings say; module
@@ -407,6 +439,7 @@ class ContactFilter:
         jaw_margin: float = 2.0,
         noise_scales: ArrayLike = NOISE_SCALES,
         slope_envelope: ArrayLike = SLOPE_ENVELOPE,
+        lookalike_slope: float = LOOKALIKE_SLOPE,
         sd_jaw: float = 0.015,
         jaw_spacing: float = 5.0,
         sd_turn: float = ENCODER_SD,
@@ -423,6 +456,7 @@ class ContactFilter:
             ("sd_jaw", sd_jaw),
             ("sd_turn", sd_turn),
             ("sd_drift", sd_drift),
+            ("lookalike_slope", lookalike_slope),
         ):
             if not (math.isfinite(value) and value >= 0):
                 raise QueryError(f"{name}={value!r} must be ≥ 0")
@@ -468,6 +502,7 @@ class ContactFilter:
         self.temper = float(temper)
         self.noise_scales = tuple(float(v) for v in scales)
         self.slope_envelope = tuple(float(v) for v in envelope if v != 1.0) if sd_slope > 0 else ()
+        self.lookalike_slope = float(lookalike_slope) if sd_slope > 0 else 0.0
         self.tracks = tracks_for(part, spacing, jaw)
         self.sd_position = float(sd_position)
         self.sd_scale = float(sd_scale)
@@ -1318,6 +1353,14 @@ class ContactFilter:
             w_f = self._posterior(factor)
             mean_f, sd_f = self._shift(factor)
             mass = min(mass, self._mass_near(w_f, part.wrap_arc(self.current + mean_f), sd_f, map_arc, radius))
+        if self.lookalike_slope > 0 and mass >= self.confidence:
+            # ... and no look-alike place under a part a form tolerance off its model: which place, so the
+            # starts' nominal present contacts (the slope term's offset there is the envelope's question).
+            # Asked only where it would decide: the starts it weighs are those live under the envelope
+            nominal = part.wrap_arc(self.current)
+            w_f = self._posterior(self.lookalike_slope)
+            zero = np.zeros_like(nominal)
+            mass = min(mass, self._mass_near(w_f, nominal, zero, float(nominal[i]), LOOKALIKE_RADIUS))
         if self.slope_envelope:
             self._prune_under_every_prior()
         modes = self._modes(w, present, radius)

@@ -10,6 +10,7 @@ import pytest
 from localizer import (
     BRIDGE_MISS,
     CONTRADICTION,
+    LOOKALIKE_SLOPE,
     SLOPE_ENVELOPE,
     ContactFilter,
     QueryError,
@@ -242,7 +243,16 @@ def test_noise_four_times_what_it_was_told_does_not_make_it_sure_and_wrong(kidne
         z = travel + e[1:] - e[0]
         for name, extra in (
             ("weighed", {}),
-            ("told", {"noise_scales": (1.0,), "temper": 1.0, "slope_envelope": (), "defect_window": 0.0}),
+            (
+                "told",
+                {
+                    "noise_scales": (1.0,),
+                    "temper": 1.0,
+                    "slope_envelope": (),
+                    "lookalike_slope": 0.0,
+                    "defect_window": 0.0,
+                },
+            ),
         ):
             sure, est, k = stop_rule(ContactFilter(kidney, spacing=0.05, **told, **extra), z, turns, every=10)
             wrong[name] += bool(sure and abs(kidney.arc_offset(est, start + travel[k - 1])) > 0.3)
@@ -319,9 +329,16 @@ def test_a_look_alike_that_the_slope_term_explains_is_not_stated_sure():
     rec = json.loads((DATA / "heldout-a-glyph22-x4-t26.json").read_text())
     part = load_part(DATA / rec["part"])
     verdicts = {}
-    for envelope in ((), SLOPE_ENVELOPE):
-        # every stretch trusted (defect_window 0): what the slope envelope alone does
-        flt = ContactFilter(part, radius=0.3, confidence=0.95, slope_envelope=envelope, defect_window=0.0)
+    for envelope, lookalike in (((), 0.0), (SLOPE_ENVELOPE, 0.0)):
+        # every stretch trusted (defect_window 0), no look-alike check: what the slope envelope alone does
+        flt = ContactFilter(
+            part,
+            radius=0.3,
+            confidence=0.95,
+            slope_envelope=envelope,
+            lookalike_slope=lookalike,
+            defect_window=0.0,
+        )
         true = int(np.argmin(np.abs(part.arc_offset(flt.grid, rec["start_arc"]))))
         sure = wrong = 0
         for name, args, kwargs in rec["calls"]:
@@ -331,6 +348,31 @@ def test_a_look_alike_that_the_slope_term_explains_is_not_stated_sure():
                 if b.mass >= 0.95:
                     sure += 1
                     wrong += abs(part.arc_offset(b.map_arc, float(part.wrap_arc(flt.current[true])))) > 0.3
-        verdicts[envelope] = (sure, wrong)
-    assert verdicts[()][1] >= 50, verdicts
-    assert verdicts[SLOPE_ENVELOPE][1] == 0, verdicts
+        verdicts[envelope, lookalike] = (sure, wrong)
+    assert verdicts[(), 0.0][1] >= 50, verdicts
+    assert verdicts[SLOPE_ENVELOPE, 0.0][1] == 0, verdicts
+
+
+def test_a_look_alike_is_not_stated_sure_on_a_part_a_form_tolerance_off_its_model():
+    # A star of the heldout-g family against its model resampled (the world within 22 µm of the model
+    # there, its slope up to 11 mrad off): 131 recorded calls of the reactive rolling (world-heldout-g-
+    # resampled.toml trial 64, run with the look-alike check off), which stopped sure at 0.951 on the
+    # star's look-alike arm 386 mm from the truth after 26°. Under the slope prior eight times wider the
+    # true arm fits as well: with the check the filter is never sure there.
+    rec = json.loads((DATA / "heldout-g-resampled-star12-t64.json").read_text())
+    part = load_part(DATA / rec["part"])
+    verdicts = {}
+    for lookalike in (0.0, LOOKALIKE_SLOPE):
+        flt = ContactFilter(part, lookalike_slope=lookalike, **rec["settings"])
+        true = int(np.argmin(np.abs(part.arc_offset(flt.grid, rec["start_arc"]))))
+        sure = wrong = 0
+        for name, args, kwargs in rec["calls"]:
+            getattr(flt, name)(*args, **kwargs)
+            if name == "update" and flt.steps % 5 == 0:
+                b = flt.belief()
+                off = abs(part.arc_offset(b.map_arc, float(part.wrap_arc(flt.current[true]))))
+                sure += b.mass >= 0.95
+                wrong += b.mass >= 0.95 and off > 0.3
+        verdicts[lookalike] = (sure, wrong)
+    assert verdicts[0.0][1] >= 1, verdicts
+    assert verdicts[LOOKALIKE_SLOPE] == (0, 0), verdicts
