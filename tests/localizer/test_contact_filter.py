@@ -320,6 +320,22 @@ def test_a_bridge_counts_against_the_starts_that_expected_the_way_clear(star):
 DATA = Path(__file__).resolve().parent / "data"
 
 
+def sure_checks(rec, part, flt):
+    """Recorded calls of a reactive rolling (bench.replay) made on ``flt``, the belief asked every fifth
+    reading as the rolling did: (checks stated sure, of them wrong: more than 0.3 mm from the true
+    start's present contact)."""
+    true = int(np.argmin(np.abs(part.arc_offset(flt.grid, rec["start_arc"]))))
+    sure = wrong = 0
+    for name, args, kwargs in rec["calls"]:
+        getattr(flt, name)(*args, **kwargs)
+        if name == "update" and flt.steps % 5 == 0:
+            b = flt.belief()
+            if b.mass >= 0.95:
+                sure += 1
+                wrong += abs(part.arc_offset(b.map_arc, float(part.wrap_arc(flt.current[true])))) > 0.3
+    return sure, wrong
+
+
 def test_a_look_alike_that_the_slope_term_explains_is_not_stated_sure():
     # A glyph of the heldout-a family at four times the paper noise: 1152 recorded calls of the
     # reactive rolling (bench.replay, heldout-a.toml level 3 trial 26). With the slope prior alone,
@@ -329,28 +345,12 @@ def test_a_look_alike_that_the_slope_term_explains_is_not_stated_sure():
     rec = json.loads((DATA / "heldout-a-glyph22-x4-t26.json").read_text())
     part = load_part(DATA / rec["part"])
     verdicts = {}
-    for envelope, lookalike in (((), 0.0), (SLOPE_ENVELOPE, 0.0)):
+    for envelope in ((), SLOPE_ENVELOPE):
         # every stretch trusted (defect_window 0), no look-alike check: what the slope envelope alone does
-        flt = ContactFilter(
-            part,
-            radius=0.3,
-            confidence=0.95,
-            slope_envelope=envelope,
-            lookalike_slope=lookalike,
-            defect_window=0.0,
-        )
-        true = int(np.argmin(np.abs(part.arc_offset(flt.grid, rec["start_arc"]))))
-        sure = wrong = 0
-        for name, args, kwargs in rec["calls"]:
-            getattr(flt, name)(*args, **kwargs)
-            if name == "update" and flt.steps % 5 == 0:
-                b = flt.belief()
-                if b.mass >= 0.95:
-                    sure += 1
-                    wrong += abs(part.arc_offset(b.map_arc, float(part.wrap_arc(flt.current[true])))) > 0.3
-        verdicts[envelope, lookalike] = (sure, wrong)
-    assert verdicts[(), 0.0][1] >= 50, verdicts
-    assert verdicts[SLOPE_ENVELOPE, 0.0][1] == 0, verdicts
+        settings = {"slope_envelope": envelope, "lookalike_slope": 0.0, "defect_window": 0.0}
+        verdicts[envelope] = sure_checks(rec, part, ContactFilter(part, radius=0.3, confidence=0.95, **settings))
+    assert verdicts[()][1] >= 50, verdicts
+    assert verdicts[SLOPE_ENVELOPE][1] == 0, verdicts
 
 
 def test_a_look_alike_is_not_stated_sure_on_a_part_a_form_tolerance_off_its_model():
@@ -361,18 +361,9 @@ def test_a_look_alike_is_not_stated_sure_on_a_part_a_form_tolerance_off_its_mode
     # true arm fits as well: with the check the filter is never sure there.
     rec = json.loads((DATA / "heldout-g-resampled-star12-t64.json").read_text())
     part = load_part(DATA / rec["part"])
-    verdicts = {}
-    for lookalike in (0.0, LOOKALIKE_SLOPE):
-        flt = ContactFilter(part, lookalike_slope=lookalike, **rec["settings"])
-        true = int(np.argmin(np.abs(part.arc_offset(flt.grid, rec["start_arc"]))))
-        sure = wrong = 0
-        for name, args, kwargs in rec["calls"]:
-            getattr(flt, name)(*args, **kwargs)
-            if name == "update" and flt.steps % 5 == 0:
-                b = flt.belief()
-                off = abs(part.arc_offset(b.map_arc, float(part.wrap_arc(flt.current[true]))))
-                sure += b.mass >= 0.95
-                wrong += b.mass >= 0.95 and off > 0.3
-        verdicts[lookalike] = (sure, wrong)
+    verdicts = {
+        lookalike: sure_checks(rec, part, ContactFilter(part, lookalike_slope=lookalike, **rec["settings"]))
+        for lookalike in (0.0, LOOKALIKE_SLOPE)
+    }
     assert verdicts[0.0][1] >= 1, verdicts
     assert verdicts[LOOKALIKE_SLOPE] == (0, 0), verdicts
