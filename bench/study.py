@@ -342,7 +342,8 @@ def load_study(path) -> Study:
     parts = [resolve(p) for p in parts]
     for p in parts:
         if not Path(p).is_file():
-            raise StudyError(f"study {path}: part file {p} does not exist")
+            what = "is a folder, not a part file" if Path(p).is_dir() else "does not exist"
+            raise StudyError(f"study {path}: part file {p} {what}")
         try:  # read now, so that a bad part is named before any trial runs
             load_part(p)
         except RolltouchError as exc:

@@ -118,6 +118,8 @@ def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[st
         where = f"{path}: {kind} (handle {e.dxf.handle}, layer {e.dxf.layer!r})"
         if kind == "LINE":
             pieces.append(_line(_pt(e.dxf.start, k), _pt(e.dxf.end, k), where))
+        elif kind in ("ARC", "CIRCLE") and not float(e.dxf.radius) > 0:
+            raise PartError(f"{where}: radius={float(e.dxf.radius)!r} must be positive")
         elif kind == "ARC":
             sweep = (float(e.dxf.end_angle) - float(e.dxf.start_angle)) % 360.0 or 360.0
             pieces.append(
@@ -269,6 +271,8 @@ def _svg_scale(text: str, path: Path) -> tuple[float, tuple[float, float], str]:
         if w is None or w.group(2) not in SVG_UNITS:
             raise PartError(f"{path}: width={width!r}: use a number with mm, cm, in, pt, pc or px")
         unit = SVG_UNITS[w.group(2)]
+        if not float(w.group(1)) > 0:
+            raise PartError(f"{path}: width={width!r} of the drawing must be positive")
         if unit is not None:
             width_mm = float(w.group(1)) * unit
             # a physical size without a viewBox: user units are CSS px
@@ -279,15 +283,36 @@ def _svg_scale(text: str, path: Path) -> tuple[float, tuple[float, float], str]:
     return scale, origin, text.replace(root, stripped, 1)
 
 
+def _svg_text(path: Path) -> str:
+    """The SVG file's text, in the encoding it declares (a byte-order mark, or the XML declaration's
+    ``encoding``; UTF-8 without either, as XML says), the declaration's encoding then dropped: the text
+    is parsed as text."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise PartError(f"{path}: cannot read the SVG file ({exc.strerror or exc})") from None
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        encoding = "utf-16"
+    elif raw.startswith(b"\xef\xbb\xbf"):
+        encoding = "utf-8-sig"
+    else:
+        declared = re.match(rb"""\s*<\?xml[^>]*\bencoding\s*=\s*["']([A-Za-z0-9._-]+)["']""", raw)
+        encoding = declared.group(1).decode("ascii") if declared else "utf-8"
+    try:
+        text = raw.decode(encoding)
+    except LookupError:
+        raise PartError(f"{path}: the SVG declares encoding={encoding!r}, which Python does not know") from None
+    except UnicodeDecodeError as exc:
+        raise PartError(f"{path}: the SVG is not valid {encoding} ({exc.reason} at byte {exc.start})") from None
+    return re.sub(r"""^(\s*<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1)
+
+
 def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[str]]:
     try:
         import svgelements as se
     except ImportError:  # pragma: no cover - a dependency of the package
         raise PartError("reading SVG needs svgelements: pip install svgelements") from None
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise PartError(f"{path}: cannot read the SVG file ({exc})") from None
+    text = _svg_text(path)
     k, origin, text = _svg_scale(text, path)
 
     def pt(p: Any) -> tuple[float, float]:
@@ -312,6 +337,7 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
             ignored.append(f"{type(shape).__name__} {shape.id or '(no id)'}")
             continue
         where = f"{path}: {type(shape).__name__} {shape.id or '(no id)'}"
+        _check_svg_sizes(shape, se, where)
         current: list[Piece] = []
         for seg in se.Path(shape).segments():
             if isinstance(seg, se.Move):
@@ -355,6 +381,21 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
                 loose.extend(current)
     loops.extend(_chain(loose, str(path), ignored))
     return loops, ignored
+
+
+def _check_svg_sizes(shape: Any, se: Any, where: str) -> None:
+    """Refuse a circle's, an ellipse's or a rectangle's negative size (an error in SVG: the parser would
+    draw it as if positive, or turn the outline inside out)."""
+    sizes = {se.Circle: ("r", "rx", "ry"), se.Ellipse: ("rx", "ry"), se.Rect: ("width", "height", "rx", "ry")}
+    names = next((n for kind, n in sizes.items() if isinstance(shape, kind)), ())
+    for name in names:
+        given = shape.values.get(name)
+        try:
+            negative = given is not None and float(re.sub(r"[a-z%]+$", "", str(given).strip())) < 0
+        except ValueError:
+            continue
+        if negative:
+            raise PartError(f"{where}: {name}={given!r} is negative; a size in SVG is positive")
 
 
 # ------------------------------------------------------------------ loops

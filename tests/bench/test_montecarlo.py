@@ -102,6 +102,7 @@ def test_dask_local_cluster_gives_the_same_table(reference):
     "text, match",
     [
         ('parts = ["nope.json"]\nrolls_deg = [20.0]', "part file .*nope.json does not exist"),
+        ('parts = ["."]\nrolls_deg = [20.0]', "part file .* is a folder, not a part file"),
         ("parts = []\nrolls_deg = [20.0]", "'parts' must be a non-empty list"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0, -15.0]', "one sign"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "guess"', "method 'guess'"),

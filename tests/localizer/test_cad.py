@@ -322,3 +322,50 @@ def test_part_files_that_are_not_parts_name_the_file(tmp_path):
     with pytest.raises(PartError, match="more than the 64 MB a CAD file may have"):
         huge.rename(tmp_path / "huge.dxf")
         load_outline(tmp_path / "huge.dxf")
+
+
+CIRCLE_SVG = (
+    '<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="100mm" viewBox="0 0 100 100">'
+    "<!-- pièce --><{shape}/></svg>\n"
+)
+
+
+@pytest.mark.parametrize(
+    "width, shape, match",
+    [
+        ("100mm", 'circle id="c" cx="50" cy="50" r="-20"', r"Circle c: r='-20' is negative"),
+        ("100mm", 'ellipse id="e" cx="50" cy="50" rx="20" ry="-10"', r"Ellipse e: ry='-10' is negative"),
+        ("100mm", 'rect id="r" x="10" y="10" width="-50" height="30"', r"Rect r: width='-50' is negative"),
+        ("-100mm", 'circle id="c" cx="50" cy="50" r="20"', r"width='-100mm' of the drawing must be positive"),
+    ],
+)
+def test_negative_svg_sizes_are_refused_by_name(tmp_path, width, shape, match):
+    # SVG makes a negative size an error; the parser drew r="-20" as a circle of 20, width="-100mm" turned
+    # the drawing inside out ("arc radius=-20.0 mm")
+    f = tmp_path / "neg.svg"
+    f.write_text(CIRCLE_SVG.format(w=width, shape=shape), encoding="utf-8")
+    with pytest.raises(PartError, match=match):
+        load_outline(f)
+
+
+@pytest.mark.parametrize("encoding", ["ISO-8859-1", "UTF-16", "UTF-8"])
+def test_an_svg_is_read_in_the_encoding_it_declares(tmp_path, encoding):
+    body = CIRCLE_SVG.format(w="100mm", shape='circle id="c" cx="50" cy="50" r="20"')
+    f = tmp_path / "c.svg"
+    f.write_bytes((f'<?xml version="1.0" encoding="{encoding}"?>\n' + body).encode(encoding))
+    assert load_outline(f).perimeter == pytest.approx(2 * math.pi * 20, rel=1e-12)
+    f.write_bytes(body.encode("latin-1"))  # no declaration: UTF-8, which this is not
+    with pytest.raises(PartError, match=r"not valid utf-8 \(invalid continuation byte at byte \d+\)"):
+        load_outline(f)
+    f.write_bytes(('<?xml version="1.0" encoding="x-nonsense"?>\n' + body).encode("latin-1"))
+    with pytest.raises(PartError, match="declares encoding='x-nonsense', which Python does not know"):
+        load_outline(f)
+
+
+def test_a_negative_dxf_radius_names_the_file_and_the_entity(tmp_path):
+    doc = ezdxf.new()
+    doc.modelspace().add_circle((0, 0), -5)
+    f = tmp_path / "neg.dxf"
+    doc.saveas(f)
+    with pytest.raises(PartError, match=r"neg\.dxf: CIRCLE \(handle \w+, layer '0'\): radius=-5\.0 must be positive"):
+        load_outline(f)
