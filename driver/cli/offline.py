@@ -26,6 +26,7 @@ from ..part_match import SAME_PART_FLAG, check_same_part
 from ..rig import RigError
 from ._options import (
     PLOT_SUFFIXES,
+    UsageError,
     add_command,
     check_before_moving,
     jaw_argument,
@@ -225,6 +226,11 @@ def locate_reactive(args, path) -> int:
 
     if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
         raise RigError(f"trace {path} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
+    if args.plot:
+        raise UsageError(
+            f"--plot {args.plot}: a reactive trace's plot is drawn by the run itself ('simulate --reactive --plot'); "
+            "drop --plot to have its belief again"
+        )
     meta, columns = read_archive(path, LOG_COLUMNS)
     truth = read_archive(path, ("true_arcs",))[1]["true_arcs"]  # one per reading: another length
     part = load_part(args.part)

@@ -38,6 +38,10 @@ def test_locate_has_the_runs_belief_again(burr_run, capsys):
     # another part is refused, not scored
     assert main(["locate", str(out), "--part", str(PARTS / "trefoil.json")]) == 2
     assert "was made on part 'kidney'" in capsys.readouterr().err
+    # a plot it cannot draw is said, not silently left out
+    with pytest.raises(SystemExit):
+        main(["locate", str(out), "--part", str(PARTS / "kidney.csv"), "--plot", str(out.with_suffix(".png"))])
+    assert "a reactive trace's plot is drawn by the run itself" in capsys.readouterr().err
 
 
 def test_the_log_keeps_outer_calls_in_order_and_replays_exactly():
