@@ -271,6 +271,9 @@ def emulate_command(args) -> int:
         if args.start is None:
             start_pose = rig.calibration_pose()
         else:
+            # laid where it touches elsewhere, every later command would read nonsense (a calibration "not
+            # monotone"): refused before the ports are served
+            _check_reach(part, float(args.start) % part.perimeter, 0.0)
             start_pose = rig.approach_pose(float(args.start) % part.perimeter, jaw_position=0.0, standoff=1.0)
     emulator = Emulator(rig, start_pose=start_pose, faults=faults, seed=args.seed)
     if args.tcp is not None:

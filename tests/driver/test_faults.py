@@ -331,6 +331,11 @@ def test_the_emulators_arguments_and_a_busy_port(capsys):
         with pytest.raises(SystemExit):
             main(argv)
         assert words in capsys.readouterr().err
+    # a start in the kidney's waist, where the jaw laid at its middle touches the part elsewhere: once a
+    # calibration "not monotone ... recalibrate with more averaging"
+    kidney = str(Path(TREFOIL).with_name("kidney.csv"))
+    assert main(["emulate", kidney, "--start", "60"]) == 2
+    assert "would touch the part elsewhere" in capsys.readouterr().err
     first = emulator()
     arm, _ = first.serve_tcp(0)
     port = int(arm.rsplit(":", 1)[1])
