@@ -18,11 +18,14 @@ import numpy as np
 
 from localizer import Belief, ContactFilter
 
-__all__ = ["LoggedFilter", "replay_log", "LOG_COLUMNS", "CALLS", "REACTIVE_FORMAT"]
+__all__ = ["LoggedFilter", "replay_log", "LOG_COLUMNS", "CALLS", "REACTIVE_FORMAT", "FILTER_CALLS_EVENT"]
 
 #: The ``format`` of a reactive rolling's trace ('simulate --reactive' with the straight jaw): its
 #: readings, the filter's calls (:data:`LOG_COLUMNS`) and the run's JSON object as metadata.
 REACTIVE_FORMAT = "rolltouch-reactive/1"
+#: The run log's event that holds a reactive run's filter calls (:data:`LOG_COLUMNS` as lists, None for
+#: NaN), written at the end of 'run --reactive'.
+FILTER_CALLS_EVENT = "filter_calls"
 
 #: The filter calls kept, by their code in the ``call`` column.
 CALLS = ("reset", "update", "touch", "bridged", "regrasp", "belief")

@@ -21,7 +21,7 @@ from localizer import (
     localize,
 )
 
-from ..filter_log import CALLS, LOG_COLUMNS, REACTIVE_FORMAT, replay_log
+from ..filter_log import CALLS, FILTER_CALLS_EVENT, LOG_COLUMNS, REACTIVE_FORMAT, replay_log
 from ..part_match import SAME_PART_FLAG, check_same_part
 from ..rig import RigError
 from ._options import (
@@ -199,31 +199,51 @@ def locate_command(args) -> int:
     if str(args.trace).endswith(".jsonl"):
         from driver.runlog import read_log
 
-        if str(read_log(args.trace)[0].get("jaw", "straight")).startswith("wheel"):
+        events = read_log(args.trace)
+        if str(events[0].get("jaw", "straight")).startswith("wheel"):
             return locate_wheel(args, args.trace)
+        calls = [e for e in events if e.get("event") == FILTER_CALLS_EVENT]
+        if calls:
+            columns = {
+                k: np.array([math.nan if v is None else v for v in calls[-1][k]], dtype=float) for k in LOG_COLUMNS
+            }
+            result = next((e for e in reversed(events) if e.get("event") == "result"), {})
+            meta = {**result, "part": events[0].get("part")}
+            return locate_reactive(args, args.trace, meta, columns, np.array([], dtype=float))
+        if any(e.get("event") == "belief" for e in events):
+            raise RigError(
+                f"run log {args.trace} is of a reactive run whose filter calls it does not hold (the run ended "
+                "before its result, or was logged before they were): its last belief event is its answer"
+            )
     elif trace_format(args.trace) == WHEEL_FORMAT:
         return locate_wheel(args, args.trace)
     elif trace_format(args.trace) == REACTIVE_FORMAT:
-        return locate_reactive(args, args.trace)
+        from driver.trace import read_archive
+
+        meta, columns = read_archive(args.trace, LOG_COLUMNS)
+        truth = read_archive(args.trace, ("true_arcs",))[1]["true_arcs"]  # one per reading: another length
+        return locate_reactive(args, args.trace, meta, columns, truth)
     if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
         raise RigError(f"trace {args.trace} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
     part = load_part(args.part)
     trace = Trace.load(args.trace)
     check_same_part(trace.metadata.get("part"), part, args.part, f"trace {args.trace}", same=args.same_part)
+    if not trace.metadata["steps"]:
+        raise RigError(f"trace {args.trace} holds no roll: nothing to localize from")
     estimates = trace.estimates()
     direction = "ccw" if np.sign(trace.metadata["steps"][0]) > 0 else "cw"
     loc = localize(part, estimates, rule=args.rule, direction=direction)
     return emit_run(args, run_summary(part, trace, loc), part, trace, loc)
 
 
-def locate_reactive(args, path) -> int:
-    """'locate TRACE --part PART' of a reactive rolling's trace (straight jaw): its filter calls made again
-    on a filter of the default settings, as the run's was, and the belief printed as the run printed it.
+def locate_reactive(args, path, meta: dict, columns: dict, truth: np.ndarray) -> int:
+    """'locate TRACE --part PART' of a reactive rolling's trace or run log (straight jaw): its filter calls
+    (``columns``, :data:`driver.filter_log.LOG_COLUMNS`) made again on a filter of the default settings, as
+    the run's was, and the belief printed as the run printed it; ``meta``: the run's JSON object and part
+    record; ``truth``: the true contact at each reading (empty on a real rig).
 
     Where the part seemed to differ from its model is the filter's finding, or else the run's own
     (a jump the jaw left, or one no place explains: what the hand did, which the calls do not hold)."""
-    from driver.trace import read_archive
-
     if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
         raise RigError(f"trace {path} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
     if args.plot:
@@ -231,8 +251,6 @@ def locate_reactive(args, path) -> int:
             f"--plot {args.plot}: a reactive trace's plot is drawn by the run itself ('simulate --reactive --plot'); "
             "drop --plot to have its belief again"
         )
-    meta, columns = read_archive(path, LOG_COLUMNS)
-    truth = read_archive(path, ("true_arcs",))[1]["true_arcs"]  # one per reading: another length
     part = load_part(args.part)
     check_same_part(meta.get("part"), part, args.part, f"trace {path}", same=args.same_part)
     b = replay_log(ContactFilter(part), columns)

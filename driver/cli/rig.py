@@ -10,6 +10,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, WheelJaw
 
+from ..filter_log import FILTER_CALLS_EVENT
 from ..part_match import part_record
 from ._options import (
     PLOT_SUFFIXES,
@@ -224,9 +225,11 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
             Hand(rig, here)
         x, y, phi = here
         start = (x + 40.0 * math.cos(phi), y + 40.0 * math.sin(phi), phi)  # as run_from_here: contact at -40 mm
-        doc, _, _ = run_reactive(args, rig, part, calibration, start, observer=progress)
+        doc, _, calls = run_reactive(args, rig, part, calibration, start, observer=progress)
     args.interrupted = RELEASED
     if log is not None:
+        # the filter's calls, for 'locate' to have the belief again (driver.filter_log)
+        log({"event": FILTER_CALLS_EVENT, **{k: [None if v != v else v for v in c.tolist()] for k, c in calls.items()}})
         log({"event": "result", **doc})
         log.close()
     if args.json:

@@ -260,6 +260,51 @@ def test_cli_emulate_and_run(tmp_path):
     assert loc.returncode == 0 and json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"])
 
 
+def test_cli_emulate_run_reactively_and_locate_its_log(tmp_path):
+    # the log of 'run --reactive' holds the filter's calls: locate has the run's belief again from it
+    port = 46000 + os.getpid() % 1000
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    exe = [sys.executable, "-m", "driver.cli"]
+    trefoil = str(ROOT / "parts" / "trefoil.json")
+    emu = subprocess.Popen(
+        exe + ["emulate", trefoil, "--tcp", str(port), "--start", "120", "--seed", "3"],
+        stdout=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    rig = ["--arm", f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}"]
+    try:
+        assert emu.stdout.readline().startswith("arm socket://127.0.0.1:")
+        emu.stdout.readline()
+        args = [
+            "run",
+            trefoil,
+            *rig,
+            "--reactive",
+            "--max-rotation",
+            "30",
+            "--json",
+            "--log",
+            str(tmp_path / "r.jsonl"),
+        ]
+        out = subprocess.run(exe + args, capture_output=True, text=True, timeout=180, env=env)
+    finally:
+        emu.terminate()
+        emu.wait(10)
+    assert out.returncode in (0, 2), out.stderr
+    doc = json.loads(out.stdout)
+    loc = subprocess.run(
+        exe + ["locate", str(tmp_path / "r.jsonl"), "--part", trefoil, "--json"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
+    again = json.loads(loc.stdout)
+    assert loc.returncode == out.returncode, loc.stderr
+    assert again["estimate_arc"] == doc["estimate_arc"] and again["mass"] == doc["mass"]
+
+
 def test_cli_run_fails_with_one_line_on_disconnect(tmp_path):
     port = 48000 + os.getpid() % 1000
     exe = [sys.executable, "-m", "driver.cli"]
