@@ -207,7 +207,7 @@ def locate_command(args) -> int:
             columns = {
                 k: np.array([math.nan if v is None else v for v in calls[-1][k]], dtype=float) for k in LOG_COLUMNS
             }
-            result = next((e for e in reversed(events) if e.get("event") == "result"), {})
+            result: dict = next((e for e in reversed(events) if e.get("event") == "result"), {})
             meta = {**result, "part": events[0].get("part")}
             return locate_reactive(args, args.trace, meta, columns, np.array([], dtype=float))
         if any(e.get("event") == "belief" for e in events):
