@@ -479,20 +479,6 @@ class ContactFilter:
             raise QueryError(f"jaw_margin={jaw_margin!r} mm must be ≥ 0")
         if not (math.isfinite(defect_window) and defect_window >= 0):
             raise QueryError(f"defect_window={defect_window!r} mm must be ≥ 0 (0: trust every stretch)")
-        # a part too large for the grid of starts or for the sums over it (8 bytes × the basis columns laid
-        # out below: exact with the slope, jaw and drift terms on, more without) is refused before either is built
-        check_grid(
-            part,
-            "filter",
-            spacing,
-            grid_size(part, spacing),
-            point_bytes=8.0
-            * (
-                2 * math.ceil(part.perimeter / shape_spacing)
-                + math.ceil(2 * (jaw.half + jaw_margin) / jaw_spacing)
-                + 64
-            ),
-        )
         self.defect_window = float(defect_window)
         # the stretches the fit test judges: twice the envelope's (a burr's misfit and its edges)
         self._fit_width = FIT_WIDTH * self.defect_window
@@ -503,20 +489,7 @@ class ContactFilter:
         self.noise_scales = tuple(float(v) for v in scales)
         self.slope_envelope = tuple(float(v) for v in envelope if v != 1.0) if sd_slope > 0 else ()
         self.lookalike_slope = float(lookalike_slope) if sd_slope > 0 else 0.0
-        self.tracks = tracks_for(part, spacing, jaw)
-        self.sd_position = float(sd_position)
-        self.sd_scale = float(sd_scale)
-        self.sd_slope = float(sd_slope)
-        self.sd_jaw = float(sd_jaw)
-        self.sd_turn = float(sd_turn)
-        self.sd_drift = float(sd_drift)
-        self.shape_spacing = float(shape_spacing)
         self.jaw_spacing = float(jaw_spacing)
-        self.prune = float(prune)
-        self.refresh = int(refresh)
-        # before the first reference hypothesis: the median radius over the stretches a jaw touches
-        convex = self.tracks.kappa[self.tracks.convex & (self.tracks.kappa > 0)]
-        self._rho_prior = float(np.clip(np.median(1.0 / convex), 5.0, 500.0)) if convex.size else 50.0
         # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
         self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
         self._segments = 48  # offsets: one per contact segment (see regrasp)
@@ -528,6 +501,22 @@ class ContactFilter:
         # and the sensor's drift: a rate per reading, the same all run long
         self._drift = self._jaw_end
         self._m = self._jaw_end + (1 if sd_drift > 0 else 0)
+        # a part too large for the grid of starts or for the sums over it (8 bytes a basis column a start)
+        # is refused before either is built
+        check_grid(part, "filter", spacing, grid_size(part, spacing), point_bytes=8.0 * self._m)
+        self.tracks = tracks_for(part, spacing, jaw)
+        self.sd_position = float(sd_position)
+        self.sd_scale = float(sd_scale)
+        self.sd_slope = float(sd_slope)
+        self.sd_jaw = float(sd_jaw)
+        self.sd_turn = float(sd_turn)
+        self.sd_drift = float(sd_drift)
+        self.shape_spacing = float(shape_spacing)
+        self.prune = float(prune)
+        self.refresh = int(refresh)
+        # before the first reference hypothesis: the median radius over the stretches a jaw touches
+        convex = self.tracks.kappa[self.tracks.convex & (self.tracks.kappa > 0)]
+        self._rho_prior = float(np.clip(np.median(1.0 / convex), 5.0, 500.0)) if convex.size else 50.0
         self.radius = float(radius)
         self.mode_floor = float(mode_floor)
         self.confidence = float(confidence)
