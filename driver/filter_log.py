@@ -18,7 +18,16 @@ import numpy as np
 
 from localizer import Belief, ContactFilter
 
-__all__ = ["LoggedFilter", "replay_log", "LOG_COLUMNS", "CALLS", "REACTIVE_FORMAT", "FILTER_CALLS_EVENT"]
+__all__ = [
+    "LoggedFilter",
+    "replay_log",
+    "calls_event",
+    "calls_from_events",
+    "LOG_COLUMNS",
+    "CALLS",
+    "REACTIVE_FORMAT",
+    "FILTER_CALLS_EVENT",
+]
 
 #: The ``format`` of a reactive rolling's trace ('simulate --reactive' with the straight jaw): its
 #: readings, the filter's calls (:data:`LOG_COLUMNS`) and the run's JSON object as metadata.
@@ -99,6 +108,22 @@ class LoggedFilter(ContactFilter):
         out = {name: rows[:, k] for k, name in enumerate(LOG_COLUMNS)}
         out["call"] = rows[:, 0].astype(np.int8)
         return out
+
+
+def calls_event(columns: dict[str, np.ndarray]) -> dict[str, Any]:
+    """The run log's event of a kept log (:meth:`LoggedFilter.columns`): JSON lists, None for NaN."""
+    return {
+        "event": FILTER_CALLS_EVENT,
+        **{k: [None if math.isnan(v) else v for v in columns[k].tolist()] for k in LOG_COLUMNS},
+    }
+
+
+def calls_from_events(events: list[dict[str, Any]]) -> dict[str, np.ndarray] | None:
+    """The kept log of a run log's events (the last :data:`FILTER_CALLS_EVENT`), or None if it has none."""
+    found = [e for e in events if e.get("event") == FILTER_CALLS_EVENT]
+    if not found:
+        return None
+    return {k: np.array([math.nan if v is None else v for v in found[-1][k]], dtype=float) for k in LOG_COLUMNS}
 
 
 def replay_log(flt: ContactFilter, columns: dict[str, np.ndarray]) -> Belief:

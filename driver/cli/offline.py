@@ -21,7 +21,7 @@ from localizer import (
     localize,
 )
 
-from ..filter_log import CALLS, FILTER_CALLS_EVENT, LOG_COLUMNS, REACTIVE_FORMAT, replay_log
+from ..filter_log import CALLS, LOG_COLUMNS, REACTIVE_FORMAT, calls_from_events, replay_log
 from ..part_match import SAME_PART_FLAG, check_same_part
 from ..rig import RigError
 from ._options import (
@@ -202,11 +202,8 @@ def locate_command(args) -> int:
         events = read_log(args.trace)
         if str(events[0].get("jaw", "straight")).startswith("wheel"):
             return locate_wheel(args, args.trace)
-        calls = [e for e in events if e.get("event") == FILTER_CALLS_EVENT]
-        if calls:
-            columns = {
-                k: np.array([math.nan if v is None else v for v in calls[-1][k]], dtype=float) for k in LOG_COLUMNS
-            }
+        columns = calls_from_events(events)
+        if columns is not None:
             result: dict = next((e for e in reversed(events) if e.get("event") == "result"), {})
             meta = {**result, "part": events[0].get("part")}
             return locate_reactive(args, args.trace, meta, columns, np.array([], dtype=float))

@@ -10,7 +10,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, WheelJaw
 
-from ..filter_log import FILTER_CALLS_EVENT
+from ..filter_log import calls_event
 from ..part_match import part_record
 from ._options import (
     PLOT_SUFFIXES,
@@ -229,7 +229,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
     args.interrupted = RELEASED
     if log is not None:
         # the filter's calls, for 'locate' to have the belief again (driver.filter_log)
-        log({"event": FILTER_CALLS_EVENT, **{k: [None if v != v else v for v in c.tolist()] for k, c in calls.items()}})
+        log(calls_event(calls))
         log({"event": "result", **doc})
         log.close()
     if args.json:
