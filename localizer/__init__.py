@@ -28,6 +28,7 @@ from ._defaults import (
 )
 from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
+from ._facets import FACETS, FacetRule, read_facets
 from ._files import load_part
 from ._fingerprint import QUANTUM_MM, fingerprint
 from ._limits import (
@@ -70,6 +71,9 @@ __all__ = [
     "Outline",
     "Corner",
     "outline_from_pieces",
+    "FacetRule",
+    "FACETS",
+    "read_facets",
     "outline_segments",
     "load_outline",
     "CAD_SUFFIXES",

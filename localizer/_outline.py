@@ -23,7 +23,7 @@ import numpy as np
 from ._boundary import ArcPositions
 from ._errors import PartError
 from ._part import _segments_cross
-from ._pieces import CubicBezier, Line, Piece
+from ._pieces import CircularArc, CubicBezier, Line, Piece
 from ._types import ArrayLike, FloatArray
 
 __all__ = ["Outline", "Corner", "outline_from_pieces"]
@@ -42,6 +42,9 @@ FOLD_TOL = 1e-6
 #: An outline enclosing less than this times its perimeter squared has no inside (a sliver; a square
 #: has 1/16, a 1 mm strip 1 m long 2.5e-4).
 AREA_RTOL = 1e-6
+
+
+_LINE, _ARC, _BEZIER = 0, 1, 2
 
 
 class Corner(NamedTuple):
@@ -67,6 +70,8 @@ class Outline(ArcPositions):
         What the file the outline was read from held besides it (other loops, text, layers).
     starts : ndarray, shape (n + 1,), mm
         Arc position of each piece's start, and the perimeter.
+    turning : float, rad
+        Total turning over one lap, every jump included (2π for a simple counter-clockwise outline).
     """
 
     pieces: tuple[Piece, ...]
@@ -74,40 +79,98 @@ class Outline(ArcPositions):
     ignored: tuple[str, ...] = ()
     perimeter: float = field(init=False)
     corners: tuple[Corner, ...] = field(init=False)
+    turning: float = field(init=False, repr=False)
     starts: FloatArray = field(init=False, repr=False)
     _theta0: FloatArray = field(init=False, repr=False)  # unwrapped θ at each piece's start (after its corner)
+    _kind: np.ndarray = field(init=False, repr=False)  # _LINE, _ARC or _BEZIER per piece
+    _exact: tuple[FloatArray, ...] = field(init=False, repr=False)  # the lines' and arcs' arrays
     _tables: dict[tuple[str, Hashable], Any] = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
+        n = len(self.pieces)
         lengths = np.array([p.length for p in self.pieces])
         starts = np.concatenate([[0.0], np.cumsum(lengths)])
         object.__setattr__(self, "starts", starts)
         object.__setattr__(self, "perimeter", float(starts[-1]))
-        theta0 = np.empty(len(self.pieces))
-        corners = []
-        theta = float(self.pieces[0].tangent_angle(0.0))
+        # lines and arcs are evaluated for all their arc positions at once, from these arrays, by the
+        # same arithmetic as the pieces' own; Béziers one piece at a time
+        kind = np.full(n, _BEZIER, dtype=np.int8)
+        origin, delta = np.zeros((n, 2)), np.zeros((n, 2))  # a line's start and end − start
+        polar0, sense, radius = np.zeros(n), np.zeros(n), np.ones(n)  # an arc's, origin its centre
         for i, piece in enumerate(self.pieces):
-            local0 = float(piece.tangent_angle(0.0))
+            if isinstance(piece, Line):
+                kind[i], origin[i] = _LINE, piece.start
+                delta[i] = (piece.end[0] - piece.start[0], piece.end[1] - piece.start[1])
+            elif isinstance(piece, CircularArc):
+                kind[i], origin[i], radius[i] = _ARC, piece.center, piece.radius
+                polar0[i], sense[i] = piece.start_angle, math.copysign(1.0, piece.sweep)
+        heading = np.arctan2(delta[:, 1], delta[:, 0])
+        quarter = sense * (0.5 * math.pi)
+        first = np.where(kind == _LINE, heading, polar0 + quarter)
+        last = np.where(kind == _LINE, heading, polar0 + sense * lengths / radius + quarter)
+        for b in np.flatnonzero(kind == _BEZIER):
+            piece = self.pieces[int(b)]
+            first[b], last[b] = float(piece.tangent_angle(0.0)), float(piece.tangent_angle(piece.length))
+        theta0 = np.empty(n)
+        corners = []
+        theta = float(first[0])
+        for i in range(n):
+            local0 = float(first[i])
             if i > 0:
-                jump = float(_wrap_scalar(local0 - theta))
+                jump = _wrap_scalar(local0 - theta)
                 if abs(jump) > SMOOTH_TOL:
                     corners.append(Corner(float(starts[i]), jump))
                 theta += jump
             theta0[i] = theta
-            theta += float(piece.tangent_angle(piece.length)) - local0
-        jump = float(_wrap_scalar(float(self.pieces[0].tangent_angle(0.0)) - theta))
+            theta += float(last[i]) - local0
+        jump = _wrap_scalar(float(first[0]) - theta)
         if abs(jump) > SMOOTH_TOL:
             corners.insert(0, Corner(0.0, jump))
         object.__setattr__(self, "_theta0", theta0)
         object.__setattr__(self, "corners", tuple(corners))
+        # every jump counts, the smooth ones too: the total is then exactly that of the pieces' ends
+        object.__setattr__(self, "turning", float(theta + jump - theta0[0]))
+        object.__setattr__(self, "_kind", kind)
+        object.__setattr__(self, "_exact", (origin, delta, lengths, polar0, sense, radius, first))
 
-    @property
-    def turning(self) -> float:
-        """Total turning over one lap, jumps included, rad (2π for a simple counter-clockwise outline)."""
-        last = self.pieces[-1]
-        end = self._theta0[-1] + float(last.tangent_angle(last.length)) - float(last.tangent_angle(0.0))
-        first_corner = self.corners[0].angle if self.corners and self.corners[0].arc == 0.0 else 0.0
-        return float(end + first_corner - self._theta0[0])
+    def _evaluate(
+        self, k: np.ndarray, local: FloatArray, point: bool = False, angle: bool = False, curvature: bool = False
+    ) -> tuple[FloatArray | None, FloatArray | None, FloatArray | None]:
+        """(points (..., 2) mm, θ rad, κ 1/mm), those asked for, of pieces ``k`` at arcs ``local``
+        within them (mm); θ unwrapped from the piece's start θ :attr:`_theta0`."""
+        origin, delta, lengths, polar0, sense, radius, first = self._exact
+        shape = np.shape(local)
+        kind = self._kind[k]
+        line, arc = kind == _LINE, kind == _ARC
+        kl, ka = k[line], k[arc]
+        xy = th = kappa = None
+        polar = polar0[ka] + sense[ka] * local[arc] / radius[ka]
+        if point:
+            xy = np.empty(shape + (2,))
+            xy[line] = origin[kl] + (local[line] / lengths[kl])[..., None] * delta[kl]
+            xy[arc] = origin[ka] + radius[ka][:, None] * np.stack([np.cos(polar), np.sin(polar)], -1)
+        if angle:
+            th = np.empty(shape)
+            th[line] = self._theta0[kl]
+            th[arc] = self._theta0[ka] + (polar + sense[ka] * (0.5 * math.pi)) - first[ka]
+        if curvature:
+            kappa = np.empty(shape)
+            kappa[line] = 0.0
+            kappa[arc] = sense[ka] * (1.0 / radius[ka])
+        for i in np.unique(k[kind == _BEZIER]):
+            sel = k == i
+            piece = self.pieces[int(i)]
+            assert isinstance(piece, CubicBezier)
+            if point:
+                xy[sel] = piece.point(local[sel])  # type: ignore[index]
+            if angle and curvature:
+                t, kappa[sel] = piece.angle_and_curvature(local[sel])  # type: ignore[index]
+                th[sel] = self._theta0[i] + t - first[i]  # type: ignore[index]
+            elif angle:
+                th[sel] = self._theta0[i] + piece.tangent_angle(local[sel]) - first[i]  # type: ignore[index]
+            elif curvature:
+                kappa[sel] = piece.curvature(local[sel])  # type: ignore[index]
+        return xy, th, kappa
 
     def _locate(self, sigma: ArrayLike) -> tuple[FloatArray, np.ndarray, FloatArray]:
         """(laps, piece index, arc within the piece) of unrolled arc positions ``sigma`` (mm)."""
@@ -121,10 +184,8 @@ class Outline(ArcPositions):
     def point_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Points at arc positions ``sigma`` (mm, any real: wraps), shape (..., 2), mm."""
         _, k, local = self._locate(sigma)
-        out = np.empty(np.shape(local) + (2,))
-        for i in np.unique(k):
-            sel = k == i
-            out[sel] = self.pieces[int(i)].point(local[sel])
+        out, _, _ = self._evaluate(k, local, point=True)
+        assert out is not None
         return out
 
     def tangent_angle_at_arc(self, sigma: ArrayLike, side: str = "after") -> FloatArray:
@@ -133,12 +194,9 @@ class Outline(ArcPositions):
         if side not in ("after", "before"):
             raise PartError(f"side={side!r}: use 'after' or 'before'")
         lap, k, local = self._locate(sigma)
-        out = np.empty(np.shape(local))
-        for i in np.unique(k):
-            sel = k == i
-            piece = self.pieces[int(i)]
-            out[sel] = self._theta0[int(i)] + piece.tangent_angle(local[sel]) - float(piece.tangent_angle(0.0))
-        out = out + 2.0 * np.pi * lap
+        _, theta, _ = self._evaluate(k, local, angle=True)
+        assert theta is not None
+        out = theta + 2.0 * np.pi * lap
         if side == "before" and self.corners:
             arcs = np.array([c.arc for c in self.corners])
             angles = np.array([c.angle for c in self.corners])
@@ -158,25 +216,16 @@ class Outline(ArcPositions):
         """(:meth:`tangent_angle_at_arc`, :meth:`curvature_at_arc`) at ``sigma`` (mm), the angle after a
         corner's jump; a Bézier's arc length inverted once for both."""
         lap, k, local = self._locate(sigma)
-        theta, kappa = np.empty(np.shape(local)), np.empty(np.shape(local))
-        for i in np.unique(k):
-            sel = k == i
-            piece = self.pieces[int(i)]
-            if isinstance(piece, CubicBezier):
-                th, kappa[sel] = piece.angle_and_curvature(local[sel])
-            else:
-                th, kappa[sel] = piece.tangent_angle(local[sel]), piece.curvature(local[sel])
-            theta[sel] = self._theta0[int(i)] + th - float(piece.tangent_angle(0.0))
+        _, theta, kappa = self._evaluate(k, local, angle=True, curvature=True)
+        assert theta is not None and kappa is not None
         return theta + 2.0 * np.pi * lap, kappa
 
     def curvature_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Signed curvature at arc positions ``sigma`` (mm), 1/mm (zero on lines, ±1/r on arcs)."""
         _, k, local = self._locate(sigma)
-        out = np.empty(np.shape(local))
-        for i in np.unique(k):
-            sel = k == i
-            out[sel] = self.pieces[int(i)].curvature(local[sel])
-        return out
+        _, _, kappa = self._evaluate(k, local, curvature=True)
+        assert kappa is not None
+        return kappa
 
     # an outline's parameter is its arc position: the parametric interface of a spline Part, so that
     # what places a jaw by parameter (the simulated rig) takes either
@@ -203,11 +252,12 @@ class Outline(ArcPositions):
     def sample(self, spacing: float = 0.5) -> FloatArray:
         """A closed polyline through the outline every ``spacing`` mm or less (every piece's ends
         included), shape (M + 1, 2), mm, its last point the first."""
-        pts = []
-        for piece in self.pieces:
-            n = max(2, int(math.ceil(piece.length / spacing)))
-            pts.append(piece.point(np.linspace(0.0, piece.length, n + 1)[:-1]))
-        poly = np.concatenate(pts)
+        lengths = np.diff(self.starts)
+        n = np.maximum(2, np.ceil(lengths / spacing)).astype(np.int64)
+        k = np.repeat(np.arange(len(self.pieces)), n)
+        j = np.arange(k.size) - np.repeat(np.cumsum(n) - n, n)
+        poly, _, _ = self._evaluate(k, j * (lengths / n)[k], point=True)
+        assert poly is not None
         out: FloatArray = np.vstack([poly, poly[:1]])
         return out
 

@@ -37,7 +37,7 @@ from ._cache import per_part
 from ._certify import certify_cells
 from ._errors import QueryError
 from ._limits import check_grid
-from ._outline import Outline
+from ._outline import _BEZIER, Outline
 from ._pieces import CubicBezier
 from ._segment import DIRECTIONS, Segment
 
@@ -142,27 +142,35 @@ def _solve_ccw(outline: Outline, L: float, omega: float, spacing: float) -> list
     bounds = np.append(breaks, breaks[0] + P)
     corner_at = {round(c.arc, 9): c for c in outline.corners}
 
-    def g(s: float) -> float:
-        """g on the open interval that holds s (both ends strictly inside their pieces)."""
-        return _theta(outline, s + L, "after") - _theta(outline, s, "after") - omega
+    def g(s: np.ndarray) -> np.ndarray:
+        """g at starts ``s``, each with both ends strictly inside their pieces."""
+        return np.asarray(outline.tangent_angle_at_arc(s + L) - outline.tangent_angle_at_arc(s) - omega)
 
-    out: list[tuple[float, str, float, float]] = []
+    # on an interval whose ends are on lines and arcs g is linear: its root (or a continuum) in closed
+    # form, all such intervals at once; the others are certified cell by cell
     eps = 1e-9 * max(1.0, P)
-    for a, b in zip(bounds[:-1], bounds[1:]):
-        lo, hi = a + eps, b - eps
-        if hi <= lo:
-            continue
-        ga, gb = g(lo), g(hi)
-        curved = _on_bezier(outline, lo, hi, L)
-        if not curved:
-            slope = (gb - ga) / (hi - lo)
-            if abs(ga) <= 1e-12 and abs(gb) <= 1e-12:
-                out.append((float(a), "continuum", float(b - a), 0.0))
-            elif ga * gb < 0 or abs(gb) <= 1e-12:
-                s = lo - ga / slope if slope != 0 else lo
-                out.append((float(s), "simple", 0.0, abs(g(min(max(s, lo), hi)))))
-            continue
-        out.extend(_certified(outline, L, omega, lo, hi, spacing))
+    a, b = bounds[:-1], bounds[1:]
+    lo, hi = a + eps, b - eps
+    kind = outline._kind
+    mid = 0.5 * (lo + hi)
+    curved = (kind[outline._locate(mid)[1]] == _BEZIER) | (kind[outline._locate(mid + L)[1]] == _BEZIER)
+    ga, gb = g(lo), g(hi)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (gb - ga) / (hi - lo)
+        root = np.where(slope != 0, lo - ga / slope, lo)
+    continuum = (np.abs(ga) <= 1e-12) & (np.abs(gb) <= 1e-12)
+    simple = ~continuum & ((ga * gb < 0) | (np.abs(gb) <= 1e-12))
+    residual = np.zeros(a.size)
+    if simple.any():
+        residual[simple] = np.abs(g(np.minimum(np.maximum(root[simple], lo[simple]), hi[simple])))
+    out: list[tuple[float, str, float, float]] = []
+    for i in np.flatnonzero((hi > lo) & (curved | continuum | simple)):
+        if curved[i]:
+            out.extend(_certified(outline, L, omega, float(lo[i]), float(hi[i]), spacing))
+        elif continuum[i]:
+            out.append((float(a[i]), "continuum", float(b[i] - a[i]), 0.0))
+        else:
+            out.append((float(root[i]), "simple", 0.0, float(residual[i])))
     # corners: a start at corner c, or an end at a corner, fits a range of rotations
     for b in breaks:
         c_start = corner_at.get(round(float(b), 9))
@@ -183,12 +191,6 @@ def _covers(s0: float, span: float, b: float, P: float) -> bool:
     """Whether the solution at s0 (a continuum of ``span`` mm) already holds the start b."""
     d = (b - s0) % P
     return d <= span + 1e-6 or d >= P - 1e-6
-
-
-def _on_bezier(outline: Outline, lo: float, hi: float, L: float) -> bool:
-    """Whether an end of the starts in (lo, hi) lies on a Bézier piece."""
-    _, k, _ = outline._locate(np.array([0.5 * (lo + hi), 0.5 * (lo + hi) + L]))
-    return any(isinstance(outline.pieces[int(i)], CubicBezier) for i in k)
 
 
 def _certified(

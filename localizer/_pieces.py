@@ -34,6 +34,10 @@ _GL_X, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W
 
 
 def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
+    if isinstance(p, tuple) and len(p) == 2 and all(type(v) in (float, int, np.float64) for v in p):
+        x, y = float(p[0]), float(p[1])  # the common case, without an array: a drawing has 10⁵ points
+        if math.isfinite(x) and math.isfinite(y):
+            return x, y
     a = np.asarray(p, dtype=float)
     if a.shape != (2,) or not np.all(np.isfinite(a)):
         raise PartError(f"{what} must be a finite (x, y) point in mm, got {p!r}")
