@@ -205,6 +205,15 @@ class SerialRig:
         self._emit({"event": "axle", "psi": psi})
         return psi
 
+    def has_wheel(self) -> bool:
+        """Whether the hand has a wheel on an axle encoder: AXLE answers. An arm that refuses it
+        (``ERR UNSUPPORTED``, or ``ERR BADCMD`` from a controller older than the wheel) has none."""
+        try:
+            self._transact("arm", "AXLE")
+        except ProtocolError:
+            return False
+        return True
+
     def read(self, n: int = 32) -> tuple:
         """READ n: averaged (v1, v2) in volts; stops the run above the overload limit."""
         v1, v2 = self._transact("daq", "READ", int(n)).numbers(2)

@@ -103,6 +103,7 @@ def calibrate_command(args) -> int:
         )
         return 0
     with SerialRig(args.arm, args.daq, timeout=args.timeout) as rig:
+        _check_straight_hand(rig, args.jaw)
         calibration = calibrate(rig, rig.pose())
     args.interrupted = RELEASED
     calibration.save(args.out)
@@ -111,6 +112,18 @@ def calibrate_command(args) -> int:
         f"{calibration.ratios[-1]:.5f} at +50 mm"
     )
     return 0
+
+
+def _check_straight_hand(rig, jaw) -> None:
+    """Refuse, before anything moves, to run a straight jaw's procedure on a hand with a wheel: its
+    readings would say only "no contact"."""
+    from driver.rig import RigError
+
+    if rig.has_wheel():
+        raise RigError(
+            f"the hand has a wheel on an axle encoder (its arm answers AXLE) but --jaw is {jaw}: "
+            "give --jaw wheel:RADIUS with the wheel's radius in mm, or connect the straight jaw's hand"
+        )
 
 
 def _progress(event) -> None:
@@ -164,6 +177,7 @@ def run_command(args) -> int:
         return _run_reactively(args, part, calibration, log, observer)
     args.interrupted = CONNECTING
     with ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+        _check_straight_hand(rig, args.jaw)
         run, calibration = run_from_here(
             rig,
             part,
@@ -219,6 +233,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
 
     args.interrupted = CONNECTING
     with ending_progress_line(log), SerialRig(args.arm, args.daq, timeout=args.timeout, log=log) as rig:
+        _check_straight_hand(rig, args.jaw)
         here = tuple(rig.pose())
         if calibration is None:
             calibration = calibrate(rig, here)

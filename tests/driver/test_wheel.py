@@ -155,7 +155,7 @@ def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_t
     assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3
 
 
-def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_reading_back(tmp_path):
+def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_connecting_and_reading_back(tmp_path):
     import json
     import os
     import subprocess
@@ -183,6 +183,8 @@ def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_reading
         assert cal.returncode == 0, cal.stderr
         assert json.loads((tmp_path / "cal.json").read_text())["jaw"] == "wheel:5"
         wrong = cli("run", kidney, *rig, "--calibration", str(tmp_path / "cal.json"), "--json")
+        # a straight jaw's procedures on this hand: refused before anything moves, not "no contact"
+        straight = [cli("calibrate", *rig, "--out", str(tmp_path / "s.json")), cli("run", kidney, *rig, "--reactive")]
         run = cli(
             "run", kidney, *rig, "--jaw", "wheel:5", "--reactive", "--calibration", str(tmp_path / "cal.json"),
             "--json", "--log", str(tmp_path / "r.jsonl"),
@@ -191,6 +193,10 @@ def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_reading
         emu.terminate()
         emu.wait(10)
     assert wrong.returncode == 2 and "calibration is for wheel:5, the finger is straight:100" in wrong.stderr
+    for refused in straight:
+        assert refused.returncode == 2 and "the hand has a wheel on an axle encoder" in refused.stderr, refused.stderr
+        assert "--jaw is straight:100" in refused.stderr and len(refused.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "s.json").exists()
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
     assert doc["jaw"] == "wheel:5" and doc["stopped"] == "confident" and doc["mass"] >= 0.95
