@@ -93,7 +93,16 @@ import numpy as np
 
 from driver.procedures import STEP_RANGE_DEG
 from driver.reactive import CONFIDENCE, MAX_ROTATION
-from localizer import ROLL_STEP, SUCCESS_RADIUS, Outline, Part, RolltouchError, load_part, read_toml
+from localizer import (
+    MAX_GRID_POINTS,
+    ROLL_STEP,
+    SUCCESS_RADIUS,
+    Outline,
+    Part,
+    RolltouchError,
+    load_part,
+    read_toml,
+)
 from sim2d import WorldSpec
 
 from .part_cache import cached_part
@@ -522,8 +531,10 @@ def _options(path, table, cls, name):
         raise StudyError(f"study {path}: [{name}] temper={values['temper']!r} must be at most 1")
     if values.get("confidence", 0.5) >= 1:
         raise StudyError(f"study {path}: [{name}] confidence={values['confidence']!r} must be below 1")
-    if values.get("particles", 2) < 2:
-        raise StudyError(f"study {path}: [{name}] particles={values['particles']!r} must be at least 2")
+    if not 2 <= values.get("particles", 2) <= MAX_GRID_POINTS:
+        raise StudyError(
+            f"study {path}: [{name}] particles={values['particles']!r} must be from 2 to {MAX_GRID_POINTS}"
+        )
     return cls(**values)
 
 

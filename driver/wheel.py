@@ -162,7 +162,8 @@ class WheelPolicy:
     max_rotation : float, rad
         Budget of the hand's turning, both ways counted.
     max_arc : float or None, mm
-        Budget of rolled arc (default: the part's perimeter).
+        Budget of rolled arc (default: the part's perimeter, and never more than the filter keeps:
+        :attr:`localizer.WheelFilter.max_readings` readings, one every ``thin`` mm).
     max_slip : float, mm
         Summed slip beyond this plus ``max_slip_fraction`` of the arc rolled stops the rolling (the
         readings are no longer the part's arc).
@@ -524,6 +525,8 @@ def localize_with_wheel(
     flt.reset()
     pol = policy
     max_arc = pol.max_arc if pol.max_arc is not None else float(part.perimeter)
+    # the filter keeps a reading every ``thin`` mm rolled, up to its memory's max_readings: stop before
+    max_arc = min(max_arc, (flt.max_readings - 1) * flt.thin)
     start = disc.begin(approach_pose)
     lengths, turns, truths, segments, history = [0.0], [0.0], [disc.truth()], [0], []
     flt.update(0.0, 0.0)

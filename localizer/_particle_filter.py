@@ -15,6 +15,7 @@ import numpy as np
 from ._boundary import Boundary
 from ._defaults import SUCCESS_RADIUS
 from ._errors import QueryError
+from ._limits import MAX_GRID_POINTS
 from ._tracks import tracks_for
 from ._types import BoolArray, FloatArray
 
@@ -62,8 +63,11 @@ class ParticleFilter:
         seed: int = 0,
         spacing: float = 0.02,
     ) -> None:
-        if particles < 2:
-            raise QueryError(f"particles={particles!r} must be at least 2")
+        if not (isinstance(particles, (int, np.integer)) and 2 <= particles <= MAX_GRID_POINTS):
+            raise QueryError(
+                f"particles={particles!r} must be a whole number from 2 to {MAX_GRID_POINTS} (as many as the "
+                "largest per-part grid; the default 2000 is the conventional peer's setting)"
+            )
         for name, value in (("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
                 raise QueryError(f"{name}={value!r} mm must be a positive number")

@@ -58,7 +58,7 @@ from ._belief import Belief, belief_flags, find_modes
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
-from ._limits import check_grid
+from ._limits import MAX_ARRAY_BYTES, _bytes, check_grid
 from ._part import Part
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 from ._types import BoolArray, FloatArray
@@ -179,6 +179,10 @@ class WheelFilter:
         if not touch.any():
             raise QueryError(f"a {wheel} touches {part.name} nowhere")
         self._ahead, self._behind = _free_runs(touch, self.h)
+        # each reading used keeps three numbers a start and a row of the Cholesky factor: 24·n·k + 8·k² bytes
+        # for k readings stay within MAX_ARRAY_BYTES (a 1000 mm part: 443 readings, 443 mm rolled at thin=1)
+        b = 24.0 * n
+        self.max_readings = int((math.sqrt(b * b + 32.0 * MAX_ARRAY_BYTES) - b) / 16.0)
         self.reset()
 
     # ------------------------------------------------------------ geometry
@@ -195,18 +199,64 @@ class WheelFilter:
     def reset(self) -> None:
         """Forget every reading (a new roll from a new start)."""
         self.L_used: list[float] = []
-        self._chol = np.zeros((0, 0))
-        self._z = np.zeros((self.grid.size, 0))
+        # the readings' arrays, grown by doubling up to max_readings: the first k rows (columns of _zbuf,
+        # each start's whitened residuals, kept contiguous per reading) are those of the readings used
+        self._cholbuf = np.zeros((0, 0))
+        self._zbuf = np.zeros((self.grid.size, 0), order="F")
+        self._zzbuf = np.zeros((0, self.grid.size))
+        self._lvbuf = np.zeros((0, self.grid.size))
         self._quad = np.zeros(self.grid.size)
         self._logdet = np.zeros(self.grid.size)
         self._penalty = np.zeros(self.grid.size)
         self.current = 0.0
         self.span = (0.0, 0.0)
         self.steps = 0
-        self._zz: list[FloatArray] = []
-        self._logvar: list[FloatArray] = []
         self._misfit: tuple[tuple[float, float], float] | None = None  # (stretch on the model, p-value)
         self._fit_at = 0  # readings used at the last fit test
+
+    @property
+    def _chol(self) -> FloatArray:
+        k = len(self.L_used)
+        out: FloatArray = self._cholbuf[:k, :k]
+        return out
+
+    @property
+    def _z(self) -> FloatArray:
+        out: FloatArray = self._zbuf[:, : len(self.L_used)]
+        return out
+
+    @property
+    def _zz(self) -> FloatArray:
+        """Each reading's squared whitened misfit under each start, shape (readings, starts)."""
+        out: FloatArray = self._zzbuf[: len(self.L_used)]
+        return out
+
+    @property
+    def _logvar(self) -> FloatArray:
+        """Each reading's log variance under each start, shape (readings, starts)."""
+        out: FloatArray = self._lvbuf[: len(self.L_used)]
+        return out
+
+    def _make_room(self) -> None:
+        """Room for one more reading: the buffers doubled, up to :attr:`max_readings`; refused beyond."""
+        k, n = len(self.L_used), self.grid.size
+        if k < self._zzbuf.shape[0]:
+            return
+        if k >= self.max_readings:
+            raise QueryError(
+                f"the wheel's filter holds {k} readings of {n} starts on {self.part.name!r} "
+                f"({_bytes(24.0 * n * k + 8.0 * k * k)}): one more passes the {_bytes(MAX_ARRAY_BYTES)} "
+                f"limit. It keeps a reading every thin={self.thin:g} mm rolled: give a larger thin, or roll "
+                "less from one start (WheelPolicy.max_arc)"
+            )
+        cap = min(max(64, 2 * k), self.max_readings)
+        chol = np.zeros((cap, cap))
+        chol[:k, :k] = self._chol
+        z = np.zeros((n, cap), order="F")
+        z[:, :k] = self._z
+        zz, lv = np.zeros((cap, n)), np.zeros((cap, n))
+        zz[:k], lv[:k] = self._zz, self._logvar
+        self._cholbuf, self._zbuf, self._zzbuf, self._lvbuf = chol, z, zz, lv
 
     def _cov(self, a: FloatArray, b: FloatArray) -> FloatArray:
         """Covariance of the shared errors of residuals at arcs ``a`` and ``b`` (mm) rolled from the start."""
@@ -241,18 +291,16 @@ class WheelFilter:
         rho = om - (self._theta(self.grid + L) - self._theta0)
         var = d2 + extra
         z = (rho - self._z @ ell) / np.sqrt(var)
-        self._quad += z**2
-        self._zz.append(z**2)  # each start's misfit of this reading, for the fit test and the stretches
-        self._logvar.append(np.log(var))
-        self._logdet += np.log(var)
-        self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
-        self._z = np.column_stack([self._z, z * np.sqrt(var / d2)])  # whitened by the shared part alone
+        self._make_room()
         k = used.size
-        chol = np.zeros((k + 1, k + 1))
-        chol[:k, :k] = self._chol
-        chol[k, :k] = ell
-        chol[k, k] = math.sqrt(d2)
-        self._chol = chol
+        self._quad += z**2
+        self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
+        self._lvbuf[k] = np.log(var)
+        self._logdet += self._lvbuf[k]
+        self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
+        self._zbuf[:, k] = z * np.sqrt(var / d2)  # whitened by the shared part alone
+        self._cholbuf[k, :k] = ell
+        self._cholbuf[k, k] = math.sqrt(d2)
         self.L_used.append(L)
 
     def jumped(self, direction: int, margin: float = 1.0) -> None:
@@ -362,7 +410,7 @@ class WheelFilter:
         w = DEFECT_WINDOW
         if float(np.ptp(rolled)) <= w:
             return 0.0
-        zz, logvar = np.array(self._zz), np.array(self._logvar)
+        zz, logvar = self._zz, self._logvar
         near = np.abs(np.asarray(self.part.arc_offset(self.present(), arc))) <= radius
         allowed = self.prior > 0
         worst = 1.0
@@ -389,7 +437,7 @@ class WheelFilter:
         k = len(self.L_used)
         if k < FIT_MIN_READINGS or not starts:
             return None
-        zz = np.array(self._zz)[:, starts]  # (readings, starts)
+        zz = self._zz[:, starts]  # (readings, starts)
         rolled = np.array(self.L_used)
         w = DEFECT_WINDOW * FIT_WIDTH
         windows = []

@@ -124,6 +124,10 @@ def test_dask_local_cluster_gives_the_same_table(reference):
             'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nspeed = 2',
             r"unknown key\(s\) \['speed'\]",
         ),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["particle"]\n[particle]\nparticles = 1000000000',
+            r"particles=1000000000 must be from 2 to 262144",
+        ),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[world]\nburrs = 1', r"\[world\] unknown key\(s\) \['burrs'\]"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[world]\nscale = 3.0', r"\[world\] scale=3.0 must be within"),
         (

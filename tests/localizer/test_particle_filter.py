@@ -43,7 +43,13 @@ def test_many_particles_agree_with_the_grid_filter(cam):
 
 @pytest.mark.parametrize(
     "kwargs, match",
-    [({"particles": 1}, "particles=1"), ({"sd_position": 0}, "sd_position=0"), ({"process": -1.0}, "process=-1.0")],
+    [
+        ({"particles": 1}, "particles=1"),
+        ({"particles": 10**9}, r"particles=1000000000 must be a whole number from 2 to 262144"),
+        ({"particles": 2.5}, "particles=2.5"),
+        ({"sd_position": 0}, "sd_position=0"),
+        ({"process": -1.0}, "process=-1.0"),
+    ],
 )
 def test_bad_particle_filter_settings(cam, kwargs, match):
     with pytest.raises(QueryError, match=match):

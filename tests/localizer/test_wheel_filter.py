@@ -25,11 +25,12 @@ def test_the_grown_factor_gives_the_full_gaussian_density_of_the_residuals():
     part = load_part(KIDNEY)
     f = WheelFilter(part, WheelJaw(5.0), sd_length=0.0, sd_scale=0.0, thin=0.7)
     rng = np.random.default_rng(3)
-    lengths = np.arange(0.5, 20.0, 0.5)
+    lengths = np.arange(0.5, 140.0, 0.5)  # 139 readings used: the filter's arrays doubled twice on the way
     turns = rng.normal(0.0, 0.2, lengths.size).cumsum() * 0.01
     for L, om in zip(lengths, turns):
         f.update(L, om)
     used = np.array(f.L_used)
+    assert used.size > 128
     cov = f._cov(used, used)  # the documented covariance, built in one piece
     picks = (100, 3000, 7000)
     full = []
@@ -39,6 +40,23 @@ def test_the_grown_factor_gives_the_full_gaussian_density_of_the_residuals():
     # log N = -½ quad - ½ log det - k/2 log 2π; compare differences between starts
     ours = -0.5 * f._quad[list(picks)] - 0.5 * f._logdet[list(picks)]
     assert np.allclose(np.diff(ours), np.diff(full), rtol=1e-6, atol=1e-6)
+
+
+def test_the_readings_kept_are_bounded_and_a_reading_past_the_bound_is_refused_by_name():
+    from localizer import MAX_ARRAY_BYTES
+
+    part = load_part(KIDNEY)
+    f = WheelFilter(part, WheelJaw(5.0))
+    n, k = f.grid.size, f.max_readings
+    assert 24 * n * k + 8 * k * k <= MAX_ARRAY_BYTES < 24 * n * (k + 1) + 8 * (k + 1) ** 2
+    f.max_readings = 70  # as on a part 50 times larger: past the first doubling, to the bound
+    for i in range(70):
+        f.update(float(i + 1), 0.0)
+    assert len(f.L_used) == 70 and f._zzbuf.shape[0] == 70
+    with pytest.raises(QueryError, match=r"holds 70 readings of \d+ starts .* give a larger thin, or roll less"):
+        f.update(71.0, 0.0)
+    f.reset()
+    f.update(1.0, 0.0)  # a new start: room again
 
 
 @pytest.mark.parametrize("radius", [3.0, 10.0])
