@@ -20,7 +20,7 @@ import numpy as np
 
 from ._errors import PartError
 from ._facets import FACETS, FacetRule, read_facets
-from ._limits import MAX_PART_BYTES, check_size
+from ._limits import MAX_PART_BYTES, MAX_PIECES, _count, check_size
 from ._outline import JOIN_TOL, Outline, outline_from_pieces
 from ._pieces import CircularArc, CubicBezier, Line, Piece, elliptical_arc
 
@@ -116,8 +116,11 @@ def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[st
     pieces: list[Piece] = []
     loops: list[list[Piece]] = []
     ignored: list[str] = []
+    count = 0  # pieces so far, an entity counted before it is built
     for e in msp:
         kind = e.dxftype()
+        count += len(cast(Any, e)) if kind in ("LWPOLYLINE", "POLYLINE") else 1
+        _check_pieces(path, count)
         if layer is not None and e.dxf.layer != layer:
             ignored.append(f"{kind} on layer {e.dxf.layer!r}")
             continue
@@ -173,6 +176,15 @@ def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[st
             )
     loops.extend(_chain(pieces, str(path), ignored))
     return loops, ignored
+
+
+def _check_pieces(path: Path, count: int) -> None:
+    """Refuse a drawing of more than :data:`MAX_PIECES` pieces, before building the one past it."""
+    if count > MAX_PIECES:
+        raise PartError(
+            f"{path}: more than {_count(MAX_PIECES)} pieces (line segments, arcs, curves) in the drawing, more "
+            "than an outline may have: export its curves with a coarser chord tolerance, or as arcs and splines"
+        )
 
 
 def _pt(v: Any, k: float) -> tuple[float, float]:
@@ -340,6 +352,7 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
         raise PartError(f"{path}: no path or shape with id {element!r}; ids: {sorted(ids)}")
     loops: list[list[Piece]] = []
     loose: list[Piece] = []
+    count = 0  # segments so far
     ignored: list[str] = [f"{type(e).__name__} element" for e in doc.elements() if isinstance(e, se.Text)]
     for shape in shapes:
         if element is not None and shape.id != element:
@@ -349,6 +362,8 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
         _check_svg_sizes(shape, se, where)
         current: list[Piece] = []
         for seg in se.Path(shape).segments():
+            count += 1
+            _check_pieces(path, count)
             if isinstance(seg, se.Move):
                 loose.extend(current)
                 current = []

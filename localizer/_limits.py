@@ -44,6 +44,11 @@ MAX_PART_BYTES = 64 * 2**20
 #: takes a drawing of up to 2.6 m, a filter grid of 5.2 m (its array, :data:`MAX_ARRAY_BYTES`, takes
 #: less).
 MAX_GRID_POINTS = 2**18
+#: The most pieces (segments, arcs, Béziers) a drawing may have, counted as it is read: an outline keeps
+#: an object per piece (and a smooth vertex of a faceted drawing becomes two), measured 580 MB to read
+#: 200 000 loose LINEs, 2.6 GB at 1 300 000 vertices (a 60 MB LWPOLYLINE). A curve exported at a chord
+#: tolerance of 0.001 mm takes 3 500 segments per 100 mm of a 10 mm radius.
+MAX_PIECES = 2**18
 #: The most points of a table whose every point is compared with every other (the straight jaw's
 #: reach every 0.2 mm, :class:`localizer.Reach`): its time grows as the square, measured 1.3 s at 5 153
 #: points (the 1030 mm star, bench/parts/heldout-g/star-12), 15 s and 325 MB at 16 334 (the star

@@ -326,3 +326,42 @@ def test_the_1_m_star_runs_the_filter_within_the_array_limit(passed_checks):
     (args, kwargs) = passed_checks[0]
     assert args[3] == 51_527 and kwargs["point_bytes"] == 8 * 499
     assert args[3] * kwargs["point_bytes"] < 0.4 * MAX_ARRAY_BYTES
+
+
+# ------------------------------------------------------------------------------------ the drawing's pieces
+def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_they_are_built(tmp_path, monkeypatch):
+    """One LWPOLYLINE of MAX_PIECES + 1 vertices (10 MB) is refused by its count, before its pieces
+    are made (the 60 MB one of 1 300 000 vertices took 45 s and 2.6 GB before); loose LINEs and SVG
+    segments are counted as they are read (here against a limit of 50)."""
+    import ezdxf
+
+    from localizer import MAX_PIECES, load_outline
+
+    t = np.linspace(0.0, 2 * np.pi, MAX_PIECES + 1, endpoint=False)
+    doc = ezdxf.new()
+    doc.modelspace().add_lwpolyline([], close=True).lwpoints.extend(
+        [(x, y, 0, 0, 0) for x, y in np.c_[600 * np.cos(t), 200 * np.sin(t)].tolist()]
+    )
+    doc.saveas(tmp_path / "dense.dxf")
+    with pytest.raises(PartError, match=r"dense.dxf: more than 262 144 pieces .* coarser chord tolerance"):
+        load_outline(tmp_path / "dense.dxf")
+
+    import localizer._cad as cad
+
+    monkeypatch.setattr(cad, "MAX_PIECES", 50)
+    square = [(0, 0), (10, 0), (10, 10), (0, 10)]
+    doc = ezdxf.new()
+    for i in range(60):
+        a, b = square[i % 4], square[(i + 1) % 4]
+        doc.modelspace().add_line((a[0] + 20 * (i // 4), a[1]), (b[0] + 20 * (i // 4), b[1]))
+    doc.saveas(tmp_path / "lines.dxf")
+    with pytest.raises(PartError, match=r"lines.dxf: more than 50 pieces"):
+        load_outline(tmp_path / "lines.dxf")
+    path = " ".join(f"M {20 * i} 0 h 10 v 10 h -10 Z" for i in range(15))
+    (tmp_path / "many.svg").write_text(f'<svg xmlns="http://www.w3.org/2000/svg"><path d="{path}"/></svg>')
+    with pytest.raises(PartError, match=r"many.svg: more than 50 pieces"):
+        load_outline(tmp_path / "many.svg")
+    (tmp_path / "few.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0 h 10 v 10 h -10 Z"/></svg>'
+    )
+    assert load_outline(tmp_path / "few.svg").perimeter == pytest.approx(40.0)
