@@ -178,6 +178,9 @@ def _read_dxf(path: Path, layer: str | None) -> tuple[list[list[Piece]], list[st
     return loops, ignored
 
 
+_NUMBER = re.compile(r"\d+(?:\.\d*)?|\.\d+")
+
+
 def _check_pieces(path: Path, count: int) -> None:
     """Refuse a drawing of more than :data:`MAX_PIECES` pieces, before building the one past it."""
     if count > MAX_PIECES:
@@ -334,6 +337,9 @@ def _read_svg(path: Path, element: str | None) -> tuple[list[list[Piece]], list[
     except ImportError:  # pragma: no cover - a dependency of the package
         raise PartError("reading SVG needs svgelements: pip install svgelements") from None
     text = _svg_text(path)
+    # the parser builds every segment before one can be counted (a 50 MB path: 70 s, 1.5 GB): a segment
+    # takes at most 7 numbers (an arc), so more numbers than 7 pieces' worth is surely too many pieces
+    _check_pieces(path, len(_NUMBER.findall(text)) // 7)
     k, origin, text = _svg_scale(text, path)
 
     def pt(p: Any) -> tuple[float, float]:

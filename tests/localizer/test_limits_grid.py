@@ -332,7 +332,8 @@ def test_the_1_m_star_runs_the_filter_within_the_array_limit(passed_checks):
 def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_they_are_built(tmp_path, monkeypatch):
     """One LWPOLYLINE of MAX_PIECES + 1 vertices (10 MB) is refused by its count, before its pieces
     are made (the 60 MB one of 1 300 000 vertices took 45 s and 2.6 GB before); loose LINEs and SVG
-    segments are counted as they are read (here against a limit of 50)."""
+    segments are counted as they are read, an SVG's numbers before it is parsed (here against a limit
+    of 50)."""
     import ezdxf
 
     from localizer import MAX_PIECES, load_outline
@@ -361,6 +362,11 @@ def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_the
     (tmp_path / "many.svg").write_text(f'<svg xmlns="http://www.w3.org/2000/svg"><path d="{path}"/></svg>')
     with pytest.raises(PartError, match=r"many.svg: more than 50 pieces"):
         load_outline(tmp_path / "many.svg")
+    # and one whose numbers alone say so, before the parser builds its segments
+    dense = " ".join(f"{math.cos(a):.4f},{math.sin(a):.4f}" for a in np.linspace(0, 6.28, 200, endpoint=False))
+    (tmp_path / "dense.svg").write_text(f'<svg xmlns="http://www.w3.org/2000/svg"><polygon points="{dense}"/></svg>')
+    with pytest.raises(PartError, match=r"dense.svg: more than 50 pieces"):
+        load_outline(tmp_path / "dense.svg")
     (tmp_path / "few.svg").write_text(
         '<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0 h 10 v 10 h -10 Z"/></svg>'
     )
