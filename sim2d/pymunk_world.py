@@ -23,7 +23,7 @@ import math
 import numpy as np
 import pymunk
 
-from localizer import Line, Outline, Part
+from localizer import CircularArc, Line, Outline, Part
 
 from ._errors import SimError
 from .quasistatic import outline_touch, tangent_point
@@ -67,21 +67,59 @@ def _polygon(part: Part | SampledPart, chord_tolerance: float):
 
 
 def _outline_polygon(machined: SampledPart, chord_tolerance: float):
-    """(points, arcs) of the machined outline's polygon: its sample points at the model's piece ends
-    (so every corner), one chord per line, curves at the spacing whose sagitta κ_max·h²/8 on the model
-    meets the tolerance. The machined deviation between vertices is left to the contact's refinement
-    on the dense sample (:func:`sim2d.quasistatic.outline_touch`)."""
+    """(points, arcs) of the machined outline's polygon: its sample points at every corner and at both
+    ends of every line longer than a chord (one chord per such line), and along each curved stretch
+    between them vertices spaced so that a chord's sagitta κ·h²/8 on the model meets the tolerance, κ
+    the largest curvature of the piece or its neighbours. A curved stretch is spaced as a whole, not
+    piece by piece: a faceted drawing read as thousands of short arcs gets the vertices its curve
+    needs, not one per arc. The machined deviation between vertices is left to the contact's
+    refinement on the dense sample (:func:`sim2d.quasistatic.outline_touch`)."""
     model = machined.model
     assert isinstance(model, Outline)
-    arcs = []
-    for start, piece in zip(model.starts[:-1], model.pieces):
+    n = len(model.pieces)
+    starts = np.asarray(model.starts, float)
+    lengths = np.diff(starts)
+    perimeter = float(starts[-1])
+    line = np.zeros(n, bool)
+    kappa = np.zeros(n)
+    for i, piece in enumerate(model.pieces):
         if isinstance(piece, Line):
-            n = 1
+            line[i] = True
+        elif isinstance(piece, CircularArc):
+            kappa[i] = 1.0 / piece.radius
         else:
-            kappa = float(np.abs(piece.curvature(np.linspace(0.0, piece.length, 65))).max())
-            n = max(1, math.ceil(piece.length / math.sqrt(8.0 * chord_tolerance / max(kappa, 1e-12))))
-        arcs.append(start + piece.length * np.arange(n) / n)
-    want = np.concatenate(arcs)
+            kappa[i] = float(np.abs(piece.curvature(np.linspace(0.0, piece.length, 65))).max())
+    # a chord across a piece's end lies on both pieces
+    kappa = np.maximum(kappa, np.maximum(np.roll(kappa, 1), np.roll(kappa, -1)))
+    # the chord the sagitta allows, less one sample step: each vertex is moved to the nearest sample
+    chord = np.sqrt(8.0 * chord_tolerance / np.maximum(kappa, 1e-12))
+    step = float(np.diff(machined.arcs).max())
+    density = 1.0 / np.maximum(chord - step, 0.5 * chord)  # chords per mm
+    # a line longer than a chord is one chord, its ends vertices; a shorter one (a faceted curve's
+    # remnant between two arcs) is part of the curve: its neighbours' curvature bounds the sagitta
+    alone = line & (lengths * density >= 1.0)
+    density[alone] = 0.0
+    forced = alone | np.roll(alone, 1)
+    if model.corners:
+        at = np.searchsorted(starts[:-1], [c.arc for c in model.corners]).clip(0, n - 1)
+        forced[at] = True
+    first = np.flatnonzero(forced)
+    if first.size == 0:
+        first = np.array([0])
+    # two laps of the cumulative chord count, so that a stretch may run on past the seam
+    cum = np.concatenate([[0.0], np.cumsum(np.concatenate([density * lengths] * 2))])
+    arc2 = np.concatenate([starts[:-1], starts[:-1] + perimeter, [2.0 * perimeter]])
+    density2 = np.concatenate([density, density])
+    stop = np.append(first[1:], first[0] + n)
+    span = cum[stop] - cum[first]
+    count = np.maximum(1, np.ceil(span - 1e-9)).astype(int)
+    stretch = np.repeat(np.arange(first.size), count)
+    k = np.arange(stretch.size) - np.repeat(np.cumsum(count) - count, count)
+    target = cum[first[stretch]] + span[stretch] * k / count[stretch]
+    j = (np.searchsorted(cum, target, side="right") - 1).clip(0, 2 * n - 1)
+    inside = np.where(density2[j] > 0, (target - cum[j]) / np.where(density2[j] > 0, density2[j], 1.0), 0.0)
+    want = np.where(k == 0, starts[first[stretch]], arc2[j] + inside) % perimeter
+    want = np.sort(want)
     # the nearest sample of the machined boundary (its corners are samples)
     j = np.clip(np.searchsorted(machined.arcs, want), 1, machined.arcs.size - 1)
     j = np.where(want - machined.arcs[j - 1] <= machined.arcs[j] - want, j - 1, j)

@@ -83,3 +83,62 @@ def test_jaw_bridges_a_concavity_in_pymunk_too():
     assert part.curvature(a.param) > 0
     assert abs(float(part.arc_offset(part.arc_at_param(a.param), concave))) > 3.0
     assert part.arc_at_param(a.param) == pytest.approx(part.arc_at_param(b.param), abs=0.05)
+
+
+def polyline_dxf(pts, path):
+    import ezdxf
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline([], close=True).lwpoints.extend([(x, y, 0, 0, 0) for x, y in pts.tolist()])
+    doc.saveas(path)
+    return path
+
+
+def chord_error(outline, tolerance):
+    """(the arcs of the pymunk polygon's vertices, the largest distance of the model from the chord over
+    it, mm)."""
+    from sim2d.sampled import SampledPart, model_sample
+
+    arcs, xy, _ = model_sample(outline)
+    pts = polygonise(SampledPart(outline, arcs, xy), tolerance)
+    # the vertices are model samples: found by position
+    index = {tuple(p): i for i, p in enumerate(xy)}
+    vert = np.array([index[tuple(p)] for p in pts[:-1]])
+    worst = 0.0
+    for a, b in zip(vert, np.append(vert[1:], vert[0] + len(arcs))):
+        seg = xy[np.arange(a, b + 1) % len(arcs)]
+        d = seg[-1] - seg[0]
+        n = np.array([-d[1], d[0]]) / np.hypot(*d)
+        worst = max(worst, float(np.abs((seg - seg[0]) @ n).max()))
+    return arcs[vert], worst
+
+
+@pytest.mark.parametrize("n", [100, 2000, 20000])
+def test_a_faceted_drawing_gets_the_vertices_its_curve_needs_not_one_per_facet(tmp_path, n):
+    """A 60 × 20 mm ellipse drawn as n segments reads as thousands of short arcs; the world's polygon
+    still meets the chord tolerance and has about as many vertices at 20 000 facets as at 100."""
+    from localizer import load_outline
+
+    t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    outline = load_outline(polyline_dxf(np.c_[60.0 * np.cos(t), 20.0 * np.sin(t)], tmp_path / f"e{n}.dxf"))
+    assert len(outline.pieces) >= n
+    at, worst = chord_error(outline, 1e-3)
+    assert worst <= 1e-3
+    # 2π·60 mm at the sagitta rule with the ellipse's largest curvature (60/20²) bounds the count
+    assert len(at) <= 1.1 * 2.0 * np.pi * 60.0 / math.sqrt(8.0 * 1e-3 / (60.0 / 400.0)) + 10
+
+
+@pytest.mark.parametrize("name", ["bracket.dxf", "profile.svg"])
+def test_a_drawings_polygon_meets_the_chord_tolerance_with_one_chord_per_face(name):
+    from localizer import Line, load_outline
+
+    outline = load_outline(PARTS / name)
+    at, worst = chord_error(outline, 1e-3)
+    assert worst <= 1e-3
+    # a face (a line) is one chord: a vertex at each end, none between
+    faces = [(a, a + p.length) for a, p in zip(outline.starts, outline.pieces) if isinstance(p, Line)]
+    assert faces
+    for a, b in faces:
+        assert np.abs(at - a).min() < 0.005 and np.abs(at - b % outline.perimeter).min() < 0.005
+        assert not np.any((at > a + 0.005) & (at < b - 0.005))
