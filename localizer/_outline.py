@@ -36,6 +36,11 @@ JOIN_TOL = 1e-6
 #: (or, turned the other way, a concave corner the jaw cannot touch) in the middle of a smooth
 #: stretch. 1e-3 rad is half of two steps of the arm's 0.03° encoder: a jump the jaw cannot sense.
 SMOOTH_TOL = 1e-3
+#: An arc position this close to a corner, relative to the perimeter (or 1 mm), is at the corner
+#: (:meth:`Outline.corner_at`): a start plus a length that should land on a corner misses it by rounding,
+#: about 1e-15 of the perimeter. Far below any place the jaw can tell, and below the solver's own
+#: margin inside its intervals (1e-9), so that a limit taken beside a corner stays on its side.
+AT_CORNER = 1e-11
 #: A corner whose direction turns by more than π less this, rad, is a fold: the outline goes back along
 #: itself (a line drawn twice, a zero-width slot), which no part has.
 FOLD_TOL = 1e-6
@@ -173,13 +178,43 @@ class Outline(ArcPositions):
         return xy, th, kappa
 
     def _locate(self, sigma: ArrayLike) -> tuple[FloatArray, np.ndarray, FloatArray]:
-        """(laps, piece index, arc within the piece) of unrolled arc positions ``sigma`` (mm)."""
+        """(laps, piece index, arc within the piece) of unrolled arc positions ``sigma`` (mm); a position
+        at a corner (:meth:`corner_at`) is the start of the piece after it."""
+        lap, k, local, _ = self._place(sigma)
+        return lap, k, local
+
+    def _place(self, sigma: ArrayLike) -> tuple[FloatArray, np.ndarray, FloatArray, np.ndarray]:
+        """:meth:`_locate` and :meth:`corner_at` of ``sigma`` at once."""
+        P = self.perimeter
         s = np.asarray(sigma, dtype=float)
-        lap = np.floor(s / self.perimeter)
-        ss = s - lap * self.perimeter
+        lap = np.floor(s / P)
+        ss = s - lap * P
+        over = ss >= P  # rounding: just under a whole lap
+        lap, ss = np.where(over, lap + 1.0, lap), np.where(over, ss - P, ss)
+        corner = np.full(ss.shape, -1, dtype=np.int64)
+        if self.corners:
+            arcs = np.array([c.arc for c in self.corners])
+            # each corner, and the last one a lap before and the first a lap after: a sum of arcs that should
+            # land on a corner lands within rounding of it on either side, through the seam as well
+            near = np.concatenate([[arcs[-1] - P], arcs, [arcs[0] + P]])
+            j = np.clip(np.searchsorted(near, ss), 1, near.size - 1)
+            j = np.where(ss - near[j - 1] <= near[j] - ss, j - 1, j)
+            at = np.abs(ss - near[j]) <= AT_CORNER * max(1.0, P)
+            index = (j - 1) % arcs.size
+            corner = np.where(at, index, -1)
+            lap = np.where(at & (j == near.size - 1), lap + 1.0, np.where(at & (j == 0), lap - 1.0, lap))
+            ss = np.where(at, arcs[index], ss)
         k = np.clip(np.searchsorted(self.starts, ss, side="right") - 1, 0, len(self.pieces) - 1)
         local: FloatArray = ss - self.starts[k]
-        return lap, k, local
+        return lap, k, local, corner
+
+    def corner_at(self, sigma: ArrayLike) -> np.ndarray:
+        """The index in :attr:`corners` of the corner at each arc position ``sigma`` (mm, any real), −1
+        where there is none. Every question "is this arc at a corner?" is answered here: a position
+        within :data:`AT_CORNER` of a corner (relative to the perimeter, or 1 mm) is at it, on either
+        side, through the seam too, so that an end computed as a start plus a length lands on the
+        corner it was meant to, whatever the rounding."""
+        return self._place(sigma)[3]
 
     def point_at_arc(self, sigma: ArrayLike) -> FloatArray:
         """Points at arc positions ``sigma`` (mm, any real: wraps), shape (..., 2), mm."""
@@ -193,16 +228,13 @@ class Outline(ArcPositions):
         corner ``side`` says which value: ``"after"`` (default) or ``"before"`` the jump."""
         if side not in ("after", "before"):
             raise PartError(f"side={side!r}: use 'after' or 'before'")
-        lap, k, local = self._locate(sigma)
+        lap, k, local, corner = self._place(sigma)
         _, theta, _ = self._evaluate(k, local, angle=True)
         assert theta is not None
         out = theta + 2.0 * np.pi * lap
         if side == "before" and self.corners:
-            arcs = np.array([c.arc for c in self.corners])
             angles = np.array([c.angle for c in self.corners])
-            s = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
-            at = np.abs(s[..., None] - arcs) <= 1e-12 * max(1.0, self.perimeter)
-            out = out - (at * angles).sum(axis=-1)
+            out = out - np.where(corner >= 0, angles[corner], 0.0)
         result: FloatArray = out
         return result
 

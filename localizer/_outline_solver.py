@@ -11,11 +11,11 @@ each, so g' = κ(σ + L) − κ(σ) there:
   feasible starts (``kind="continuum"``, ``span``);
 * where an end is on a Bézier, the spline solver's certificate (:mod:`localizer._certify`) runs on
   cells of ``spacing`` mm: g and g' are exact at the cells' ends, and |g''| = |κ'(σ + L) − κ'(σ)| is
-  bounded per cell from each Bézier's κ tabulated every ``spacing``/2 mm (the largest slope of the
-  cell and its neighbours, times :data:`SLOPE_CUSHION`; lines and arcs add nothing). A cell is then
-  certified to hold one root (refined by Brent to 1e-12 mm), none, a near-double root or a flat
-  stretch, or it is bisected. The bound is measured on that dense sample, as the spline table's
-  interpolation error is, not proved.
+  bounded per cell by the sum of |κ'| bounds on its two ends' stretches, each proved from the
+  Bézier's Bernstein coefficients over the stretch (:func:`localizer._bezier_bound.kappa_slope_bound`,
+  rational pieces included; lines and arcs add nothing), not from a sample. A cell is then certified
+  to hold one root (refined by Brent to 1e-12 mm), none, a near-double root or a flat stretch, or it
+  is bisected.
 
 **Corners.** A jaw laid on a convex corner touches it at every angle within the corner's jump, so
 a start (or an end) exactly at a corner fits every rotation in a range: with θ⁻, θ⁺ the angles
@@ -33,6 +33,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from ._bezier_bound import kappa_slope_bound
 from ._cache import per_part
 from ._certify import certify_cells
 from ._errors import QueryError
@@ -41,13 +42,12 @@ from ._outline import _BEZIER, Outline
 from ._pieces import CubicBezier
 from ._segment import DIRECTIONS, Segment
 
-__all__ = ["outline_segments", "SLOPE_CUSHION"]
+__all__ = ["outline_segments"]
 
-#: How much the largest sampled slope of κ near a cell is widened to bound |dκ/dσ| on it: on a
-#: smooth piece the slope between samples h apart differs from the cell's largest by O(h·κ'').
-SLOPE_CUSHION = 1.25
 #: The certificate's settings on Bézier cells (the spline solver's defaults, localizer.EXACT).
 _FLAT_TOL, _DOUBLE_WIDTH, _MAX_CELLS = 1e-10, 1e-7, 2_000_000
+#: How far a table cell's parameter interval is widened past the arc's inversion (which is to 1e-12).
+_PARAM_SLACK = 1e-9
 
 
 def _theta(outline: Outline, sigma: float, side: str) -> float:
@@ -140,7 +140,6 @@ def _solve_ccw(outline: Outline, L: float, omega: float, spacing: float) -> list
     tol = 1e-9 * max(1.0, P)
     breaks = breaks[np.concatenate([[True], np.diff(breaks) > tol])]
     bounds = np.append(breaks, breaks[0] + P)
-    corner_at = {round(c.arc, 9): c for c in outline.corners}
 
     def g(s: np.ndarray) -> np.ndarray:
         """g at starts ``s``, each with both ends strictly inside their pieces."""
@@ -173,9 +172,7 @@ def _solve_ccw(outline: Outline, L: float, omega: float, spacing: float) -> list
             out.append((float(root[i]), "simple", 0.0, float(residual[i])))
     # corners: a start at corner c, or an end at a corner, fits a range of rotations
     for b in breaks:
-        c_start = corner_at.get(round(float(b), 9))
-        c_end = corner_at.get(round(float((b + L) % P), 9))
-        if c_start is None and c_end is None:
+        if outline.corner_at(b) < 0 and outline.corner_at(b + L) < 0:
             continue
         lo_end, hi_end = sorted((_theta(outline, b + L, "before"), _theta(outline, b + L, "after")))
         lo_start, hi_start = sorted((_theta(outline, b, "before"), _theta(outline, b, "after")))
@@ -258,7 +255,8 @@ def _slope_bound(outline: Outline, x: np.ndarray, spacing: float) -> np.ndarray:
 
 
 def _bezier_slopes(outline: Outline, spacing: float) -> dict[int, tuple[float, np.ndarray]]:
-    """Per Bézier piece: (table step h, mm; bound of |dκ/dσ| on each table cell, 1/mm²), built once."""
+    """Per Bézier piece: (table step h, mm; a proved bound of |dκ/dσ| on each table cell, 1/mm²), built
+    once per outline and spacing."""
 
     def build() -> dict[int, tuple[float, np.ndarray]]:
         cells = sum(
@@ -273,10 +271,11 @@ def _bezier_slopes(outline: Outline, spacing: float) -> dict[int, tuple[float, n
                 continue
             m = max(8, int(math.ceil(piece.length / (0.5 * spacing))))
             h = piece.length / m
-            kappa = np.asarray(piece.curvature(np.linspace(0.0, piece.length, m + 1)))
-            slope = np.abs(np.diff(kappa)) / h
-            near = np.maximum(slope, np.maximum(np.r_[slope[:1], slope[:-1]], np.r_[slope[1:], slope[-1:]]))
-            out[i] = (h, SLOPE_CUSHION * near + 1e-12)
+            u = np.asarray(piece.param(np.arange(m + 1) * h), dtype=float)
+            # the parameter from the arc by Newton's method, to 1e-12: each cell widened past that
+            u0 = np.clip(u[:-1] - _PARAM_SLACK, 0.0, 1.0)
+            u1 = np.clip(u[1:] + _PARAM_SLACK, 0.0, 1.0)
+            out[i] = (h, kappa_slope_bound(piece, u0, u1))
         return out
 
     return per_part("bezier_slopes", outline, float(spacing), build)
