@@ -307,7 +307,7 @@ def reactive_filter(study, part, noise, filter_class=None):
     for key in ("noise_scales", "slope_envelope"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)
-    for key in ("temper", "shape_spacing", "defect_window", "lookalike_slope"):
+    for key in ("temper", "shape_spacing", "defect_window", "lookalike_slope", "corner_ends"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)
     cls = ContactFilter if filter_class is None else filter_class

@@ -50,6 +50,8 @@ Several methods on the same trials (instead of ``method``)::
     lookalike_slope = 8.0                # optional: the factor on sd_slope under which a look-alike
                                          #   must be ruled out too (default localizer.LOOKALIKE_SLOPE;
                                          #   0: no such check)
+    corner_ends = true                   # optional: the stated mass must hold too under a prior that
+                                         #   lays the jaw on a corner only at its jump's ends (drawings)
 
     [world]                              # optional: how each trial's world differs from the model
     defects = 1                          #   (sim2d.world_part): defects near the start, or anywhere,
@@ -206,6 +208,7 @@ class ReactiveOptions:
     slope_envelope: tuple | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
     defect_window: float | None = None  # None: localizer.DEFECT_WINDOW (mm); 0: trust every stretch, test none
     lookalike_slope: float | None = None  # None: localizer.LOOKALIKE_SLOPE; 0: no look-alike check
+    corner_ends: bool | None = None  # None: the filter's default (True); false: the uniform prior over a corner
 
 
 @dataclass(frozen=True)
@@ -508,6 +511,11 @@ def _options(path, table, cls, name):
     for key, value in table.items():
         if key == "sd_slope" and value == "auto":
             values[key] = "auto"
+            continue
+        if key == "corner_ends":
+            if not isinstance(value, bool):
+                raise StudyError(f"study {path}: [{name}] corner_ends={value!r} must be true or false")
+            values[key] = value
             continue
         if key in ("noise_scales", "slope_envelope"):
             if (

@@ -102,6 +102,17 @@ the tuning family (100 trials per level, ×0.7/×1.4/×2.8/×5.6; confident and 
 alone 0/0/0/11, with {¼} 0/0/0/5, with {¼, 2} 0/0/0/1, with {¼, 4} 0/0/0/0 but sure in only 21 of
 100 trials at ×2.8.
 
+*A jaw laid on a corner.* A convex corner is a range of starts, one per jaw angle within its jump, each
+as likely a priori as a start on a piece (the tracks spread a corner over ``PIVOT_SPREAD`` mm per
+radian). A pure pivot, the jaw turning on the corner with no contact travel, tells only that the
+corner's jump is at least the pivot; between two corners that both allow it, the uniform prior over
+the jaw's angle then decides, in proportion to how many of each corner's angles allow the pivot: a
+plate's 81.7° corner outweighed the true 64.3° one 60 to 1 after a 64° pivot, where the jaw had been
+laid on the face before the corner (sure and wrong, 94 mm off). A jaw put on a part from a face lies at
+a corner's ends more often than inside it, so the stated mass is also at most the probability under a
+prior that lays the jaw on a corner only at the ends of its jump (``corner_ends``): under it such a
+pivot leaves the corners equally likely.
+
 The belief over the *present* contact is the push-forward of the posterior over
 σ₀ (with the slope term's offset at the last reading, except on a pivot: there the real contact
 is the corner, which machining moves along its normal only). :meth:`ContactFilter.belief`
@@ -403,6 +414,10 @@ class ContactFilter:
         nominal present contact is within :data:`LOOKALIKE_RADIUS` of the most probable one's: a look-alike
         place must be ruled out under a part off its model by a form tolerance, not only by machining
         (default :data:`LOOKALIKE_SLOPE`; 0: no such check). Module notes, "A part that is not its model".
+    corner_ends : bool
+        Also state at most the probability under a prior that lays the jaw on a convex corner only at the
+        ends of its jump (on one of the two pieces beside it), not at any angle within it (module notes,
+        "A jaw laid on a corner"). No effect on a part without convex corners.
     noise_scales : sequence of float
         Common factors on ``sd_position``, ``sd_scale``, ``sd_slope`` and ``sd_jaw`` that the filter weighs
         with equal prior probability (the real noise is rarely what the settings say; module
@@ -440,6 +455,7 @@ class ContactFilter:
         noise_scales: ArrayLike = NOISE_SCALES,
         slope_envelope: ArrayLike = SLOPE_ENVELOPE,
         lookalike_slope: float = LOOKALIKE_SLOPE,
+        corner_ends: bool = True,
         sd_jaw: float = 0.015,
         jaw_spacing: float = 5.0,
         sd_turn: float = ENCODER_SD,
@@ -489,6 +505,7 @@ class ContactFilter:
         self.noise_scales = tuple(float(v) for v in scales)
         self.slope_envelope = tuple(float(v) for v in envelope if v != 1.0) if sd_slope > 0 else ()
         self.lookalike_slope = float(lookalike_slope) if sd_slope > 0 else 0.0
+        self.corner_ends = bool(corner_ends)
         self.jaw_spacing = float(jaw_spacing)
         # basis columns: 0 the constant, then B-splines B_k(z) for knots over z in [-P, P]
         self._k0 = int(math.ceil(part.perimeter / shape_spacing)) + 3
@@ -1342,6 +1359,15 @@ class ContactFilter:
             w_f = self._posterior(factor)
             mean_f, sd_f = self._shift(factor)
             mass = min(mass, self._mass_near(w_f, part.wrap_arc(self.current + mean_f), sd_f, map_arc, radius))
+        if self.corner_ends and self.tracks.pivot.any():
+            # ... and under a prior that lays the jaw on a corner only at its jump's ends: a pure pivot tells
+            # only that the corner's jump is at least the pivot, so the uniform prior over the jump alone
+            # would decide between two such corners (module notes, "A jaw laid on a corner")
+            pivot = self.tracks.pivot  # per start: the table's node of each start is its index
+            w_e = np.where(pivot & np.roll(pivot, 1), 0.0, w)
+            total = float(w_e.sum())
+            if total > 0:
+                mass = min(mass, self._mass_near(w_e / total, present, sd, map_arc, radius))
         if self.lookalike_slope > 0 and mass >= self.confidence:
             # ... and no look-alike place under a part a form tolerance off its model: which place, so the
             # starts' nominal present contacts (the slope term's offset there is the envelope's question).

@@ -176,3 +176,20 @@ def test_pruning_does_not_raise_the_stated_probability():
     assert not [c for c in pruned if c[0] >= 0.95 and c[1] > 0.3]
     checked = replay_checks("cad-heldout-dee10-t62.json")  # with the look-alike check: never sure and wrong
     assert len(checked) > 100 and not [c for c in checked if c[0] >= 0.95 and c[1] > 0.3]
+
+
+def test_a_pure_pivot_does_not_choose_between_corners_that_both_allow_it():
+    # plate-04 of cad-heldout-b, trial 62, its 321 calls recorded when it was sure and wrong (commit
+    # afd8350, `python -m bench.replay bench/studies/cad-heldout-b.toml --level 0 --trial 62`): the jaw,
+    # laid on the face just before a 64.3° corner, pivoted 60° on it with no contact travel. The plate's
+    # 81.7° corner allows that pivot from more of its angles: under the uniform prior over a corner's
+    # angles it leads (then 60:1 and sure, 94 mm off). Under the prior that lays the jaw at a corner's
+    # ends the two corners are alike: the stated mass stays near a half while the pivot says nothing more
+    uniform = replay_checks("cad-heldout-b-plate04-t62.json", corner_ends=False)
+    ends = replay_checks("cad-heldout-b-plate04-t62.json")
+    assert len(ends) == len(uniform) > 50
+    far = [i for i, c in enumerate(uniform) if c[1] > 50.0]  # the look-alike corner leads
+    assert len(far) > 40
+    assert max(uniform[i][0] for i in far) > 0.7
+    assert max(ends[i][0] for i in far) < 0.6
+    assert not [c for c in ends if c[0] >= 0.95 and c[1] > 0.3]
