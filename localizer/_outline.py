@@ -38,9 +38,10 @@ JOIN_TOL = 1e-6
 SMOOTH_TOL = 1e-3
 #: An arc position this close to a corner, relative to the perimeter (or 1 mm), is at the corner
 #: (:meth:`Outline.corner_at`): a start plus a length that should land on a corner misses it by rounding,
-#: about 1e-15 of the perimeter. Far below any place the jaw can tell, and below the solver's own
-#: margin inside its intervals (1e-9), so that a limit taken beside a corner stays on its side.
-AT_CORNER = 1e-11
+#: about 1e-15 of the perimeter. Far below any place the jaw can tell (0.3 nm on a 300 mm part), and
+#: below the solver's own margin inside its intervals (1e-9), so that a limit taken beside a corner
+#: stays on its side.
+AT_CORNER = 1e-12
 #: A corner whose direction turns by more than π less this, rad, is a fold: the outline goes back along
 #: itself (a line drawn twice, a zero-width slot), which no part has.
 FOLD_TOL = 1e-6

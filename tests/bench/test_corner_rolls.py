@@ -62,8 +62,8 @@ def test_a_roll_whose_end_lands_on_a_corner_through_the_seam_is_found(which, cor
     P = ref.perimeter
     s = start * P
     L = (c.arc - s) % P if ccw else (s - c.arc) % P
-    if not 0.02 * P < L < 0.98 * P:
-        return
+    if not 0.02 * P < L < 0.98 * P or min(abs((s - k.arc + P / 2) % P - P / 2) for k in outline.corners) < 1e-6:
+        return  # too short, or the start is itself at a corner (the ends at corners are the next test's)
     # the jaw's angle at the end (unrolled: a lap on where the end passed the first point) within the corner's
     before, after = ref.range(s + L if ccw else s - L)
     assert after - before == pytest.approx(c.angle, abs=1e-9)  # the reference sees the corner there
@@ -78,7 +78,7 @@ def test_an_arc_within_rounding_of_a_corner_is_at_it_on_either_side_and_through_
     outline, _ = drawing(name)
     P = outline.perimeter
     for i, c in enumerate(outline.corners):
-        for sigma in (c.arc, c.arc + 1e-13 * P, c.arc - 1e-13 * P, c.arc + P, c.arc - P, c.arc - 3 * P + 1e-12 * P):
+        for sigma in (c.arc, c.arc + 1e-13 * P, c.arc - 1e-13 * P, c.arc + P, c.arc - P, c.arc - 3 * P + 5e-13 * P):
             assert outline.corner_at(sigma) == i
             # the angles on the two sides are the corner's, a whole number of laps on
             lap = math.floor((sigma - c.arc) / P + 0.5)
