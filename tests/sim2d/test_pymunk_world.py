@@ -9,6 +9,7 @@ import pytest
 from localizer import load_part
 from sim2d.pymunk_world import PymunkWorld, polygonise
 from sim2d.quasistatic import QuasiStaticWorld
+from tests.localizer.test_facets import polyline_dxf
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 
@@ -83,16 +84,6 @@ def test_jaw_bridges_a_concavity_in_pymunk_too():
     assert part.curvature(a.param) > 0
     assert abs(float(part.arc_offset(part.arc_at_param(a.param), concave))) > 3.0
     assert part.arc_at_param(a.param) == pytest.approx(part.arc_at_param(b.param), abs=0.05)
-
-
-def polyline_dxf(pts, path):
-    import ezdxf
-
-    doc = ezdxf.new()
-    doc.header["$INSUNITS"] = 4
-    doc.modelspace().add_lwpolyline([], close=True).lwpoints.extend([(x, y, 0, 0, 0) for x, y in pts.tolist()])
-    doc.saveas(path)
-    return path
 
 
 def chord_error(outline, tolerance):
