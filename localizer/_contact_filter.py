@@ -113,6 +113,13 @@ a corner's ends more often than inside it, so the stated mass is also at most th
 prior that lays the jaw on a corner only at the ends of its jump (``corner_ends``): under it such a
 pivot leaves the corners equally likely.
 
+*A face just crossed.* Turned past a face's angle, the model's contact is on the piece after it, where the
+tangent has turned that much; but the machined face is locally tilted by several of its slope errors, and
+until the jaw has turned past that the real contact may still be on the face, anywhere short of its end
+(a plate, 0.18° past a 46 mm face: the model put the contact 0.01 mm into the next fillet, the rig's jaw
+rested on the face 0.35 mm before its end, stated 1.00). Within :data:`FACE_SLOPES` slope errors of a
+face's angle, a start's present contact counts as anywhere from the face's far end to the model's contact.
+
 The belief over the *present* contact is the push-forward of the posterior over
 σ₀ (with the slope term's offset at the last reading, except on a pivot: there the real contact
 is the corner, which machining moves along its normal only). :meth:`ContactFilter.belief`
@@ -188,6 +195,7 @@ from ._defaults import CALIBRATION_SCALE_SD, FIT_ALPHA, PART_SCALE_SD, SUCCESS_R
 from ._errors import QueryError
 from ._filter_kernels import add_row, weigh_scales
 from ._limits import check_grid
+from ._pieces import Line
 from ._reach import DEFAULT_JAW, StraightJaw
 from ._stretches import (
     DEFECT_WINDOW,
@@ -242,6 +250,10 @@ ENCODER_SD = math.radians(0.03) / math.sqrt(12.0)
 #: reading's effects on the contact grow with ρ, and on a straight stroke of a glyph or a flat side
 #: (ρ of metres) the readings cannot place the contact along it, which the model must say.
 RHO_MAX = 5000.0
+#: How many of the machined slope's standard deviations (``sd_slope``) past a face's angle the jaw must have
+#: turned before its contact is taken to have left the face: a face machined wavy by microns over
+#: millimetres is locally tilted by several (module notes, "A face just crossed").
+FACE_SLOPES = 5.0
 #: The largest radius, mm, the slope term's prior takes: beyond it the offset's prior is so wide
 #: (metres times mrad) that it makes the marginalisation ill-conditioned, and it is already wide
 #: enough to leave the contact's place on such a stretch to the other readings.
@@ -1359,6 +1371,9 @@ class ContactFilter:
             w_f = self._posterior(factor)
             mean_f, sd_f = self._shift(factor)
             mass = min(mass, self._mass_near(w_f, part.wrap_arc(self.current + mean_f), sd_f, map_arc, radius))
+        if self.tracks.has_faces:
+            # ... and with the contact just past a face counted anywhere on that face's end (module notes)
+            mass = min(mass, self._mass_past_faces(w, present, sd, map_arc, radius))
         if self.corner_ends and self.tracks.pivot.any():
             # ... and under a prior that lays the jaw on a corner only at its jump's ends: a pure pivot tells
             # only that the corner's jump is at least the pivot, so the uniform prior over the jump alone
@@ -1457,6 +1472,42 @@ class ContactFilter:
         rel = np.asarray(self.part.arc_offset(np.array(present), first))
         lo, hi = first + float(rel.min()), first + float(rel.max())
         return float(self.part.wrap_arc(lo)), float(self.part.wrap_arc(hi))
+
+    def _mass_past_faces(self, w: FloatArray, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> float:
+        """:meth:`_mass_near`, but a start whose jaw is within :data:`FACE_SLOPES` machined slopes (``sd_slope``)
+        of the angle of a face its contact has just left or is about to reach counts as anywhere between that
+        face's far end and its contact: the real face, tilted by its machining, may still hold the jaw there.
+        The jaw's angle is the start's present node's (on a pivot, within the corner's jump)."""
+        part = self.part
+        i = int(np.argmax(w))
+        sel = np.flatnonzero(w > 1e-12 * w[i])
+        p = present[sel]
+        theta = np.asarray(self.tracks.theta[self.node[sel]], dtype=float)
+        slack = FACE_SLOPES * max(self.sd_slope, 1e-4)
+        lo, hi = p.copy(), p.copy()
+        wide = np.zeros(p.size, dtype=bool)
+        for start, piece in zip(getattr(part, "starts", ()), getattr(part, "pieces", ())):
+            if not isinstance(piece, Line):
+                continue
+            angle = float(piece.tangent_angle(0.0))
+            turned = (theta - angle + np.pi) % (2.0 * np.pi) - np.pi
+            past = np.asarray(part.arc_offset(p, start + piece.length))  # > 0: beyond the face's end
+            before = np.asarray(part.arc_offset(start, p))  # > 0: short of the face's start
+            after = (past > 0) & (past < piece.length) & (turned > 0) & (turned <= slack)
+            ahead = (before > 0) & (before < piece.length) & (turned < 0) & (turned >= -slack)
+            lo = np.where(after, p - past - piece.length, lo)
+            hi = np.where(ahead, p + before + piece.length, hi)
+            wide |= after | ahead
+        if not wide.any():
+            return self._mass_near(w, present, sd, arc, radius)
+        off_lo = np.asarray(part.arc_offset(lo, arc))
+        off_hi = off_lo + (hi - lo)
+        overlap = np.clip(np.minimum(off_hi, radius) - np.maximum(off_lo, -radius), 0.0, None)
+        inside_wide = overlap / np.maximum(hi - lo, 1e-12)
+        off, s_ = np.asarray(part.arc_offset(p, arc)), sd[sel]
+        spread = np.where(s_ > 0, s_, 1.0)
+        inside = np.where(s_ > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius)
+        return float(np.sum(w[sel] * np.where(wide, inside_wide, inside)))
 
     def _mass_near(self, w: FloatArray, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> float:
         """Probability that the present contact is within ``radius`` mm of ``arc``: each start's (weight
