@@ -106,7 +106,7 @@ def kappa_slope_bound(piece: CubicBezier, u0: FloatArray, u1: FloatArray, depth:
     ndarray
         One bound per interval, ≥ the largest |dκ/ds| on it.
     """
-    N, Q, size = _per_piece(piece)
+    N, Q, size = _polynomials(piece)
     bound = _bound(N, Q, np.asarray(u0, dtype=float), np.asarray(u1, dtype=float), depth)
     result: FloatArray = bound * (1.0 + ROUNDING) / size**2
     return result
@@ -124,16 +124,3 @@ def _bound(N: FloatArray, Q: FloatArray, u0: FloatArray, u1: FloatArray, depth: 
         mid = 0.5 * (u0[bad] + u1[bad])
         out[bad] = np.maximum(_bound(N, Q, u0[bad], mid, depth - 1), _bound(N, Q, mid, u1[bad], depth - 1))
     return out
-
-
-_CACHE: dict[CubicBezier, tuple[FloatArray, FloatArray, float]] = {}
-
-
-def _per_piece(piece: CubicBezier) -> tuple[FloatArray, FloatArray, float]:
-    """:func:`_polynomials`, kept per piece (a piece is a frozen value)."""
-    got = _CACHE.get(piece)
-    if got is None:
-        if len(_CACHE) > 4096:
-            _CACHE.clear()
-        got = _CACHE[piece] = _polynomials(piece)
-    return got

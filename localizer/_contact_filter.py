@@ -534,6 +534,13 @@ class ContactFilter:
         # is refused before either is built
         check_grid(part, "filter", spacing, grid_size(part, spacing), point_bytes=8.0 * self._m)
         self.tracks = tracks_for(part, spacing, jaw)
+        # the faces (start mm, length mm, angle rad) and the starts inside a corner's jump, for the belief
+        self._faces = [
+            (float(a), float(piece.length), float(piece.tangent_angle(0.0)))
+            for a, piece in zip(getattr(part, "starts", ()), getattr(part, "pieces", ()))
+            if isinstance(piece, Line)
+        ]
+        self._inside_corner = self.tracks.pivot & np.roll(self.tracks.pivot, 1)
         self.sd_position = float(sd_position)
         self.sd_scale = float(sd_scale)
         self.sd_slope = float(sd_slope)
@@ -1378,8 +1385,7 @@ class ContactFilter:
             # ... and under a prior that lays the jaw on a corner only at its jump's ends: a pure pivot tells
             # only that the corner's jump is at least the pivot, so the uniform prior over the jump alone
             # would decide between two such corners (module notes, "A jaw laid on a corner")
-            pivot = self.tracks.pivot  # per start: the table's node of each start is its index
-            w_e = np.where(pivot & np.roll(pivot, 1), 0.0, w)
+            w_e = np.where(self._inside_corner, 0.0, w)  # per start: a start's table node is its index
             total = float(w_e.sum())
             if total > 0:
                 mass = min(mass, self._mass_near(w_e / total, present, sd, map_arc, radius))
@@ -1486,17 +1492,14 @@ class ContactFilter:
         slack = FACE_SLOPES * max(self.sd_slope, 1e-4)
         lo, hi = p.copy(), p.copy()
         wide = np.zeros(p.size, dtype=bool)
-        for start, piece in zip(getattr(part, "starts", ()), getattr(part, "pieces", ())):
-            if not isinstance(piece, Line):
-                continue
-            angle = float(piece.tangent_angle(0.0))
+        for start, length, angle in self._faces:
             turned = (theta - angle + np.pi) % (2.0 * np.pi) - np.pi
-            past = np.asarray(part.arc_offset(p, start + piece.length))  # > 0: beyond the face's end
+            past = np.asarray(part.arc_offset(p, start + length))  # > 0: beyond the face's end
             before = np.asarray(part.arc_offset(start, p))  # > 0: short of the face's start
-            after = (past > 0) & (past < piece.length) & (turned > 0) & (turned <= slack)
-            ahead = (before > 0) & (before < piece.length) & (turned < 0) & (turned >= -slack)
-            lo = np.where(after, p - past - piece.length, lo)
-            hi = np.where(ahead, p + before + piece.length, hi)
+            after = (past > 0) & (past < length) & (turned > 0) & (turned <= slack)
+            ahead = (before > 0) & (before < length) & (turned < 0) & (turned >= -slack)
+            lo = np.where(after, p - past - length, lo)
+            hi = np.where(ahead, p + before + length, hi)
             wide |= after | ahead
         if not wide.any():
             return self._mass_near(w, present, sd, arc, radius)
@@ -1504,9 +1507,7 @@ class ContactFilter:
         off_hi = off_lo + (hi - lo)
         overlap = np.clip(np.minimum(off_hi, radius) - np.maximum(off_lo, -radius), 0.0, None)
         inside_wide = overlap / np.maximum(hi - lo, 1e-12)
-        off, s_ = np.asarray(part.arc_offset(p, arc)), sd[sel]
-        spread = np.where(s_ > 0, s_, 1.0)
-        inside = np.where(s_ > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius)
+        inside = self._inside(p, sd[sel], arc, radius)
         return float(np.sum(w[sel] * np.where(wide, inside_wide, inside)))
 
     def _mass_near(self, w: FloatArray, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> float:
@@ -1514,10 +1515,16 @@ class ContactFilter:
         ``w``) is N(``present``, ``sd``²) along the part."""
         i = int(np.argmax(w))
         sel = np.flatnonzero(w > 1e-12 * w[i])
-        off, s = np.asarray(self.part.arc_offset(present[sel], arc)), sd[sel]
-        spread = np.where(s > 0, s, 1.0)
-        inside = np.where(s > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius)
-        return float(np.sum(w[sel] * inside))
+        return float(np.sum(w[sel] * self._inside(present[sel], sd[sel], arc, radius)))
+
+    def _inside(self, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> FloatArray:
+        """Probability that a contact N(``present``, ``sd``²) along the part is within ``radius`` mm of ``arc``."""
+        off = np.asarray(self.part.arc_offset(present, arc))
+        spread = np.where(sd > 0, sd, 1.0)
+        inside: FloatArray = np.where(
+            sd > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius
+        )
+        return inside
 
     def _modes(self, w: FloatArray, present: FloatArray, radius: float) -> list[Mode]:
         """Connected groups of probable present contacts, binned at ``radius``."""

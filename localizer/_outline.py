@@ -89,6 +89,8 @@ class Outline(ArcPositions):
     starts: FloatArray = field(init=False, repr=False)
     _theta0: FloatArray = field(init=False, repr=False)  # unwrapped θ at each piece's start (after its corner)
     _kind: np.ndarray = field(init=False, repr=False)  # _LINE, _ARC or _BEZIER per piece
+    _corner_arcs: FloatArray = field(init=False, repr=False)  # the corners' arcs and jumps, as arrays
+    _corner_angles: FloatArray = field(init=False, repr=False)
     _exact: tuple[FloatArray, ...] = field(init=False, repr=False)  # the lines' and arcs' arrays
     _tables: dict[tuple[str, Hashable], Any] = field(init=False, repr=False, default_factory=dict)
 
@@ -134,6 +136,8 @@ class Outline(ArcPositions):
             corners.insert(0, Corner(0.0, jump))
         object.__setattr__(self, "_theta0", theta0)
         object.__setattr__(self, "corners", tuple(corners))
+        object.__setattr__(self, "_corner_arcs", np.array([c.arc for c in corners], dtype=float))
+        object.__setattr__(self, "_corner_angles", np.array([c.angle for c in corners], dtype=float))
         # every jump counts, the smooth ones too: the total is then exactly that of the pieces' ends
         object.__setattr__(self, "turning", float(theta + jump - theta0[0]))
         object.__setattr__(self, "_kind", kind)
@@ -194,7 +198,7 @@ class Outline(ArcPositions):
         lap, ss = np.where(over, lap + 1.0, lap), np.where(over, ss - P, ss)
         corner = np.full(ss.shape, -1, dtype=np.int64)
         if self.corners:
-            arcs = np.array([c.arc for c in self.corners])
+            arcs = self._corner_arcs
             # each corner, and the last one a lap before and the first a lap after: a sum of arcs that should
             # land on a corner lands within rounding of it on either side, through the seam as well
             near = np.concatenate([[arcs[-1] - P], arcs, [arcs[0] + P]])
@@ -234,8 +238,7 @@ class Outline(ArcPositions):
         assert theta is not None
         out = theta + 2.0 * np.pi * lap
         if side == "before" and self.corners:
-            angles = np.array([c.angle for c in self.corners])
-            out = out - np.where(corner >= 0, angles[corner], 0.0)
+            out = out - np.where(corner >= 0, self._corner_angles[corner], 0.0)
         result: FloatArray = out
         return result
 
