@@ -28,7 +28,7 @@ MAX_REDRAWS = 1000
 def run_wheel_trial(spec) -> dict:
     """One wheel trial (module notes). Never raises: a failure is the row's ``failure``."""
     from driver.wheel import WheelPolicy, calibrate_wheel, localize_with_wheel, wheel_calibration_arc
-    from localizer import Part, WheelJaw, parse_jaw, wheel_reach_for
+    from localizer import WheelJaw, parse_jaw, wheel_reach_for
     from sim2d import WheelRig
 
     from .methods import _curve, _err, mismatch_cell, reactive_stop, rotation_curve
@@ -37,8 +37,6 @@ def run_wheel_trial(spec) -> dict:
     s = spec.study
     t0 = time.perf_counter()
     rng, part_file, part, noise, row = draw_trial(spec)
-    if not isinstance(part, Part):  # load_study refuses drawings with a wheel
-        raise TypeError(f"{part_file}: a wheel rolls on spline parts only")
     jaw = s.level_jaw(spec.level)
     wheel = parse_jaw(jaw)
     assert isinstance(wheel, WheelJaw)

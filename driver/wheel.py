@@ -41,7 +41,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from localizer import Belief, Part, WheelFilter, WheelJaw, wheel_reach_for
+from localizer import Belief, Outline, Part, WheelFilter, WheelJaw, wheel_reach_for
 
 from .procedures import PRESS, Calibration, Hand, PressSettings, delta_voltages, press, zero
 from .reactive import CONFIDENCE, MAX_ROTATION
@@ -57,6 +57,7 @@ __all__ = [
     "load_calibration",
     "check_calibration",
     "kappa_band",
+    "corner_pivot",
     "wheel_calibration_arc",
     "CALIBRATION_LENGTH",
     "MAX_RESTARTS",
@@ -214,10 +215,11 @@ class WheelRun:
         Arc rolled, both ways counted.
     steps : int
     stopped : str
-        "confident", "max_rotation", "max_arc", "blocked" (jumps both ways) or "mismatch" (a stretch of the
-        readings fits no probable place, or nothing fits after :data:`MAX_RESTARTS` fresh starts: the part
-        is not its model, ``belief.mismatch`` says where when it can); slip beyond the
-        policy's limit raises :class:`WheelSlip` instead.
+        "confident", "max_rotation", "max_arc", "blocked" (jumps both ways at one place, or again where the
+        wheel jumped the same way before: enclosed) or "mismatch" (a stretch of the readings fits no probable
+        place, or nothing fits after :data:`MAX_RESTARTS` fresh starts: the part is not its model,
+        ``belief.mismatch`` says where when it can); slip beyond the policy's limit raises
+        :class:`WheelSlip` instead.
     reversals, jumps : int
     slip : float, mm
         The rim's slip summed over the run (module notes, step 5).
@@ -261,11 +263,13 @@ class WheelRun:
 class _Wheel:
     """A wheel pressed on the part: the servo, the settled readings and one checked step (module notes)."""
 
-    def __init__(self, rig, cal: WheelCalibration, policy: WheelPolicy, pressing: PressSettings, kappa_band):
+    def __init__(
+        self, rig, cal: WheelCalibration, policy: WheelPolicy, pressing: PressSettings, kappa_band, pivot: float = 0.0
+    ):
         if not isinstance(rig, AxleEncoder):
             raise RigError(f"{type(rig).__name__} has no axle encoder: a wheel finger needs one (docs/wheel.md)")
         self.rig, self.cal, self.policy, self.pressing = rig, cal, policy, pressing
-        self.kappa_band = kappa_band
+        self.kappa_band, self.pivot = kappa_band, float(pivot)
 
     def begin(self, approach_pose) -> tuple[float, float, float, float, float]:
         """Zero the wrist clear of the part, press from ``approach_pose``, measure the wrist's stiffness;
@@ -327,6 +331,11 @@ class _Wheel:
         path = _along(prev, now, self.cal.direction_zero)
         mismatch = path - (d_len + (r - self.depth) * d_turn)
         lo, hi = sorted((self.kappa_band[0] * d_len, self.kappa_band[1] * d_len))
+        # on a convex corner the hand turns the rolling way with no arc rolled (the wheel pivots)
+        if direction > 0:
+            hi += self.pivot
+        else:
+            lo -= self.pivot
         if not (lo - JUMP_FLOOR <= d_turn <= hi + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step:
             self.hand.go(*before)
             self.state = self.settled()
@@ -475,7 +484,7 @@ def _along(a, b, zero: float = 0.0):
     return (np.asarray(b[3]) - np.asarray(a[3])) * np.cos(beta) + (np.asarray(b[4]) - np.asarray(a[4])) * np.sin(beta)
 
 
-def kappa_band(part: Part, wheel: WheelJaw) -> tuple[float, float]:
+def kappa_band(part: Part | Outline, wheel: WheelJaw) -> tuple[float, float]:
     """The curvatures (1/mm) a step of rolling on ``part`` may show: those of the stretches the wheel
     reaches, widened half way to −1/r on the concave side (a disc jammed between two walls reads exactly
     −1/r) and by half on the convex side (module notes, step 4)."""
@@ -485,9 +494,20 @@ def kappa_band(part: Part, wheel: WheelJaw) -> tuple[float, float]:
     return lo - 0.5 * (lo + 1.0 / wheel.radius), hi + 0.5 * abs(hi)
 
 
+def corner_pivot(part: Part | Outline, wheel: WheelJaw) -> float:
+    """The most one step may turn the hand beyond rolling, the rolling way (rad): the largest jump of a
+    convex corner of a drawing that the wheel reaches, on which it pivots (0 on a spline part)."""
+    corners = [c for c in getattr(part, "corners", ()) if c.angle > 0]
+    if not corners:
+        return 0.0
+    reach = wheel_reach_for(part, wheel)
+    reached = reach.touchable(np.array([c.arc for c in corners]))
+    return max((c.angle for c, ok in zip(corners, reached) if ok), default=0.0)
+
+
 def localize_with_wheel(
     rig: Rig,
-    part: Part,
+    part: Part | Outline,
     wheel: WheelJaw,
     *,
     approach_pose,
@@ -502,7 +522,7 @@ def localize_with_wheel(
     Parameters
     ----------
     rig : Rig with an axle encoder (:class:`AxleEncoder`)
-    part : Part
+    part : Part or Outline
         The part's model.
     wheel : WheelJaw
     approach_pose : (x mm, y mm, φ rad)
@@ -520,7 +540,7 @@ def localize_with_wheel(
     """
     cal = calibration if calibration is not None else WheelCalibration.nominal(wheel)
     cal.check(wheel)
-    disc = _Wheel(rig, cal, policy, pressing, kappa_band(part, wheel))
+    disc = _Wheel(rig, cal, policy, pressing, kappa_band(part, wheel), corner_pivot(part, wheel))
     flt = filter if filter is not None else WheelFilter(part, wheel)
     flt.reset()
     pol = policy
@@ -533,17 +553,20 @@ def localize_with_wheel(
     direction, reversals, jumps, steps, segment = 1, 0, 0, 0, 0
     poses, segment_rotation = [disc.hand.pose], 0.0  # the settled poses of this segment, to retrace
     rotation = arc = slip = 0.0
-    blocked_at: float | None = None
+    blocked: list[tuple[int, float]] = []  # (direction, L mm) of the jumps of this segment
     stopped = "max_rotation"
     while True:
         moved = disc.step(direction)
         if moved is None:
             flt.jumped(direction, margin=1.0 + pol.step)
             jumps += 1
-            if blocked_at is not None and abs(lengths[-1] - blocked_at) < 2 * pol.step:
+            # a jump where the last one was (stuck), or where one the same way was before (the wheel enclosed
+            # between two places it cannot pass: rolling on reads the same ground again)
+            near = [(d, L) for d, L in blocked if abs(lengths[-1] - L) < 2 * pol.step]
+            if near and (near[-1] == blocked[-1] or any(d == direction for d, _ in near)):
                 stopped = "blocked"
                 break
-            blocked_at = lengths[-1]
+            blocked.append((direction, lengths[-1]))
             direction, reversals = -direction, reversals + 1
             continue
         d_turn, d_len, mismatch = moved
@@ -599,7 +622,7 @@ def localize_with_wheel(
                 truths.append(disc.truth())
                 segments.append(segment)
                 direction, reversals = -direction, reversals + 1
-                blocked_at = None
+                blocked = []
         if rotation >= pol.max_rotation:
             stopped = "max_rotation"
             break

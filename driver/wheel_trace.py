@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from localizer import Belief, Part, WheelFilter, WheelJaw, parse_jaw
+from localizer import Belief, Outline, Part, WheelFilter, WheelJaw, parse_jaw
 
 from .rig import RigError
 from .trace import read_archive
@@ -133,7 +133,7 @@ class WheelTrace:
         _ = trace.wheel  # the finger it names must be a wheel
         return trace
 
-    def relocalize(self, part: Part, **filter_options) -> Belief:
+    def relocalize(self, part: Part | Outline, **filter_options) -> Belief:
         """The belief from the trace's readings, replayed into a :class:`localizer.WheelFilter` for its finger."""
         flt = WheelFilter(part, self.wheel, **filter_options)
         last = self.columns["segment"][-1] if self.columns["segment"].size else 0

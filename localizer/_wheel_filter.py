@@ -41,8 +41,14 @@ wheel jammed between two walls, which reads exactly as rolling in a concave arc 
 radius; the filter, normalising, stated 0.999 at a start that fitted as badly as the truth), and the
 belief's mass is 0, ``consistent`` False.
 
-Outlines with corners are refused: at a corner the wheel pivots, Ω changing while L does not, so Ω is
-not a function of L there (not built).
+On a drawing (:class:`~localizer.Outline`) the wheel pivots on each convex corner it reaches: its
+centre circles the corner, the hand turns through the corner's jump and the rim does not roll, so Ω
+runs through the jump while L stands still (docs/wheel.md). Θ is then the drawing's unwrapped angle,
+which steps at the corner, and a reading whose contact under a start lies within
+:meth:`WheelFilter.corner_window` of a convex corner is compared with the nearest angle the model takes
+there, the whole jump included: any turn within the jump fits a wheel on that corner. Concave corners
+need no rule: a disc cannot reach into one (the reach's prior), it straddles it, which the rolling
+detects as a jump.
 """
 
 from __future__ import annotations
@@ -59,6 +65,7 @@ from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._limits import MAX_ARRAY_BYTES, _bytes, check_grid
+from ._outline import Corner, Outline
 from ._part import Part
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 from ._types import BoolArray, FloatArray
@@ -94,7 +101,7 @@ class WheelFilter:
 
     Parameters
     ----------
-    part : Part
+    part : Part or Outline
     wheel : WheelJaw
     spacing : float, mm
         Grid of starts.
@@ -132,7 +139,7 @@ class WheelFilter:
 
     def __init__(
         self,
-        part: Part,
+        part: Part | Outline,
         wheel: WheelJaw,
         *,
         spacing: float = 0.02,
@@ -147,11 +154,8 @@ class WheelFilter:
         mode_floor: float = 0.05,
         noise_scales: tuple[float, ...] = WHEEL_NOISE_SCALES,
     ) -> None:
-        if not isinstance(part, Part):
-            raise QueryError(
-                f"{part.name}: the wheel's filter takes spline parts only; a drawing's corners are not built "
-                "(at a corner the wheel pivots and Ω is not a function of L)"
-            )
+        if not isinstance(part, (Part, Outline)):
+            raise QueryError(f"the wheel's filter takes a Part or an Outline, not {type(part).__name__}")
         for name, v in (("spacing", spacing), ("slope_length", slope_length), ("thin", thin), ("radius", radius)):
             if not (math.isfinite(v) and v > 0):
                 raise QueryError(f"{name}={v!r} mm must be a positive number")
@@ -173,6 +177,9 @@ class WheelFilter:
         self.h = P / n
         self.grid: FloatArray = np.arange(n, dtype=float) * self.h
         self._theta0 = self._theta(self.grid)
+        convex: list[Corner] = [c for c in part.corners if c.angle > 0] if isinstance(part, Outline) else []
+        self._convex: FloatArray = np.array([c.arc for c in convex], dtype=np.float64)
+        self._jumps: FloatArray = np.array([c.angle for c in convex], dtype=np.float64)
         reach = wheel_reach_for(part, wheel)
         touch = reach.touchable(self.grid)
         self.prior: FloatArray = np.asarray(touch, dtype=float)
@@ -190,6 +197,9 @@ class WheelFilter:
         """Unwrapped tangent angle Θ at unrolled arc positions (rad): continuous, Θ(σ + P) = Θ(σ) + 2π."""
         part = self.part
         sigma = np.asarray(sigma, dtype=float)
+        if isinstance(part, Outline):
+            unwrapped: FloatArray = part.tangent_angle_at_arc(sigma)
+            return unwrapped
         laps = np.floor(sigma / part.perimeter)
         t = part.param_at_arc(sigma - laps * part.perimeter)
         out: FloatArray = part.tangent_angle(t) + 2 * math.pi * laps
@@ -269,6 +279,39 @@ class WheelFilter:
         out: FloatArray = slope + self.sd_turn**2 * (1.0 + (a == b))
         return out
 
+    def corner_window(self, length: float) -> float:
+        """How near a convex corner (mm) a start's contact after rolling ``length`` mm may be for the wheel
+        to be pivoting on it: three standard errors of L (the encoder's and the calibrated radius's) and
+        one grid step (the true start lies between two of the grid's)."""
+        return self.h + 3.0 * math.hypot(self.sd_length, float(length) * self.sd_scale)
+
+    def predicted_turn(self, length: float, turn: float) -> FloatArray:
+        """Each start's model turn (rad) after rolling ``length`` mm, the nearest to the reading ``turn`` (rad)
+        the model allows: Θ(s + L) − Θ(s), or, within :meth:`corner_window` of a convex corner, any angle
+        between the model's there and across the corner's jump (the wheel pivoting on it)."""
+        x = self.grid + float(length)
+        model = self._theta(x) - self._theta0
+        if self._convex.size == 0:
+            return model
+        P = float(self.part.perimeter)
+        c = self._convex
+        xs = np.mod(x, P)
+        # the nearest convex corner either way, through the seam
+        ext = np.concatenate([c - P, c, c + P])
+        j = np.clip(np.searchsorted(ext, xs), 1, ext.size - 1)
+        j = np.where(xs - ext[j - 1] <= ext[j] - xs, j - 1, j)
+        d = xs - ext[j]
+        near = np.abs(d) <= self.corner_window(length)
+        if not near.any():
+            return model
+        i = np.flatnonzero(near)
+        after = self._theta(x[i] - d[i]) - self._theta0[i]  # Θ just past the corner, on the start's lap
+        before = after - self._jumps[j[i] % c.size]
+        lo, hi = np.minimum(model[i], before), np.maximum(model[i], after)
+        out = model.copy()
+        out[i] = np.clip(float(turn), lo, hi)
+        return out
+
     def update(self, length: float, turn: float) -> None:
         """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
         clockwise), and the hand's net turn since the start, ``turn`` rad."""
@@ -288,7 +331,7 @@ class WheelFilter:
         d2 = max(c_nn - float(ell @ ell), 1e-18)
         kappa = np.asarray(self.part.curvature_at_arc(self.part.wrap_arc(self.grid + L)), dtype=float)
         extra = kappa**2 * (self.sd_length**2 + (L * self.sd_scale) ** 2)
-        rho = om - (self._theta(self.grid + L) - self._theta0)
+        rho = om - self.predicted_turn(L, om)
         var = d2 + extra
         z = (rho - self._z @ ell) / np.sqrt(var)
         self._make_room()

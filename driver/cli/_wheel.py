@@ -7,7 +7,7 @@ import json
 import math
 import sys
 
-from localizer import SUCCESS_RADIUS, Part, QueryError, WheelJaw, wheel_reach_for
+from localizer import SUCCESS_RADIUS, QueryError, WheelJaw, wheel_reach_for
 
 from ..part_match import check_same_part, part_record
 from ..rig import RigError
@@ -34,15 +34,6 @@ __all__ = [
     "wheel_rig",
     "locate_wheel",
 ]
-
-
-def _spline_only(part, wheel: WheelJaw) -> Part:
-    if not isinstance(part, Part):
-        raise QueryError(
-            f"{part.name}: a {wheel} localizes on spline parts (JSON or CSV points) only; a drawing's corners "
-            "are not built for the wheel (docs/wheel.md)"
-        )
-    return part
 
 
 def wheel_policy(args):
@@ -105,7 +96,6 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     from ..wheel import calibrate_wheel, localize_with_wheel
     from ..wheel_trace import WheelTrace
 
-    part = _spline_only(part, wheel)
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
     args.engine = args.engine or "pymunk"
@@ -148,7 +138,6 @@ def wheel_rig(part, wheel: WheelJaw, args):
     """The simulated wheel rig 'emulate --jaw wheel:MM' serves, and its start pose (the wheel 1 mm off)."""
     from sim2d import WheelRig
 
-    part = _spline_only(part, wheel)
     rig = WheelRig(part, wheel, noise=args.noise, seed=args.seed, engine=args.engine)
     start = wheel_calibration_arc(part, wheel) if args.start is None else float(args.start) % part.perimeter
     return rig, rig.approach_pose(start)
@@ -168,7 +157,6 @@ def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
     from ..serial_rig import SerialRig
     from ..wheel import WheelCalibration, calibrate_wheel, localize_with_wheel
 
-    part = _spline_only(part, wheel)
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
     if calibration is not None:
@@ -220,7 +208,7 @@ def locate_wheel(args, path) -> int:
     trace = WheelTrace.load(path)
     if args.jaw is not None and str(args.jaw) != trace.metadata["jaw"]:
         raise RigError(f"trace {path} is of a {trace.metadata['jaw']} finger, not of {args.jaw}")
-    part = _spline_only(load_part(args.part), trace.wheel)
+    part = load_part(args.part)
     check_same_part(trace.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
     b = trace.relocalize(part)
     true = trace.true_arc

@@ -1,6 +1,7 @@
 """Localizing with a wheel finger on the kinematic wheel rig (issue 17): noise-free from starts inside
 concave stretches, jumps over pockets undone, slip and a wrong finger's calibration refused."""
 
+import json
 import math
 
 import numpy as np
@@ -248,3 +249,39 @@ def test_a_budget_that_runs_out_between_checks_judges_the_last_readings():
     assert checked.stopped == "confident" and checked.rotation < math.radians(200.0)
     assert unchecked.stopped == "confident" and not unchecked.history
     assert abs(part.arc_offset(unchecked.estimate_arc, unchecked.true_arcs[-1])) < 0.3
+
+
+def test_on_a_drawing_the_wheel_pivots_on_a_convex_corner_and_is_found():
+    """The bracket's corner at the seam (0 mm, 90°): the hand turns through it while L stands still, no step
+    of it taken for a jump; then sure and right."""
+    part = load_part("parts/bracket.dxf")
+    run, err = localize(part, WheelJaw(5.0), 240.0)
+    rolled, turn = np.asarray(run.lengths), np.asarray(run.turns)
+    at = part.perimeter - 240.0  # L at the corner
+    assert np.sum(np.abs(rolled - at) < 0.01) >= 10  # readings while it pivots
+    before, after = np.flatnonzero(rolled < at - 0.3)[-1], np.flatnonzero(rolled > at + 0.3)[0]
+    assert math.isclose(turn[after] - turn[before], math.pi / 2, abs_tol=0.01)
+    assert run.jumps == 0 and run.stopped == "confident" and abs(err) < 0.3
+
+
+def test_from_inside_a_drawings_notch_the_wheel_stops_enclosed_and_is_not_sure_and_wrong():
+    """The bracket's notch (20 mm wide, 10 deep) holds a 5 mm wheel between two walls it cannot climb: it
+    jumps at each, turns round, and stops when it comes back to where it jumped the same way before."""
+    part = load_part("parts/bracket.dxf")
+    run, err = localize(part, WheelJaw(5.0), 163.0)
+    assert run.stopped == "blocked" and run.jumps == 3 and run.arc < 30.0
+    assert 153.13 < run.estimate_arc < 173.13  # on the notch's floor
+    assert abs(err) < 0.3 or not run.belief.sure(0.95)
+
+
+def test_cli_simulates_a_wheel_on_a_drawing_and_locates_its_trace_again(tmp_path, capsys):
+    from driver.cli import main
+
+    bracket, out = "parts/bracket.dxf", str(tmp_path / "w.npz")
+    args = ["--jaw", "wheel:5", "--reactive", "--start", "240", "--engine", "kinematic", "--noise", "paper"]
+    assert main(["simulate", bracket, *args, "--seed", "1", "--out", out, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["jaw"] == "wheel:5" and doc["stopped"] == "confident" and doc["error_mm"] < 0.3
+    assert main(["locate", out, "--part", bracket, "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert abs(again["estimate_arc"] - doc["estimate_arc"]) < 1e-6 and again["error_mm"] < 0.3
