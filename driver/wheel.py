@@ -28,7 +28,8 @@ wheel too. Each rolling step:
 :func:`localize_with_wheel` rolls one way, turning round at a jump, and gives the readings to a
 :class:`localizer.WheelFilter` until it is sure (or the budget is spent). When nothing on the part fits
 what was read (a jam that reads as rolling in a concave arc of the wheel's own radius), it retraces
-its poses back to where that segment of rolling started and starts afresh there, the other way.
+its poses back to where that segment of rolling started and starts afresh there, the other way: away
+from the segment's last jump when it had one (a jam wedges the disc at a mouth it then jumps across).
 """
 
 from __future__ import annotations
@@ -605,7 +606,8 @@ def localize_with_wheel(
             if not belief.consistent:
                 # nothing fits what was read since the segment's start: the wheel jammed where it read
                 # as rolling. Retrace the segment's poses back to its start (the jam unwinds as it
-                # was wound), and start afresh there, the other way; twice at the most
+                # was wound), and start afresh there, the other way (away from its last jump); twice at
+                # the most
                 if segment >= MAX_RESTARTS:
                     stopped = "blocked"
                     break
@@ -621,7 +623,9 @@ def localize_with_wheel(
                 turns.append(0.0)
                 truths.append(disc.truth())
                 segments.append(segment)
-                direction, reversals = -direction, reversals + 1
+                # away from the segment's last jump: a jam wedges the disc at a mouth it then jumps across,
+                # so the other way from there (not from the way it was going: it may have turned round)
+                direction, reversals = -(blocked[-1][0] if blocked else direction), reversals + 1
                 blocked = []
         if rotation >= pol.max_rotation:
             stopped = "max_rotation"

@@ -285,3 +285,14 @@ def test_cli_simulates_a_wheel_on_a_drawing_and_locates_its_trace_again(tmp_path
     assert main(["locate", out, "--part", bracket, "--json"]) == 0
     again = json.loads(capsys.readouterr().out)
     assert abs(again["estimate_arc"] - doc["estimate_arc"]) < 1e-6 and again["error_mm"] < 0.3
+
+
+def test_after_a_jam_the_wheel_starts_afresh_away_from_the_jump_that_followed_it():
+    """On the bracket's notch wall, 4 mm above where a 5 mm wheel wedges against the floor: the step into the
+    wedge reads as rolling on a concave arc, the next jumps and is undone, the wheel turns round, and nothing
+    fits. Starting afresh the way it had turned to (not away from where it was going) rolled it back into the
+    wedge twice, and the run ended "mismatch" (recorded at `paper` noise, seed 1)."""
+    part = load_part("parts/bracket.dxf")
+    run, err = localize(part, WheelJaw(5.0), 144.414, noise="paper", seed=1)
+    assert run.jumps >= 1 and max(run.segments) >= 1  # it wedged, and started afresh
+    assert run.stopped == "confident" and abs(err) < 0.3
