@@ -353,7 +353,7 @@ def calibrate_wheel(
     wheel: WheelJaw,
     approach_pose,
     *,
-    part: Part | None = None,
+    part: Part | Outline | None = None,
     length: float = CALIBRATION_LENGTH,
     policy: WheelPolicy = WheelPolicy(),
     pressing: PressSettings = PRESS,
@@ -376,15 +376,18 @@ def calibrate_wheel(
         The finger, its nominal radius the first guess.
     approach_pose : (x mm, y mm, φ rad)
         Clear of a smooth surface the wheel fits along ``length`` mm counter-clockwise.
-    part : Part, optional
-        The surface's model, to tell a jump from rolling (default: any curvature from −1/2r up).
+    part : Part or Outline, optional
+        The surface's model, to tell a jump from rolling (default: any curvature from −1/2r up); on a
+        drawing the convex corners it reaches are pivoted on.
     length : float, mm
         Axle travel; the radius's error falls as 1/length.
     """
     if not (math.isfinite(length) and length > 0):
         raise RigError(f"calibration length={length!r} mm must be a positive number")
     band = kappa_band(part, wheel) if part is not None else (-0.5 / wheel.radius, math.inf)
-    disc = _Wheel(rig, WheelCalibration.nominal(wheel), policy, pressing, band)
+    # a drawing's convex corner is pivoted on: path + δ·ΔΩ = r·(Δψ_e + Δφ) holds through it as well
+    pivot = corner_pivot(part, wheel) if part is not None else 0.0
+    disc = _Wheel(rig, WheelCalibration.nominal(wheel), policy, pressing, band, pivot)
     states = [disc.begin(approach_pose)]
     travelled = 0.0
     while travelled < length:
@@ -445,7 +448,7 @@ def check_calibration(calibration: Calibration | WheelCalibration, finger) -> No
         raise RigError(f"the calibration is for {jaw}, the finger is {finger}: calibrate this finger first")
 
 
-def wheel_calibration_arc(part: Part, wheel: WheelJaw, length: float = CALIBRATION_LENGTH) -> float:
+def wheel_calibration_arc(part: Part | Outline, wheel: WheelJaw, length: float = CALIBRATION_LENGTH) -> float:
     """Where to calibrate a wheel on the part itself (mm): within the longest stretch the wheel surely
     reaches, ``length`` mm of it centred (at least 2 mm from its ends), which :func:`calibrate_wheel`
     rolls along counter-clockwise.

@@ -296,3 +296,17 @@ def test_after_a_jam_the_wheel_starts_afresh_away_from_the_jump_that_followed_it
     run, err = localize(part, WheelJaw(5.0), 144.414, noise="paper", seed=1)
     assert run.jumps >= 1 and max(run.segments) >= 1  # it wedged, and started afresh
     assert run.stopped == "confident" and abs(err) < 0.3
+
+
+def test_a_calibration_across_a_drawings_convex_corner_finds_the_radius_and_rotation():
+    """The sums of the calibration hold through a pivot (path + δ·ΔΩ = r·(Δψ_e + Δφ)): 40 mm on the bracket
+    from its notch's floor up the wall the disc wedges against would jump, so from the left face over the
+    corner at the seam onto the bottom face, at `paper` noise."""
+    from driver.wheel import calibrate_wheel
+
+    part = load_part("parts/bracket.dxf")
+    wheel = WheelJaw(5.0)
+    rig = WheelRig(part, wheel, noise="paper", seed=2, true_radius=5.03, direction_zero=math.radians(1.5))
+    cal = calibrate_wheel(rig, wheel, rig.approach_pose(part.perimeter - 15.0), part=part, length=40.0)
+    assert cal.radius == pytest.approx(5.03, abs=0.003)
+    assert math.degrees(cal.direction_zero) == pytest.approx(1.5 - math.degrees(rig.noise.crosstalk), abs=0.03)
