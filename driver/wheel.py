@@ -14,9 +14,11 @@ wheel too. Each rolling step:
    part (the encoder reads relative to the hand; r the calibrated radius);
 4. checks the step: rolling on the part, the turn changes by κ times the arc rolled, κ within the
    curvatures of the stretches the wheel reaches (widened by half way to −1/r on the concave side,
-   where a disc jammed between two walls reads exactly −1/r, and by half on the convex side). Outside
-   that is the disc straddling a pocket it cannot enter, or jammed in one: a **jump**, undone (the hand
-   goes back to the step's start, the filter told) and the direction turned round;
+   where a disc jammed between two walls reads exactly −1/r, and by half on the convex side), and on a
+   drawing a turn the rolling way by up to the largest convex corner's jump the wheel reaches
+   (:func:`corner_pivot`: it pivots there, L standing still). Outside that is the disc straddling a
+   pocket or a concave corner it cannot enter, or jammed in one: a **jump**, undone (the hand goes back
+   to the step's start, the filter told) and the direction turned round;
 5. checks for **slip**: under pure rolling the commanded axle, pressed δ into the wrist, runs along
    the part's offset at r − δ, so its travel along the contact's tangent between two steps is
    L + (r − δ)·Ω of that step (along the tangent: the servo's force corrections move it along the
@@ -28,8 +30,9 @@ wheel too. Each rolling step:
 :func:`localize_with_wheel` rolls one way, turning round at a jump, and gives the readings to a
 :class:`localizer.WheelFilter` until it is sure (or the budget is spent). When nothing on the part fits
 what was read (a jam that reads as rolling in a concave arc of the wheel's own radius), it retraces
-its poses back to where that segment of rolling started and starts afresh there, the other way: away
-from the segment's last jump when it had one (a jam wedges the disc at a mouth it then jumps across).
+its poses back to where that segment of rolling started and starts afresh there: away from the
+segment's last jump when it had one (a jam wedges the disc at a mouth it then jumps across, so the way
+the wheel turned to after that jump), else the other way.
 """
 
 from __future__ import annotations
@@ -375,7 +378,8 @@ def calibrate_wheel(
     wheel : WheelJaw
         The finger, its nominal radius the first guess.
     approach_pose : (x mm, y mm, φ rad)
-        Clear of a smooth surface the wheel fits along ``length`` mm counter-clockwise.
+        Clear of a surface the wheel fits along ``length`` mm counter-clockwise (smooth, or with convex
+        corners when ``part`` is a drawing).
     part : Part or Outline, optional
         The surface's model, to tell a jump from rolling (default: any curvature from −1/2r up); on a
         drawing the convex corners it reaches are pivoted on.
@@ -609,8 +613,7 @@ def localize_with_wheel(
             if not belief.consistent:
                 # nothing fits what was read since the segment's start: the wheel jammed where it read
                 # as rolling. Retrace the segment's poses back to its start (the jam unwinds as it
-                # was wound), and start afresh there, the other way (away from its last jump); twice at
-                # the most
+                # was wound), and start afresh there, away from its last jump; twice at the most
                 if segment >= MAX_RESTARTS:
                     stopped = "blocked"
                     break
@@ -626,9 +629,10 @@ def localize_with_wheel(
                 turns.append(0.0)
                 truths.append(disc.truth())
                 segments.append(segment)
-                # away from the segment's last jump: a jam wedges the disc at a mouth it then jumps across,
-                # so the other way from there (not from the way it was going: it may have turned round)
-                direction, reversals = -(blocked[-1][0] if blocked else direction), reversals + 1
+                # away from the segment's last jump (a jam wedges the disc at a mouth it then jumps across):
+                # the way the wheel turned to after that jump, which it keeps; without a jump, the other way
+                if not blocked:
+                    direction, reversals = -direction, reversals + 1
                 blocked = []
         if rotation >= pol.max_rotation:
             stopped = "max_rotation"

@@ -46,9 +46,13 @@ centre circles the corner, the hand turns through the corner's jump and the rim 
 runs through the jump while L stands still (docs/wheel.md). Θ is then the drawing's unwrapped angle,
 which steps at the corner, and a reading whose contact under a start lies within
 :meth:`WheelFilter.corner_window` of a convex corner is compared with the nearest angle the model takes
-there, the whole jump included: any turn within the jump fits a wheel on that corner. Concave corners
-need no rule: a disc cannot reach into one (the reach's prior), it straddles it, which the rolling
-detects as a jump.
+there, the whole jump included: any turn within the jump fits a wheel on that corner. A disc cannot
+reach into a concave corner: it touches both faces r·tan(|jump|/2) before it and would jump across,
+which the rolling detects as a jump (beyond a degree or two) and undoes; a jump's evidence
+(:meth:`WheelFilter.jumped`) takes a concave corner for the end of where the wheel could have rolled on,
+however shallow (the reach's clearance would not). A start on a corner is taken on the face after it
+(the angle after the jump): a wheel pressed onto a vertex, the hand anywhere within its jump, is not
+modelled (pressing along a face's normal near a corner lands on the face).
 """
 
 from __future__ import annotations
@@ -186,6 +190,18 @@ class WheelFilter:
         if not touch.any():
             raise QueryError(f"a {wheel} touches {part.name} nowhere")
         self._ahead, self._behind = _free_runs(touch, self.h)
+        # a jump's evidence (jumped) also ends at a drawing's concave corners, sharp or shallow: the disc
+        # touches both faces r·tan(|jump|/2) before one and cannot roll on, which the reach's clearance
+        # (kept generous for a machined part) does not say of a shallow one
+        self._ahead_jump, self._behind_jump = self._ahead, self._behind
+        if isinstance(part, Outline):
+            concave = [c for c in part.corners if c.angle < 0]
+            for c in concave:
+                skip = wheel.radius * math.tan(min(0.5 * abs(c.angle), 0.5 * math.pi - 1e-9))
+                ahead = np.maximum(np.mod(c.arc - self.grid, P) - skip, 0.0)
+                behind = np.maximum(np.mod(self.grid - c.arc, P) - skip, 0.0)
+                self._ahead_jump = np.minimum(self._ahead_jump, ahead)
+                self._behind_jump = np.minimum(self._behind_jump, behind)
         # each reading used keeps three numbers a start and a row of the Cholesky factor: 24·n·k + 8·k² bytes
         # for k readings stay within MAX_ARRAY_BYTES (a 1000 mm part: 443 readings, 443 mm rolled at thin=1)
         b = 24.0 * n
@@ -194,7 +210,8 @@ class WheelFilter:
 
     # ------------------------------------------------------------ geometry
     def _theta(self, sigma: FloatArray) -> FloatArray:
-        """Unwrapped tangent angle Θ at unrolled arc positions (rad): continuous, Θ(σ + P) = Θ(σ) + 2π."""
+        """Unwrapped tangent angle Θ at unrolled arc positions (rad), Θ(σ + P) = Θ(σ) + 2π: continuous on a
+        spline part; on a drawing it steps at corners, taking the value after the jump there."""
         part = self.part
         sigma = np.asarray(sigma, dtype=float)
         if isinstance(part, Outline):
@@ -281,9 +298,10 @@ class WheelFilter:
 
     def corner_window(self, length: float) -> float:
         """How near a convex corner (mm) a start's contact after rolling ``length`` mm may be for the wheel
-        to be pivoting on it: three standard errors of L (the encoder's and the calibrated radius's) and
-        one grid step (the true start lies between two of the grid's)."""
-        return self.h + 3.0 * math.hypot(self.sd_length, float(length) * self.sd_scale)
+        to be pivoting on it: three standard errors of L (the encoder's and the calibrated radius's) under
+        the largest of :attr:`noise_scales` (the stated probability holds under it), and one grid step (the
+        true start lies between two of the grid's)."""
+        return self.h + 3.0 * max(self.noise_scales) * math.hypot(self.sd_length, float(length) * self.sd_scale)
 
     def predicted_turn(self, length: float, turn: float) -> FloatArray:
         """Each start's model turn (rad) after rolling ``length`` mm, the nearest to the reading ``turn`` (rad)
@@ -355,7 +373,7 @@ class WheelFilter:
             raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
         n = self.grid.size
         here = np.rint(self.part.wrap_arc(self.grid + self.current) / self.h).astype(np.int64) % n
-        free = (self._ahead if direction > 0 else self._behind)[here]
+        free = (self._ahead_jump if direction > 0 else self._behind_jump)[here]
         self._penalty += np.where(free > margin, math.log(BRIDGE_MISS), 0.0)
 
     # --------------------------------------------------------------- belief

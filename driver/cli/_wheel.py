@@ -98,7 +98,6 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
 
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
-    args.engine = args.engine or "pymunk"
     if not 0 <= args.start < part.perimeter:
         raise QueryError(f"--start {args.start} mm must be in [0, perimeter={part.perimeter:.3f}) mm")
     if not bool(wheel_reach_for(part, wheel).touchable(args.start)):

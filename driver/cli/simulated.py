@@ -75,8 +75,8 @@ def register(sub) -> None:
         "--engine",
         choices=("pymunk", "kinematic"),
         help="pymunk rigid-body world, or the kinematic (static-equilibrium) world (default pymunk; "
-        "kinematic for a DXF or SVG outline: both read a face and a corner alike there, and a reactive "
-        "roll on a drawing takes several times longer in pymunk)",
+        "kinematic for a DXF or SVG outline, with either finger: both read a face and a corner alike there, "
+        "and a reactive roll on a drawing takes several times longer in pymunk)",
     )
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     world = sim.add_mutually_exclusive_group()
@@ -143,10 +143,10 @@ def simulate_command(args) -> int:
 
     check_before_moving(args, {"out": (".npz",), "plot": PLOT_SUFFIXES})
     part = read_part(args)
-    if isinstance(args.jaw, WheelJaw):
-        return simulate_wheel(args, part, args.jaw)
     if args.engine is None:
         args.engine = "kinematic" if isinstance(part, Outline) else "pymunk"
+    if isinstance(args.jaw, WheelJaw):
+        return simulate_wheel(args, part, args.jaw)
     noise = load_noise(args.noise)
     if not args.roll and not args.reactive:
         raise UsageError("give the rolls (--roll DEG, repeated) or --reactive")

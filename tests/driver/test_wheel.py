@@ -295,6 +295,9 @@ def test_after_a_jam_the_wheel_starts_afresh_away_from_the_jump_that_followed_it
     part = load_part("parts/bracket.dxf")
     run, err = localize(part, WheelJaw(5.0), 144.414, noise="paper", seed=1)
     assert run.jumps >= 1 and max(run.segments) >= 1  # it wedged, and started afresh
+    segments, lengths = np.asarray(run.segments), np.asarray(run.lengths)
+    # the first segment jumped rolling counter-clockwise (down the wall); the second starts clockwise
+    assert lengths[segments == 0].max() > 3.0 and lengths[segments == 1][1] < 0.0
     assert run.stopped == "confident" and abs(err) < 0.3
 
 
@@ -310,3 +313,14 @@ def test_a_calibration_across_a_drawings_convex_corner_finds_the_radius_and_rota
     cal = calibrate_wheel(rig, wheel, rig.approach_pose(part.perimeter - 15.0), part=part, length=40.0)
     assert cal.radius == pytest.approx(5.03, abs=0.003)
     assert math.degrees(cal.direction_zero) == pytest.approx(1.5 - math.degrees(rig.noise.crosstalk), abs=0.03)
+
+
+def test_a_wheel_that_jumps_both_ways_at_one_place_stops_blocked_unsure():
+    """A slot 0.2 mm wider than a 5 mm wheel: on its floor the disc touches a wall whichever way it rolls."""
+    from localizer import Line, outline_from_pieces
+
+    v = [(0, 0), (80, 0), (80, 40), (45.1, 40), (45.1, 32), (34.9, 32), (34.9, 40), (0, 40)]
+    slot = outline_from_pieces([Line(v[i], v[(i + 1) % len(v)]) for i in range(len(v))], name="slot")
+    run, err = localize(slot, WheelJaw(5.0), 168.0)  # the floor's middle
+    assert run.stopped == "blocked" and run.jumps == 2 and run.reversals == 1 and run.arc < 0.5
+    assert not run.belief.sure(0.95) and abs(err) < 0.3
