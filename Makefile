@@ -36,7 +36,7 @@ test: $(STAMP)
 
 # Regression runs against the committed baseline (bench/baseline/<machine>/0001_baseline.json), on
 # the fastest round of each benchmark. BENCH_FAIL is the allowed slow-down: this 2-core machine's
-# own spread between back-to-back runs reached 58% (README, "Benchmark regressions in a pull request").
+# own spread between back-to-back runs reached 58% (docs/contributing.md, "Benchmark regressions").
 BENCH_STORE := file://bench/baseline
 BENCH_OPTS  := --benchmark-only --benchmark-max-time=2 -p no:cacheprovider
 BENCH_FAIL  ?= min:75%

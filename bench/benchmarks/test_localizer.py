@@ -54,7 +54,7 @@ def _run(part, queries):
 
 
 def test_exact_query_vs_perimeter_integration(benchmark, part, queries):
-    # rounds spread over a second or more: the machine's speed drifts over seconds (README)
+    # rounds spread over a second or more: the machine's speed drifts over seconds (docs/contributing.md)
     results = benchmark.pedantic(_run, args=(part, queries), rounds=200, iterations=1, warmup_rounds=2)
     for (s0, L, w), segs in zip(queries, results):  # completeness: the truth is always found, exactly
         assert np.abs(part.arc_offset([s.start_arc for s in segs], s0)).min() < 1e-6

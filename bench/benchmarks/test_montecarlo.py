@@ -2,7 +2,7 @@
 
 Run: ``pytest bench --benchmark-only`` (figures in ``--benchmark-json``). The trial rate repeats one
 trial (the same seed each round, so that its fastest round is comparable between runs). The
-speed-up of 2 workers runs a 32-trial study with warm caches (README has the figures); below 1.2 the
+speed-up of 2 workers runs a 32-trial study with warm caches (docs/studies.md has the figures); below 1.2 the
 pool has stopped sharing the work.
 """
 

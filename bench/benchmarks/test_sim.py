@@ -55,7 +55,7 @@ def test_rolling_step(benchmark, part, calibration, engine):
     def one_step():
         return roll(rig, hand, base, calibration, STEP, step=STEP, offset=1.0)
 
-    # rounds spread over a second or two: the machine's speed drifts over seconds (README)
+    # rounds spread over a second or two: the machine's speed drifts over seconds (docs/contributing.md)
     r = benchmark.pedantic(one_step, rounds=600 if engine == "kinematic" else 60, iterations=1, warmup_rounds=2)
     assert r.length > 0
     if not benchmark.disabled:
