@@ -20,7 +20,8 @@ from localizer import Belief, Outline, Part, WheelFilter, WheelJaw, parse_jaw
 
 from .rig import RigError
 from .trace import read_archive
-from .wheel import WheelCalibration, WheelRun
+from .wheel import WheelRun
+from .wheel_disc import WheelCalibration
 
 __all__ = ["WheelTrace", "WHEEL_COLUMNS", "WHEEL_FORMAT"]
 

@@ -11,7 +11,7 @@ from localizer import SUCCESS_RADIUS, QueryError, WheelJaw, wheel_reach_for
 
 from ..part_match import check_same_part, part_record
 from ..rig import RigError
-from ..wheel import wheel_calibration_arc
+from ..wheel_calibration import wheel_calibration_arc
 from ._options import UsageError, pressing
 from ._output import (
     CONNECTING,
@@ -38,7 +38,7 @@ __all__ = [
 
 def wheel_policy(args):
     """The wheel's rolling from the reactive options (``--confidence``, ``--max-rotation``)."""
-    from ..wheel import WheelPolicy
+    from ..wheel_disc import WheelPolicy
 
     return WheelPolicy(confidence=args.confidence, max_rotation=math.radians(args.max_rotation))
 
@@ -93,7 +93,8 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     """'simulate --jaw wheel:MM --reactive': calibrate a simulated wheel, roll it from --start, save the trace."""
     from sim2d import WheelRig, load_noise
 
-    from ..wheel import calibrate_wheel, localize_with_wheel
+    from ..wheel import localize_with_wheel
+    from ..wheel_calibration import calibrate_wheel
     from ..wheel_trace import WheelTrace
 
     if not args.reactive:
@@ -145,7 +146,7 @@ def wheel_rig(part, wheel: WheelJaw, args):
 def calibrate_wheel_here(rig, wheel: WheelJaw):
     """'calibrate --jaw wheel:MM': roll 40 mm from the present pose (the hand's axis facing a smooth surface
     the wheel fits, clear of it) and measure the radius and the channels' rotation."""
-    from ..wheel import calibrate_wheel
+    from ..wheel_calibration import calibrate_wheel
 
     return calibrate_wheel(rig, wheel, tuple(rig.pose()))
 
@@ -154,7 +155,9 @@ def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
     """'run --jaw wheel:MM --reactive': from the present pose (the hand's axis facing the part, clear of it),
     calibrate there unless a calibration is given, then roll until sure."""
     from ..serial_rig import SerialRig
-    from ..wheel import WheelCalibration, calibrate_wheel, localize_with_wheel
+    from ..wheel import localize_with_wheel
+    from ..wheel_calibration import calibrate_wheel
+    from ..wheel_disc import WheelCalibration
 
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")

@@ -140,7 +140,7 @@ def run_command(args) -> int:
     from driver.runlog import RunLog
     from driver.serial_rig import SerialRig
     from driver.trace import Trace
-    from driver.wheel import check_calibration, load_calibration
+    from driver.wheel_calibration import check_calibration, load_calibration
 
     check_before_moving(args, {"plot": PLOT_SUFFIXES, "log": ()})
     part = read_part(args)
