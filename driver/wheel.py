@@ -77,8 +77,9 @@ class WheelRun:
         Arc rolled, both ways counted.
     steps : int
     stopped : str
-        "confident", "max_rotation", "max_arc", "blocked" (jumps both ways at one place, or again where the
-        wheel jumped the same way before: enclosed) or "mismatch" (a stretch of the readings fits no probable
+        "confident" (the final belief sure, whatever ended the rolling), "max_rotation", "max_arc", "blocked"
+        (jumps both ways at one place, or again where the wheel jumped the same way before: enclosed) or
+        "mismatch" (a stretch of the readings fits no probable
         place, or nothing fits after :data:`MAX_RESTARTS` fresh starts: the part is not its model,
         ``belief.mismatch`` says where when it can); slip beyond the policy's limit raises
         :class:`WheelSlip` instead.
@@ -250,8 +251,10 @@ def localize_with_wheel(
             stopped = "max_arc"
             break
     final = flt.belief()
-    if stopped in ("max_rotation", "max_arc") and final.sure(pol.confidence):
-        stopped = "confident"  # the budget ran out between two checks, and the readings since made it sure
+    if stopped in ("max_rotation", "max_arc", "blocked") and final.sure(pol.confidence):
+        # the budget ran out between two checks, or the wheel could roll no further, and the readings since
+        # the last check made it sure
+        stopped = "confident"
     if stopped != "confident" and (final.mismatch is not None or not final.consistent):
         stopped = "mismatch"
     return WheelRun(

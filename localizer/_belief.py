@@ -11,7 +11,7 @@ import numpy as np
 from ._limits import check_grid
 from ._types import FloatArray
 
-__all__ = ["Belief", "Mode", "find_modes", "belief_flags"]
+__all__ = ["Belief", "Mode", "find_modes", "belief_flags", "flat_top", "FLAT_TOP"]
 
 
 @dataclass(frozen=True)
@@ -125,6 +125,27 @@ def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray
         out.append(Mode(arc=float(present[top]), mass=float(mass[bins].sum()), start_arc=float(starts[top])))
     out.sort(key=lambda m: -m.mass)
     return out
+
+
+#: Weights within this fraction of the most probable one are as probable: a flat top, whose middle is
+#: the estimate (:func:`flat_top`).
+FLAT_TOP = 1e-3
+
+
+def flat_top(w: FloatArray) -> int:
+    """The index of the most probable point of a circular grid of weights ``w`` or, where the weights
+    around it are as high within :data:`FLAT_TOP` (the readings place the contact anywhere along a
+    stretch, as between two jumps of a wheel), the middle of that flat top: not its first point, which
+    would be as far from the truth as the top is long."""
+    n = w.size
+    i = int(np.argmax(w))
+    floor = float(w[i]) * (1.0 - FLAT_TOP)
+    left = right = 0
+    while left < n - 1 and w[(i - left - 1) % n] >= floor:
+        left += 1
+    while right < n - 1 - left and w[(i + right + 1) % n] >= floor:
+        right += 1
+    return (i + (right - left) // 2) % n
 
 
 def belief_flags(

@@ -64,7 +64,7 @@ from scipy.linalg import solve_triangular
 from scipy.stats import chi2
 from scipy.stats import f as f_dist
 
-from ._belief import Belief, belief_flags, find_modes
+from ._belief import Belief, belief_flags, find_modes, flat_top
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
@@ -414,7 +414,7 @@ class WheelFilter:
         radius = self.radius if radius is None else float(radius)
         present = self.present()
         w = self.posterior()
-        i = int(np.argmax(w))
+        i = flat_top(w)
         map_arc = float(present[i])
         mass = 1.0
         for f in self.noise_scales:
