@@ -54,7 +54,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from localizer import ROLL_STEP, UNEXPLAINED, Belief, Boundary, ContactFilter, arc_from_jaw_positions
+from localizer import CONFIDENCE, ROLL_STEP, UNEXPLAINED, Belief, Boundary, ContactFilter, arc_from_jaw_positions
 
 from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
 from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
@@ -71,8 +71,6 @@ __all__ = [
 
 #: Checks in a row at which the belief must reach the confidence before the rolling stops (step 3).
 CONFIRM = 1
-#: Probability within the success radius that stops the rolling.
-CONFIDENCE = 0.95
 #: How many times a run rolls through such a jump to leave what the jaw sat on (module notes, rule 8):
 #: once, off the thing under the start; a second would be a real concavity the belief misjudged.
 MAX_LEAVES = 1

@@ -18,6 +18,7 @@ from ._contact_filter import (
 )
 from ._defaults import (
     CALIBRATION_SCALE_SD,
+    CONFIDENCE,
     FIT_ALPHA,
     LENGTH_TOL,
     MIN_SEPARATION,
@@ -82,6 +83,7 @@ __all__ = [
     "TURN_TOL",
     "MIN_SEPARATION",
     "SUCCESS_RADIUS",
+    "CONFIDENCE",
     "ROLL_STEP",
     "FIT_ALPHA",
     "PART_SCALE_SD",

@@ -191,7 +191,7 @@ from scipy.stats import f as f_dist
 
 from ._belief import Belief, Mode, belief_flags, find_modes
 from ._boundary import Boundary
-from ._defaults import CALIBRATION_SCALE_SD, FIT_ALPHA, PART_SCALE_SD, SUCCESS_RADIUS
+from ._defaults import CALIBRATION_SCALE_SD, CONFIDENCE, FIT_ALPHA, PART_SCALE_SD, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._filter_kernels import add_row, weigh_scales
 from ._limits import check_grid
@@ -459,7 +459,7 @@ class ContactFilter:
         shape_spacing: float = 5.0,
         radius: float = SUCCESS_RADIUS,
         mode_floor: float = 0.05,
-        confidence: float = 0.95,
+        confidence: float = CONFIDENCE,
         prune: float = 40.0,
         refresh: int = 5,
         jaw: StraightJaw = DEFAULT_JAW,

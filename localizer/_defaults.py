@@ -12,6 +12,7 @@ __all__ = [
     "TURN_TOL",
     "MIN_SEPARATION",
     "SUCCESS_RADIUS",
+    "CONFIDENCE",
     "ROLL_STEP",
     "FIT_ALPHA",
     "PART_SCALE_SD",
@@ -26,6 +27,9 @@ TURN_TOL = 0.0004
 MIN_SEPARATION = 0.5
 #: A localization is a success when its estimate is within this of the true contact, mm.
 SUCCESS_RADIUS = 0.3
+#: A belief is sure when its probability within the success radius reaches this: the sequential filters'
+#: and the two-roll rules' default, and the rolling's stop.
+CONFIDENCE = 0.95
 #: The arm's rolling step, rad (0.2°).
 ROLL_STEP = math.radians(0.2)
 #: Readings whose best fit is this improbable under the noise model fit no place on the part: the

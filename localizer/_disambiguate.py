@@ -34,7 +34,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2
 
 from ._boundary import Boundary
-from ._defaults import FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, TURN_TOL
+from ._defaults import CONFIDENCE, FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, TURN_TOL
 from ._errors import QueryError
 from ._outline import Outline
 from ._outline_chain import chain_likelihood, chain_paper
@@ -370,7 +370,7 @@ def localize(
     length_tol: float = LENGTH_TOL,
     turn_tol: float = TURN_TOL,
     min_separation: float = MIN_SEPARATION,
-    confidence: float = 0.95,
+    confidence: float = CONFIDENCE,
 ) -> Localization:
     """Localize the jaw from a chain of consecutive rolls.
 

@@ -66,7 +66,7 @@ from scipy.stats import f as f_dist
 
 from ._belief import Belief, belief_flags, find_modes, flat_top
 from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
-from ._defaults import FIT_ALPHA, SUCCESS_RADIUS
+from ._defaults import CONFIDENCE, FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._limits import MAX_ARRAY_BYTES, _bytes, check_grid
 from ._outline import Corner, Outline
@@ -154,7 +154,7 @@ class WheelFilter:
         sd_scale: float = 2e-4,
         thin: float = 1.0,
         radius: float = SUCCESS_RADIUS,
-        confidence: float = 0.95,
+        confidence: float = CONFIDENCE,
         mode_floor: float = 0.05,
         noise_scales: tuple[float, ...] = WHEEL_NOISE_SCALES,
     ) -> None:
