@@ -22,6 +22,7 @@ demo: $(STAMP)
 	$(VENV)/bin/rolltouch locate out/demo.npz --part parts/trefoil.json
 	$(VENV)/bin/rolltouch simulate parts/bracket.dxf --start 75 --reactive --noise paper --seed 2 --out out/demo-cad.npz --plot out/demo-cad.png
 	$(VENV)/bin/rolltouch simulate parts/kidney.csv --jaw wheel:5 --start 66 --reactive --noise paper --seed 2 --out out/demo-wheel.npz --plot out/demo-wheel.png
+	$(VENV)/bin/rolltouch simulate parts/bracket.dxf --jaw wheel:5 --start 163 --reactive --noise paper --seed 2 --out out/demo-wheel-cad.npz --plot out/demo-wheel-cad.png
 	@# a burr where the jaw rolls: the run ends MODEL MISMATCH, exit status 2 (expected here)
 	$(VENV)/bin/rolltouch simulate parts/kidney.csv --start 40 --reactive --world parts/burr.toml --noise paper --seed 1 --engine kinematic --out out/demo-burr.npz --plot out/demo-burr.png; test $$? -eq 2
 
