@@ -36,10 +36,9 @@ power :data:`~localizer.TEMPER`, and a stated probability is the least over ``no
 covariance times each factor squared), so that readings noisier than the filter was told lower it
 instead of making it confidently wrong. And a belief is only stated when some start fits at all: when
 the best start's residuals are beyond the χ² test at :data:`~localizer.FIT_ALPHA` even under
-:data:`WHEEL_FIT_SCALE` times the error model, nothing fits (the held-out family's star held a 5 mm
-wheel jammed between two walls, which reads exactly as rolling in a concave arc of the wheel's own
-radius; the filter, normalising, stated 0.999 at a start that fitted as badly as the truth), and the
-belief's mass is 0, ``consistent`` False.
+:data:`WHEEL_FIT_SCALE` times the error model, nothing fits (a wheel jammed between two walls reads
+exactly as rolling in a concave arc of its own radius, docs/wheel.md), and the belief's mass is 0,
+``consistent`` False.
 
 On a drawing (:class:`~localizer.Outline`) the wheel pivots on each convex corner it reaches: its
 centre circles the corner, the hand turns through the corner's jump and the rim does not roll, so Ω
@@ -69,11 +68,12 @@ from ._contact_filter import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._defaults import CONFIDENCE, FIT_ALPHA, SUCCESS_RADIUS
 from ._errors import QueryError
 from ._limits import MAX_ARRAY_BYTES, _bytes, check_grid
-from ._outline import Corner, Outline
+from ._outline import Outline
 from ._part import Part
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 from ._types import BoolArray, FloatArray
 from ._wheel import WheelJaw, wheel_reach_for
+from ._wheel_rolling import free_runs, jump_runs, pivot_turn, unwrapped_angle
 
 __all__ = [
     "WheelFilter",
@@ -181,27 +181,13 @@ class WheelFilter:
         self.h = P / n
         self.grid: FloatArray = np.arange(n, dtype=float) * self.h
         self._theta0 = self._theta(self.grid)
-        convex: list[Corner] = [c for c in part.corners if c.angle > 0] if isinstance(part, Outline) else []
-        self._convex: FloatArray = np.array([c.arc for c in convex], dtype=np.float64)
-        self._jumps: FloatArray = np.array([c.angle for c in convex], dtype=np.float64)
         reach = wheel_reach_for(part, wheel)
         touch = reach.touchable(self.grid)
         self.prior: FloatArray = np.asarray(touch, dtype=float)
         if not touch.any():
             raise QueryError(f"a {wheel} touches {part.name} nowhere")
-        self._ahead, self._behind = _free_runs(touch, self.h)
-        # a jump's evidence (jumped) also ends at a drawing's concave corners, sharp or shallow: the disc
-        # touches both faces r·tan(|jump|/2) before one and cannot roll on, which the reach's clearance
-        # (kept generous for a machined part) does not say of a shallow one
-        self._ahead_jump, self._behind_jump = self._ahead, self._behind
-        if isinstance(part, Outline):
-            concave = [c for c in part.corners if c.angle < 0]
-            for c in concave:
-                skip = wheel.radius * math.tan(min(0.5 * abs(c.angle), 0.5 * math.pi - 1e-9))
-                ahead = np.maximum(np.mod(c.arc - self.grid, P) - skip, 0.0)
-                behind = np.maximum(np.mod(self.grid - c.arc, P) - skip, 0.0)
-                self._ahead_jump = np.minimum(self._ahead_jump, ahead)
-                self._behind_jump = np.minimum(self._behind_jump, behind)
+        self._ahead, self._behind = free_runs(touch, self.h)
+        self._ahead_jump, self._behind_jump = jump_runs(part, wheel, self.grid, self._ahead, self._behind)
         # each reading used keeps three numbers a start and a row of the Cholesky factor: 24·n·k + 8·k² bytes
         # for k readings stay within MAX_ARRAY_BYTES (a 1000 mm part: 443 readings, 443 mm rolled at thin=1)
         b = 24.0 * n
@@ -210,17 +196,8 @@ class WheelFilter:
 
     # ------------------------------------------------------------ geometry
     def _theta(self, sigma: FloatArray) -> FloatArray:
-        """Unwrapped tangent angle Θ at unrolled arc positions (rad), Θ(σ + P) = Θ(σ) + 2π: continuous on a
-        spline part; on a drawing it steps at corners, taking the value after the jump there."""
-        part = self.part
-        sigma = np.asarray(sigma, dtype=float)
-        if isinstance(part, Outline):
-            unwrapped: FloatArray = part.tangent_angle_at_arc(sigma)
-            return unwrapped
-        laps = np.floor(sigma / part.perimeter)
-        t = part.param_at_arc(sigma - laps * part.perimeter)
-        out: FloatArray = part.tangent_angle(t) + 2 * math.pi * laps
-        return out
+        """Unwrapped tangent angle Θ at unrolled arc positions (rad): :func:`unwrapped_angle`."""
+        return unwrapped_angle(self.part, sigma)
 
     # ------------------------------------------------------------- readings
     def reset(self) -> None:
@@ -309,26 +286,7 @@ class WheelFilter:
         between the model's there and across the corner's jump (the wheel pivoting on it)."""
         x = self.grid + float(length)
         model = self._theta(x) - self._theta0
-        if self._convex.size == 0:
-            return model
-        P = float(self.part.perimeter)
-        c = self._convex
-        xs = np.mod(x, P)
-        # the nearest convex corner either way, through the seam
-        ext = np.concatenate([c - P, c, c + P])
-        j = np.clip(np.searchsorted(ext, xs), 1, ext.size - 1)
-        j = np.where(xs - ext[j - 1] <= ext[j] - xs, j - 1, j)
-        d = xs - ext[j]
-        near = np.abs(d) <= self.corner_window(length)
-        if not near.any():
-            return model
-        i = np.flatnonzero(near)
-        after = self._theta(x[i] - d[i]) - self._theta0[i]  # Θ just past the corner, on the start's lap
-        before = after - self._jumps[j[i] % c.size]
-        lo, hi = np.minimum(model[i], before), np.maximum(model[i], after)
-        out = model.copy()
-        out[i] = np.clip(float(turn), lo, hi)
-        return out
+        return pivot_turn(self.part, x, self._theta0, model, float(turn), self.corner_window(length))
 
     def update(self, length: float, turn: float) -> None:
         """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
@@ -538,20 +496,3 @@ class WheelFilter:
             return True
         best = float(np.min(np.where(self.prior > 0, self._quad, np.inf)))
         return bool(chi2.sf(best / WHEEL_FIT_SCALE**2, k) >= FIT_ALPHA)
-
-
-def _free_runs(touch: np.ndarray, h: float) -> tuple[FloatArray, FloatArray]:
-    """For each grid point, the arc (mm) ahead and behind before the first untouchable point (inf when
-    the whole boundary is touchable)."""
-    n = touch.size
-    bad = np.flatnonzero(~touch)
-    if bad.size == 0:
-        inf = np.full(n, np.inf)
-        return inf, inf.copy()
-    idx = np.arange(n)
-    ext = np.concatenate([bad - n, bad, bad + n])
-    nxt = ext[np.searchsorted(ext, idx, side="left")]
-    prv = ext[np.searchsorted(ext, idx, side="right") - 1]
-    ahead = np.where(touch, (nxt - idx - 1) * h, -1.0)
-    behind = np.where(touch, (idx - prv - 1) * h, -1.0)
-    return ahead, behind

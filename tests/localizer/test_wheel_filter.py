@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import multivariate_normal
 
 from localizer import QueryError, WheelFilter, WheelJaw, load_part, part_from_points
-from localizer._wheel_filter import _free_runs
+from localizer._wheel_rolling import free_runs
 
 from .test_wheel import peanut
 
@@ -93,10 +93,10 @@ def test_a_start_whose_roll_runs_over_what_the_wheel_cannot_touch_is_unlikely_no
 
 def test_free_runs_count_the_arc_to_the_next_untouchable_point_both_ways():
     touch = np.array([True, True, False, True, True, True, False, True])
-    ahead, behind = _free_runs(touch, 0.5)
+    ahead, behind = free_runs(touch, 0.5)
     assert ahead.tolist() == [0.5, 0.0, -1.0, 1.0, 0.5, 0.0, -1.0, 1.0]
     assert behind.tolist() == [0.5, 1.0, -1.0, 0.0, 0.5, 1.0, -1.0, 0.0]
-    assert np.isinf(_free_runs(np.ones(5, bool), 1.0)[0]).all()
+    assert np.isinf(free_runs(np.ones(5, bool), 1.0)[0]).all()
 
 
 def test_a_jump_makes_the_starts_that_could_have_rolled_on_unlikely():
