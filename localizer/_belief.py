@@ -40,7 +40,8 @@ class Belief:
     Attributes
     ----------
     map_arc : float, mm
-        The most probable present contact.
+        The estimate of the present contact: the most probable one (the wheel's filter: the middle of a
+        flat top, :func:`flat_top`).
     mass : float
         Probability that the contact is within ``radius`` of ``map_arc``.
     radius : float, mm
@@ -133,12 +134,15 @@ FLAT_TOP = 1e-3
 
 
 def flat_top(w: FloatArray) -> int:
-    """The index of the most probable point of a circular grid of weights ``w`` or, where the weights
-    around it are as high within :data:`FLAT_TOP` (the readings place the contact anywhere along a
-    stretch, as between two jumps of a wheel), the middle of that flat top: not its first point, which
-    would be as far from the truth as the top is long."""
+    """The index of the most probable point of a circular grid of non-negative weights ``w`` or, where
+    the weights around it are as high within :data:`FLAT_TOP` (the readings place the contact anywhere
+    along a stretch, as between two jumps of a wheel), the middle of that flat top: not its first point,
+    which would be as far from the truth as the top is long. Where the largest weight is not positive
+    and finite, its index (no top to speak of)."""
     n = w.size
     i = int(np.argmax(w))
+    if not (math.isfinite(float(w[i])) and w[i] > 0):
+        return i
     floor = float(w[i]) * (1.0 - FLAT_TOP)
     left = right = 0
     while left < n - 1 and w[(i - left - 1) % n] >= floor:

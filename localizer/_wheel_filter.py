@@ -118,7 +118,7 @@ class WheelFilter:
     thin : float, mm
         Arc between two readings the likelihood uses.
     radius : float, mm
-        A belief's mass is taken within this of its most probable contact.
+        A belief's mass is taken within this of its estimate (:func:`~localizer._belief.flat_top`).
     confidence, mode_floor : float
         A belief is ambiguous when two or more modes hold ``mode_floor`` each and the first does not
         reach ``confidence``.
@@ -367,7 +367,7 @@ class WheelFilter:
         Parameters
         ----------
         radius : float, optional, mm
-            The mass is taken within this of the most probable contact (default: the filter's).
+            The mass is taken within this of the estimate (default: the filter's).
         """
         radius = self.radius if radius is None else float(radius)
         present = self.present()

@@ -33,3 +33,10 @@ def test_a_single_peak_is_its_own_estimate():
     w = np.full(50, 0.01)
     w[17], w[18] = 1.0, 0.9
     assert flat_top(w) == 17
+
+
+def test_weights_without_a_positive_top_give_the_argmax():
+    assert flat_top(np.zeros(10)) == 0
+    w = np.zeros(10)
+    w[3] = np.nan
+    assert flat_top(w) == 3
