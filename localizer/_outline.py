@@ -26,7 +26,7 @@ from ._part import _segments_cross
 from ._pieces import CircularArc, CubicBezier, Line, Piece
 from ._types import ArrayLike, FloatArray
 
-__all__ = ["Outline", "Corner", "outline_from_pieces"]
+__all__ = ["Outline", "Corner", "outline_from_pieces", "nearest_corner"]
 
 #: Two pieces meet when the end of one is this close to the start of the next, mm.
 JOIN_TOL = 1e-6
@@ -199,15 +199,12 @@ class Outline(ArcPositions):
         corner = np.full(ss.shape, -1, dtype=np.int64)
         if self.corners:
             arcs = self._corner_arcs
-            # each corner, and the last one a lap before and the first a lap after: a sum of arcs that should
-            # land on a corner lands within rounding of it on either side, through the seam as well
-            near = np.concatenate([[arcs[-1] - P], arcs, [arcs[0] + P]])
-            j = np.clip(np.searchsorted(near, ss), 1, near.size - 1)
-            j = np.where(ss - near[j - 1] <= near[j] - ss, j - 1, j)
-            at = np.abs(ss - near[j]) <= AT_CORNER * max(1.0, P)
-            index = (j - 1) % arcs.size
+            # a sum of arcs that should land on a corner lands within rounding of it on either side, through
+            # the seam as well
+            index, off, shift = nearest_corner(arcs, P, ss)
+            at = np.abs(off) <= AT_CORNER * max(1.0, P)
             corner = np.where(at, index, -1)
-            lap = np.where(at & (j == near.size - 1), lap + 1.0, np.where(at & (j == 0), lap - 1.0, lap))
+            lap = np.where(at, lap + shift, lap)
             ss = np.where(at, arcs[index], ss)
         k = np.clip(np.searchsorted(self.starts, ss, side="right") - 1, 0, len(self.pieces) - 1)
         local: FloatArray = ss - self.starts[k]
@@ -296,6 +293,17 @@ class Outline(ArcPositions):
         assert poly is not None
         out: FloatArray = np.vstack([poly, poly[:1]])
         return out
+
+
+def nearest_corner(arcs: FloatArray, period: float, x: FloatArray) -> tuple[np.ndarray, FloatArray, np.ndarray]:
+    """For arc positions ``x`` in [0, ``period``) (mm), the nearest of the sorted corner arcs ``arcs`` (mm)
+    either way, through the seam: its index, the signed offset ``x`` − it (mm), and the lap it lies in
+    relative to ``x`` (−1: the last corner a lap before, +1: the first a lap after, else 0)."""
+    near = np.concatenate([[arcs[-1] - period], arcs, [arcs[0] + period]])
+    j = np.clip(np.searchsorted(near, x), 1, near.size - 1)
+    j = np.where(x - near[j - 1] <= near[j] - x, j - 1, j)
+    offset: FloatArray = x - near[j]
+    return (j - 1) % arcs.size, offset, np.where(j == 0, -1, np.where(j == near.size - 1, 1, 0))
 
 
 def _wrap_scalar(a: float) -> float:

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from ._boundary import Boundary
-from ._outline import Outline
+from ._outline import Outline, nearest_corner
 from ._types import FloatArray
 from ._wheel import WheelJaw
 
@@ -44,20 +44,13 @@ def pivot_turn(
     corners = [c for c in part.corners if c.angle > 0] if isinstance(part, Outline) else []
     if not corners:
         return model
-    P = float(part.perimeter)
-    c = np.array([k.arc for k in corners])
-    xs = np.mod(x, P)
-    # the nearest convex corner either way, through the seam
-    ext = np.concatenate([c - P, c, c + P])
-    j = np.clip(np.searchsorted(ext, xs), 1, ext.size - 1)
-    j = np.where(xs - ext[j - 1] <= ext[j] - xs, j - 1, j)
-    d = xs - ext[j]
+    j, d, _ = nearest_corner(np.array([k.arc for k in corners]), float(part.perimeter), np.mod(x, part.perimeter))
     near = np.abs(d) <= window
     if not near.any():
         return model
     i = np.flatnonzero(near)
     after = unwrapped_angle(part, x[i] - d[i]) - theta0[i]  # Θ just past the corner, on the start's lap
-    before = after - np.array([k.angle for k in corners])[j[i] % c.size]
+    before = after - np.array([k.angle for k in corners])[j[i]]
     lo, hi = np.minimum(model[i], before), np.maximum(model[i], after)
     out = model.copy()
     out[i] = np.clip(turn, lo, hi)
