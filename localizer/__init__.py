@@ -1,21 +1,11 @@
-"""Pure geometry and estimation for localization by rolling (numpy and scipy only)."""
+"""Pure geometry and estimation for localization by rolling.
 
-from ._belief import Belief, Mode
-from ._bound import TrialNoise, roll_bound, trial_bound
-from ._boundary import Boundary
-from ._cad import CAD_SUFFIXES, load_outline
-from ._contact_filter import (
-    BRIDGE_MISS,
-    CONTRADICTION,
-    ENCODER_SD,
-    LOOKALIKE_RADIUS,
-    LOOKALIKE_SLOPE,
-    NOISE_SCALES,
-    SCALE_SD,
-    SLOPE_ENVELOPE,
-    TEMPER,
-    ContactFilter,
-)
+numpy and scipy, with numba for the compiled kernels and ezdxf and svgelements to read drawings;
+nothing here moves a robot, simulates a world or draws. The subpackages, from the ground up:
+:mod:`~localizer.geometry`, :mod:`~localizer.solve`, :mod:`~localizer.chain`,
+:mod:`~localizer.contact` and :mod:`~localizer.filters`.
+"""
+
 from ._defaults import (
     CALIBRATION_SCALE_SD,
     CONFIDENCE,
@@ -27,41 +17,96 @@ from ._defaults import (
     SUCCESS_RADIUS,
     TURN_TOL,
 )
-from ._disambiguate import RULES, Candidate, Localization, localize
 from ._errors import LocalizerError, PartError, QueryError, RolltouchError
-from ._facets import FACETS, FacetRule, read_facets
-from ._files import load_part
-from ._fingerprint import QUANTUM_MM, fingerprint
-from ._limits import (
-    MAX_ARRAY_BYTES,
-    MAX_GRID_POINTS,
-    MAX_PAIRWISE_POINTS,
-    MAX_PART_BYTES,
-    MAX_PIECES,
-    check_grid,
-    check_size,
-    read_toml,
+from .chain import RULES, Candidate, Localization, localize
+from .contact import (
+    BRIDGE_EXCESS,
+    DEFAULT_JAW,
+    PIVOT_KAPPA,
+    Finger,
+    ModeTracks,
+    Reach,
+    StraightJaw,
+    WheelJaw,
+    WheelReach,
+    arc_from_jaw_positions,
+    calibration_arc,
+    parse_jaw,
+    reach_for,
+    tracks_for,
+    wheel_reach_for,
 )
-from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
-from ._outline import Corner, Outline, outline_from_pieces
-from ._outline_solver import outline_segments
-from ._part import UNITS_TO_MM, Part, part_from_points, polygon_crossing
-from ._particle_filter import ParticleFilter
-from ._pieces import CircularArc, CubicBezier, Line, elliptical_arc
-from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
-from ._rolling import arc_from_jaw_positions
-from ._segment import DIRECTIONS, Segment
-from ._solver import EXACT, METHODS, ExactOptions, feasible_segments
-from ._stretches import DEFECT_WINDOW, UNEXPLAINED, Misfit
-from ._tracks import BRIDGE_EXCESS, PIVOT_KAPPA, ModeTracks, tracks_for
-from ._wheel import Finger, WheelJaw, WheelReach, parse_jaw, wheel_reach_for
-from ._wheel_filter import (
+from .filters import (
+    BRIDGE_MISS,
+    CONTRADICTION,
+    DEFECT_WINDOW,
+    ENCODER_SD,
+    LOOKALIKE_RADIUS,
+    LOOKALIKE_SLOPE,
+    NOISE_SCALES,
+    SCALE_SD,
+    SLOPE_ENVELOPE,
+    TEMPER,
+    UNEXPLAINED,
     WHEEL_FIT_SCALE,
     WHEEL_NOISE_SCALES,
     WHEEL_SD_SLOPE,
     WHEEL_SD_TURN,
     WHEEL_SLOPE_LENGTH,
+    Belief,
+    ContactFilter,
+    Misfit,
+    Mode,
+    ParticleFilter,
     WheelFilter,
+)
+from .geometry import (
+    CAD_SUFFIXES,
+    FACETS,
+    MAX_ARRAY_BYTES,
+    MAX_GRID_POINTS,
+    MAX_PAIRWISE_POINTS,
+    MAX_PART_BYTES,
+    MAX_PIECES,
+    QUANTUM_MM,
+    UNITS_TO_MM,
+    Boundary,
+    CircularArc,
+    Corner,
+    CubicBezier,
+    FacetRule,
+    Line,
+    Outline,
+    Part,
+    check_grid,
+    check_size,
+    elliptical_arc,
+    fingerprint,
+    load_outline,
+    load_part,
+    outline_from_pieces,
+    part_from_points,
+    polygon_crossing,
+    read_facets,
+    read_toml,
+)
+from .solve import (
+    DIRECTIONS,
+    EXACT,
+    METHODS,
+    PAPER_MARCH,
+    ExactOptions,
+    MarchGrid,
+    MarchOptions,
+    MarchResult,
+    Segment,
+    TrialNoise,
+    feasible_segments,
+    march,
+    march_grid,
+    outline_segments,
+    roll_bound,
+    trial_bound,
 )
 
 __all__ = [

@@ -95,7 +95,7 @@ def test_perimeter_integration_h1e5(benchmark):
 
 
 def test_table_build(benchmark):
-    from localizer._table import arc_table
+    from localizer.solve._table import arc_table
 
     def build():
         p = trefoil_part()

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from localizer._belief import FLAT_TOP, flat_top
+from localizer.filters._belief import FLAT_TOP, flat_top
 
 
 @given(st.integers(8, 400), st.integers(0, 399), st.integers(1, 60), st.integers(0, 2**32 - 1))

@@ -9,7 +9,7 @@ import pytest
 from scipy.optimize import brentq
 
 from localizer import CubicBezier, feasible_segments, load_outline
-from localizer._bezier_bound import kappa_slope_bound
+from localizer.solve._bezier_bound import kappa_slope_bound
 
 ROOT = Path(__file__).resolve().parents[2]
 DRAWINGS = sorted(

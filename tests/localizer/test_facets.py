@@ -3,7 +3,7 @@ vertices on circles, ellipses and a filleted plate, written as a DXF LWPOLYLINE,
 as an SVG polygon, against the closed forms of the shapes they sample; drawings with true corners
 faceted, against the drawing itself.
 
-The rule (localizer._facets): a vertex between two segments that turns by at most 15° and whose
+The rule (localizer.geometry._facets): a vertex between two segments that turns by at most 15° and whose
 fillet passes within 0.05 mm of it is smooth and becomes the arc tangent to both segments reaching
 halfway along the shorter; any other vertex is a corner. On a regular N-gon of circumradius r the
 fillets are its inscribed circle, radius r·cos(π/N), exactly.

@@ -1,4 +1,4 @@
-"""Every table built per part is sized before it is built (localizer._limits.check_grid): a part too
+"""Every table built per part is sized before it is built (localizer.geometry._limits.check_grid): a part too
 large for one (a drawing in metres read as mm, a wheel of a nanometre) is refused by name with the
 figure, at once, and the largest parts the project ships or generates are not.
 
@@ -15,7 +15,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-import localizer._limits as limits
+import localizer.geometry._limits as limits
 from localizer import (
     MAX_ARRAY_BYTES,
     MAX_GRID_POINTS,
@@ -36,26 +36,26 @@ from localizer import (
     outline_segments,
     part_from_points,
 )
-from localizer._belief import find_modes
-from localizer._outline_chain import chain_likelihood, chain_paper
-from localizer._table import arc_table
-from localizer._tracks import ModeTracks
+from localizer.chain._outline_chain import chain_likelihood, chain_paper
+from localizer.contact._tracks import ModeTracks
+from localizer.filters._belief import find_modes
+from localizer.solve._table import arc_table
 
 ROOT = Path(__file__).resolve().parents[2]
 STAR = ROOT / "bench/parts/heldout-g/star-12.json"  # 1030 mm: the filter must still run on it
 
 #: Every module that calls check_grid before building a table.
 CHECKING = (
-    "localizer._contact_filter",
-    "localizer._tracks",
-    "localizer._reach",
-    "localizer._wheel",
-    "localizer._wheel_filter",
-    "localizer._outline_chain",
-    "localizer._outline_solver",
-    "localizer._table",
-    "localizer._march",
-    "localizer._belief",
+    "localizer.filters._contact_state",
+    "localizer.contact._tracks",
+    "localizer.contact._reach",
+    "localizer.contact._wheel",
+    "localizer.filters._wheel_filter",
+    "localizer.chain._outline_chain",
+    "localizer.solve._outline_solver",
+    "localizer.solve._table",
+    "localizer.solve._march",
+    "localizer.filters._belief",
 )
 
 
@@ -311,7 +311,8 @@ def test_the_filter_sizes_its_array_as_it_builds_it(monkeypatch):
     # the check's figures are the filter's own: its starts and 8 bytes per basis column (default settings)
     asked = []
     monkeypatch.setattr(
-        "localizer._contact_filter.check_grid", lambda *a, **k: asked.append((a, k)) or limits.check_grid(*a, **k)
+        "localizer.filters._contact_state.check_grid",
+        lambda *a, **k: asked.append((a, k)) or limits.check_grid(*a, **k),
     )
     for part in (ellipse(40, 25), rectangle(60.0, 40.0)):
         f = ContactFilter(part)
@@ -347,7 +348,7 @@ def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_the
     with pytest.raises(PartError, match=r"dense.dxf: more than 262 144 pieces .* coarser chord tolerance"):
         load_outline(tmp_path / "dense.dxf")
 
-    import localizer._cad as cad
+    import localizer.geometry._cad as cad
 
     monkeypatch.setattr(cad, "MAX_PIECES", 50)
     square = [(0, 0), (10, 0), (10, 10), (0, 10)]

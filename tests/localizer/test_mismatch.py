@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from scipy.special import logsumexp, softmax
 
 from localizer import ContactFilter, QueryError, load_part, part_from_points
-from localizer._filter_kernels import weigh_scales
+from localizer.filters._filter_kernels import weigh_scales
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 STEP = math.radians(0.2)

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import localizer._contact_filter as contact_filter_module
+import localizer.filters._contact_marginal as contact_marginal_module
 from localizer import ContactFilter, load_outline
-from localizer._contact_filter import FACE_SLOPES
+from localizer.filters._contact_settings import FACE_SLOPES
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 H = 0.002  # mm between the reference's points
@@ -204,7 +204,7 @@ def test_a_contact_just_past_a_machined_face_is_not_stated_sure_on_the_next_piec
     # the simulated rig's machined face, tilted more than that, still held the jaw 0.35 mm before the face's
     # end, and the filter said 1.00 there. Within a few machined slopes of the face's angle the contact
     # counts as anywhere on the face's end: not sure (with FACE_SLOPES 0, as before: sure and 0.36 mm off)
-    monkeypatch.setattr(contact_filter_module, "FACE_SLOPES", slopes)
+    monkeypatch.setattr(contact_marginal_module, "FACE_SLOPES", slopes)
     rec = json.loads((DATA / "cad-heldout-d-plate04-t87.json").read_text())
     part = load_outline(DATA / rec["part"])
     flt = ContactFilter(part, **rec["settings"])

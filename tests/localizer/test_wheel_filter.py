@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import multivariate_normal
 
 from localizer import QueryError, WheelFilter, WheelJaw, load_part, part_from_points
-from localizer._wheel_rolling import free_runs
+from localizer.contact._wheel_rolling import free_runs
 
 from .test_wheel import peanut
 

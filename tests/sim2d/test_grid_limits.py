@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import localizer._limits as limits
+import localizer.geometry._limits as limits
 from localizer import Line, PartError, load_part, outline_from_pieces, part_from_points
 from sim2d.machining import machined_part
 from sim2d.noise import load_noise

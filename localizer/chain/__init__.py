@@ -1,0 +1,12 @@
+"""A chain of rolls, disambiguated: the paper's rule and the likelihood rule over consecutive
+rolls, on splines and on outlines with corners.
+"""
+
+from ._disambiguate import RULES, Candidate, Localization, localize
+
+__all__ = [
+    "RULES",
+    "Candidate",
+    "Localization",
+    "localize",
+]
