@@ -115,6 +115,11 @@ STEP_DEG = round(math.degrees(ROLL_STEP), 9)
 MAX_STUDY_BYTES = 2**20
 #: The most trials one study may run (split a larger one: its table is read whole).
 MAX_TRIALS = 100_000
+#: The standard deviations a study tells the two-roll rules unless its [likelihood] table says
+#: otherwise, mm and degrees: the simulated rig's own at the `paper` preset, which a study knows (a
+#: user's first run does not: the rules' defaults, :data:`localizer.SD_LENGTH`, are wider).
+STUDY_SD_LENGTH = 0.3
+STUDY_SD_TURN_DEG = 0.03
 
 __all__ = ["Study", "StudyError", "load_study", "run_trial", "TRIAL_COLUMNS", "WORLD_COLUMNS"]
 
@@ -260,8 +265,8 @@ class Study:
     noise: str = "paper"
     parameter: str | None = None
     values: tuple = ()
-    sd_length: float = 0.3
-    sd_turn_deg: float = 0.03
+    sd_length: float = STUDY_SD_LENGTH
+    sd_turn_deg: float = STUDY_SD_TURN_DEG
     source: str = ""
     methods: tuple = ()
     reactive: ReactiveOptions = ReactiveOptions()
@@ -470,8 +475,8 @@ def load_study(path) -> Study:
         noise=str(noise),
         parameter=parameter,
         values=values,
-        sd_length=float(lk.get("sd_length", 0.3)),
-        sd_turn_deg=float(lk.get("sd_turn_deg", 0.03)),
+        sd_length=float(lk.get("sd_length", STUDY_SD_LENGTH)),
+        sd_turn_deg=float(lk.get("sd_turn_deg", STUDY_SD_TURN_DEG)),
         source=str(path),
         methods=tuple(methods),
         reactive=reactive,

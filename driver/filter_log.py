@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from localizer import Belief, ContactFilter
+from localizer import BRIDGE_JUMP, Belief, ContactFilter
 
 __all__ = [
     "LoggedFilter",
@@ -89,7 +89,7 @@ class LoggedFilter(ContactFilter):
         self._keep("touch", jaw=jaw)
         self._call(super().touch, jaw)
 
-    def bridged(self, turn: float, jaw: float | None = None, jump: float = 3.0) -> float:
+    def bridged(self, turn: float, jaw: float | None = None, jump: float = BRIDGE_JUMP) -> float:
         self._keep("bridged", turn=turn, jaw=jaw, value=jump)
         return float(self._call(super().bridged, turn, jaw, jump))
 

@@ -21,7 +21,18 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from localizer import ROLL_STEP, Boundary, Localization, Outline, Part, arc_from_jaw_positions, localize
+from localizer import (
+    BRIDGE_JUMP,
+    ROLL_STEP,
+    SD_LENGTH,
+    SD_TURN,
+    Boundary,
+    Localization,
+    Outline,
+    Part,
+    arc_from_jaw_positions,
+    localize,
+)
 
 from .rig import (
     DEVICE_FAULTS,
@@ -588,7 +599,7 @@ def roll(
     step: float = ROLL_STEP,
     n: int = 32,
     offset: float | None = None,
-    bridge_jump: float | None = 3.0,
+    bridge_jump: float | None = BRIDGE_JUMP,
     observer=None,
     index: int = 0,
     pressing: PressSettings = PRESS,
@@ -780,7 +791,7 @@ def roll_sequence(
     approach_pose,
     step: float = ROLL_STEP,
     n: int = 32,
-    bridge_jump: float = 3.0,
+    bridge_jump: float = BRIDGE_JUMP,
     observer=None,
     pressing: PressSettings = PRESS,
     faces: tuple[tuple[float, float], ...] = (),
@@ -842,10 +853,10 @@ def localize_by_rolling(
     approach_pose,
     step: float = ROLL_STEP,
     n: int = 32,
-    bridge_jump: float = 3.0,
+    bridge_jump: float = BRIDGE_JUMP,
     rule: str = "likelihood",
-    sd_length: float = 0.5,
-    sd_turn: float = math.radians(0.03),
+    sd_length: float = SD_LENGTH,
+    sd_turn: float = SD_TURN,
     observer=None,
     pressing: PressSettings = PRESS,
 ) -> RollingRun:

@@ -10,12 +10,8 @@ simultaneously" as the way forward. :func:`localize_reactively` does it with
    and give the filter the cumulative arc and the arm's measured net rotation;
 3. every ``check_every`` steps: stop when the probability within the success
    radius has reached ``confidence`` at ``confirm`` checks in a row (default 1:
-   the first crossing). Two in a row turned 9 of 84 confident stops that were
-   wrong into 5 of 83 on bench/parts/heldout-a at four times the ``paper``
-   noise, and 5 of 21 into 3 of 18 on the tuning family at ×5.6, for 1–6° more
-   rolling; on the held-out family (heldout-b, ×4) it made no difference (6 of
-   81 against 5 of 82: near misses at 0.3–0.7 mm come as often one check later),
-   so it is not the default. When the rotation budget runs out between two checks, the
+   the first crossing; why not two: docs/filter.md, "How the settings were chosen"). When the
+   rotation budget runs out between two checks, the
    readings since the last one are judged as a check would judge them;
 4. the direction rule: while the belief has two or more modes, compare how much
    the next ``lookahead`` of *unexplored* rotation each way separates the two
@@ -54,7 +50,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from localizer import CONFIDENCE, ROLL_STEP, UNEXPLAINED, Belief, Boundary, ContactFilter, arc_from_jaw_positions
+from localizer import (
+    BRIDGE_JUMP,
+    CONFIDENCE,
+    ROLL_STEP,
+    UNEXPLAINED,
+    Belief,
+    Boundary,
+    ContactFilter,
+    arc_from_jaw_positions,
+)
 
 from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
 from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
@@ -217,7 +222,7 @@ class ReactivePolicy:
     direction: int | None = None
     check_every: int = 5
     lookahead: float = math.radians(15.0)
-    bridge_jump: float = 3.0
+    bridge_jump: float = BRIDGE_JUMP
     end_margin: float = 5.0
     backoff: float = 2.0
     min_spread: float = 0.05

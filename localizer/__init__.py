@@ -7,6 +7,7 @@ nothing here moves a robot, simulates a world or draws. The subpackages, from th
 """
 
 from ._defaults import (
+    BRIDGE_JUMP,
     CALIBRATION_SCALE_SD,
     CONFIDENCE,
     FIT_ALPHA,
@@ -14,6 +15,8 @@ from ._defaults import (
     MIN_SEPARATION,
     PART_SCALE_SD,
     ROLL_STEP,
+    SD_LENGTH,
+    SD_TURN,
     SUCCESS_RADIUS,
     TURN_TOL,
 )
@@ -129,6 +132,9 @@ __all__ = [
     "MIN_SEPARATION",
     "SUCCESS_RADIUS",
     "CONFIDENCE",
+    "SD_LENGTH",
+    "SD_TURN",
+    "BRIDGE_JUMP",
     "ROLL_STEP",
     "FIT_ALPHA",
     "PART_SCALE_SD",

@@ -17,6 +17,9 @@ __all__ = [
     "FIT_ALPHA",
     "PART_SCALE_SD",
     "CALIBRATION_SCALE_SD",
+    "SD_LENGTH",
+    "SD_TURN",
+    "BRIDGE_JUMP",
 ]
 
 #: The paper's tolerance on a segment's contact travel, mm.
@@ -44,3 +47,13 @@ CALIBRATION_SCALE_SD = 0.003
 #: the calibration's as one nuisance (a part 2% off its drawing at two standard deviations: a worn
 #: die, a part cast to another shrinkage, a drawing at another revision's size).
 PART_SCALE_SD = 0.01
+#: The standard deviation of a measured contact travel L the two-roll rules are told unless the user
+#: says otherwise, mm: wider than a calibrated rig's (0.3 mm at the `paper` preset, which the studies
+#: tell them) so that an uncalibrated first run is not over-sure.
+SD_LENGTH = 0.5
+#: The standard deviation of a measured rotation the two-roll rules are told, rad: the arm encoder's
+#: 0.03° step.
+SD_TURN = math.radians(0.03)
+#: A step in which the contact's place on a straight jaw moves more than this, mm, is a bridge: the jaw
+#: left the part and landed on it elsewhere (the rolling stops or undoes it; the filter weighs it).
+BRIDGE_JUMP = 3.0

@@ -14,6 +14,8 @@ from localizer import (
     DIRECTIONS,
     LENGTH_TOL,
     RULES,
+    SD_LENGTH,
+    SD_TURN,
     TURN_TOL,
     ContactFilter,
     Outline,
@@ -74,16 +76,16 @@ def register(sub) -> None:
     loc.add_argument(
         "--sd-length",
         type=positive,
-        default=0.5,
+        default=SD_LENGTH,
         metavar="MM",
-        help="std. dev. of a measured contact travel (likelihood rule, default 0.5 mm)",
+        help=f"std. dev. of a measured contact travel (likelihood rule, default {SD_LENGTH} mm)",
     )
     loc.add_argument(
         "--sd-turn",
         type=positive,
-        default=0.03,
+        default=round(math.degrees(SD_TURN), 12),
         metavar="DEG",
-        help="std. dev. of a measured rotation (likelihood rule, default 0.03 deg)",
+        help=f"std. dev. of a measured rotation (likelihood rule, default {math.degrees(SD_TURN):.2f} deg)",
     )
     loc.add_argument(
         "--length-tol",

@@ -33,7 +33,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
-from .._defaults import CONFIDENCE, FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, TURN_TOL
+from .._defaults import CONFIDENCE, FIT_ALPHA, LENGTH_TOL, MIN_SEPARATION, SD_LENGTH, SD_TURN, TURN_TOL
 from .._errors import QueryError
 from .._types import FloatArray
 from ..geometry import Boundary, Outline, Part
@@ -362,8 +362,8 @@ def localize(
     *,
     rule: str = "likelihood",
     direction: str = "ccw",
-    sd_length: float = 0.5,
-    sd_turn: float = float(np.radians(0.03)),
+    sd_length: float = SD_LENGTH,
+    sd_turn: float = SD_TURN,
     length_tol: float = LENGTH_TOL,
     turn_tol: float = TURN_TOL,
     min_separation: float = MIN_SEPARATION,

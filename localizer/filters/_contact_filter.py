@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from .._defaults import BRIDGE_JUMP
 from .._errors import QueryError
 from ._belief import Belief, belief_flags
 from ._contact_fit import ContactFit
@@ -212,7 +213,7 @@ class ContactFilter(ContactFit):
             self._version += 1
         self._log("touch", jaw)
 
-    def bridged(self, turn: float, jaw: float | None = None, jump: float = 3.0) -> float:
+    def bridged(self, turn: float, jaw: float | None = None, jump: float = BRIDGE_JUMP) -> float:
         """The jaw, turned to net rotation ``turn`` (rad), touched the part somewhere else (a bridge).
 
         The rig calls a step a bridge when the contact moves more than ``jump`` mm along the jaw

@@ -1,6 +1,6 @@
 """A part that is not its model: the stretches of readings a belief must not rest on, the fit test's
 settings, and what it reports (the straight jaw's :class:`~localizer.ContactFilter` and the wheel's
-:class:`~localizer.WheelFilter`; the module notes of the first, and docs/robustness.md)."""
+:class:`~localizer.WheelFilter`; docs/filter.md and docs/robustness.md)."""
 
 from __future__ import annotations
 
@@ -26,18 +26,16 @@ __all__ = [
 ]
 
 #: The rolled arc, mm, of a stretch of readings the belief must not rest on alone, and of the stretches
-#: the fit test judges (module notes, "A part that is not its model"): the straight jaw reads a burr's
-#: crest or a dent's rims over a few millimetres (it jumps across the rest). Chosen on the tuning family
-#: (60 trials, `paper`): 12 mm made 15 of 57 clean sure stops run out of budget, 6 mm none (median 66°
-#: of rolling against 52° at 4 mm and 31° without); none sure and wrong with a 0.3 × 4 mm burr at any.
+#: the fit test judges (docs/filter.md, "A part that is not its model"): the straight jaw reads a burr's
+#: crest or a dent's rims over a few millimetres (it jumps across the rest); longer costs clean parts
+#: their sure stops (docs/filter.md, "How the settings were chosen").
 DEFECT_WINDOW = 6.0
 #: A bridge the belief gave less than this probability when it came is one the part's model does not
 #: explain (:meth:`ContactFilter.bridged`).
 UNEXPLAINED = 0.01
 #: The stretches the fit test judges and quarantines, in units of ``defect_window``: a burr's misfit
 #: goes on past its crest (the slope term and the offset carry it a little), which a stretch twice the
-#: envelope's takes whole (on the tuning family, 60 trials with a 0.3 x 4 mm burr near the start: 23
-#: right at 12 mm, 20 at 6; clean, the same 57 of 60 sure).
+#: envelope's takes whole.
 FIT_WIDTH = 2.0
 #: A reading whose arc moved more than this (mm) beyond what the model's radius there makes of the turn
 #: since the one before came after a jump: the fit test leaves it out (a face crossed in one step, a dip
@@ -48,8 +46,7 @@ FIT_MIN_READINGS = 20
 #: Readings between two fit tests while the belief is not sure (a test before every sure stop too).
 FIT_EVERY = 25
 #: How many times the rest's misfit per reading (against its expectation) a stretch's must be to count
-#: as not fitting: on clean machined parts at the `paper` preset the worst stretch of 60 tuning trials
-#: was 4.8 times off (a glyph's nearly straight stroke), the next 2.6.
+#: as not fitting: above what clean machined parts at the `paper` preset show (docs/filter.md).
 FIT_RATIO = 6.0
 #: The most probable starts a fit test judges the readings under (besides each strong mode's best): a
 #: misfit is the part's only if none of them fits.

@@ -31,7 +31,7 @@ which the rolling procedure detects and undoes instead) is made :data:`~localize
 times less likely at each reading used: soft, as the straight jaw's reach is, so that a model error in
 the reach does not rule out the truth.
 
-Trust, as the straight jaw's filter (its notes, "Trust"): the readings' likelihood is raised to the
+Trust, as the straight jaw's filter (docs/filter.md, "Trust"): the readings' likelihood is raised to the
 power :data:`~localizer.TEMPER`, and a stated probability is the least over ``noise_scales`` (the
 covariance times each factor squared), so that readings noisier than the filter was told lower it
 instead of making it confidently wrong. And a belief is only stated when some start fits at all: when

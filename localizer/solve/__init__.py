@@ -4,7 +4,8 @@ tables, and Jia's marching algorithm as the reference), and the Cramér–Rao bo
 """
 
 from ._bound import TrialNoise, roll_bound, trial_bound
-from ._march import PAPER_MARCH, MarchGrid, MarchOptions, MarchResult, march, march_grid
+from ._march import PAPER_MARCH, MarchOptions, MarchResult, march
+from ._march_grid import MarchGrid, march_grid
 from ._outline_solver import outline_segments
 from ._segment import DIRECTIONS, Segment
 from ._solver import EXACT, METHODS, ExactOptions, feasible_segments

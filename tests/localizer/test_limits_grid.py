@@ -54,7 +54,7 @@ CHECKING = (
     "localizer.chain._outline_chain",
     "localizer.solve._outline_solver",
     "localizer.solve._table",
-    "localizer.solve._march",
+    "localizer.solve._march_grid",
     "localizer.filters._belief",
 )
 
@@ -348,9 +348,9 @@ def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_the
     with pytest.raises(PartError, match=r"dense.dxf: more than 262 144 pieces .* coarser chord tolerance"):
         load_outline(tmp_path / "dense.dxf")
 
-    import localizer.geometry._cad as cad
+    import localizer.geometry._cad_loops as cad_loops
 
-    monkeypatch.setattr(cad, "MAX_PIECES", 50)
+    monkeypatch.setattr(cad_loops, "MAX_PIECES", 50)
     square = [(0, 0), (10, 0), (10, 10), (0, 10)]
     doc = ezdxf.new()
     for i in range(60):

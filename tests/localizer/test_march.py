@@ -119,7 +119,7 @@ def test_bad_step():
 
 def test_a_zero_of_curvature_that_keeps_its_sign_is_no_inflection():
     """Footnote 5: only sign changes are inflections; at a zero the side is κ' 's."""
-    from localizer.solve._march import _sign_regions
+    from localizer.solve._march_grid import _sign_regions
 
     h = 0.01
     x = np.arange(401) * h  # one period of 4 parameter units, last sample = first
