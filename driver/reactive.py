@@ -1,44 +1,8 @@
 """Reactive localization: roll step by step, update the belief at every step, stop when sure.
 
-Jia (2005, §V) names "reactive localization which conducts sensing and movement
-simultaneously" as the way forward. :func:`localize_reactively` does it with
-:class:`localizer.ContactFilter`:
-
-1. establish contact and measure the wrist's give (the edge offset);
-2. rotate one step, press back to the force, read the contact's location on the
-   jaw; turn the step's jaw travel into signed arc (second-order inversion)
-   and give the filter the cumulative arc and the arm's measured net rotation;
-3. every ``check_every`` steps: stop when the probability within the success
-   radius has reached ``confidence`` at ``confirm`` checks in a row (default 1:
-   the first crossing; why not two: docs/filter.md, "How the settings were chosen"). When the
-   rotation budget runs out between two checks, the
-   readings since the last one are judged as a check would judge them;
-4. the direction rule: while the belief has two or more modes, compare how much
-   the next ``lookahead`` of *unexplored* rotation each way separates the two
-   leading ones (how much their radii of curvature differ over it,
-   integrated); when the way ahead cannot separate them (below ``min_spread``)
-   and the other way clearly can (above three times that), turn round (rolling
-   back over the explored range);
-5. when most of the belief says the contact will leave its convex stretch
-   within ``lookahead``, turn round before the jaw bridges the concavity; a
-   step that jumps along the jaw all the same has bridged it: it is undone (the
-   jaw rolls back one step), its reading is dropped, and the direction flips.
-   Rules 4 and 5 turn round only towards a way that is clear for ``lookahead``
-   beyond what has been rolled there; otherwise the jaw rolls on (a bridge is
-   safe: it is detected and undone). Without this the two rules can turn the
-   jaw back and forth at every check and roll in place;
-6. at the end of the jaw's calibrated span the jaw is lifted, slid along
-   itself and put back on the same point (a regrasp; the filter starts a new
-   segment with its own offset), and rolling goes on the same way;
-7. stop at ``max_rotation`` of rolled rotation, sure or not;
-8. a part that is not its model: a reading whose contact jumped more than ``reread_jump``
-   is read twice more and the middle of the three kept (a spike of the wrist's DAQ is one reading),
-   as are the readings every step after counts from; when both ways are blocked and a jump was one no
-   probable place of the model predicted (the jaw sits on a burr, or between a dent's rims), the jaw
-   rolls through that jump once and the filter starts afresh from where it lands (spline parts: a
-   drawing's corners and faces jump of their own); and a run that met something the model does not
-   have (a stretch the filter quarantined, a jump rolled through, one the final place does not
-   explain) ends "mismatch", saying where, never "confident".
+Jia (2005, §V) names "reactive localization which conducts sensing and movement simultaneously" as
+the way forward. :func:`localize_reactively` does it with :class:`localizer.ContactFilter`, by the
+rules of :class:`driver.reactive_policy.ReactivePolicy` (listed in :mod:`driver.reactive_policy`).
 
 Works on any :class:`driver.rig.Rig` (simulated or serial).
 """
@@ -46,14 +10,12 @@ Works on any :class:`driver.rig.Rig` (simulated or serial).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
 from localizer import (
-    BRIDGE_JUMP,
     CONFIDENCE,
-    ROLL_STEP,
     UNEXPLAINED,
     Belief,
     Boundary,
@@ -61,7 +23,19 @@ from localizer import (
     arc_from_jaw_positions,
 )
 
-from .procedures import PRESS, Calibration, PressSettings, _location, edge_offset, establish_contact, press
+from .calibration import Calibration
+from .hand import PRESS, PressSettings, edge_offset, establish_contact
+from .reactive_policy import (
+    CONFIRM,
+    MAX_LEAVES,
+    MAX_ROTATION,
+    REACTIVE_POLICY,
+    ReactivePolicy,
+    ReactiveRun,
+    clear_ahead,
+    spread_by_direction,
+)
+from .reactive_sensing import JawReadings
 from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 
 __all__ = [
@@ -74,175 +48,6 @@ __all__ = [
     "MAX_ROTATION",
 ]
 
-#: Checks in a row at which the belief must reach the confidence before the rolling stops (step 3).
-CONFIRM = 1
-#: How many times a run rolls through such a jump to leave what the jaw sat on (module notes, rule 8):
-#: once, off the thing under the start; a second would be a real concavity the belief misjudged.
-MAX_LEAVES = 1
-#: Budget of rolled rotation, both directions counted, rad (the command line's and the studies' too).
-MAX_ROTATION = math.radians(240.0)
-
-
-@dataclass(frozen=True)
-class ReactiveRun:
-    """Result of :func:`localize_reactively`.
-
-    Attributes
-    ----------
-    belief : Belief
-        The final belief over the present contact.
-    rotation : float, rad
-        Total rotation rolled (both directions counted).
-    steps : int
-        Rolling steps that updated the filter.
-    stopped : str
-        "confident", "max_rotation", "blocked" (concavities both ways), "lost" (the contact
-        could not be read back after a bridge) or "mismatch" (the readings do not fit the part: a
-        burr, a dent, debris, a part that is not its model; ``belief.mismatch`` says where).
-    reversals : int
-        Direction changes (a concavity ahead or bridged, or the direction rule).
-    regrasps : int
-        Times the jaw was lifted and slid along itself at the end of its span.
-    bridges : int
-        Steps that bridged a concavity (or were refused) and were undone.
-    history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
-        The belief at every check, with the truth where the rig knows it.
-    arcs, turns : tuple of float
-        The cumulative signed arc (mm) and net rotation (rad) given to the filter.
-    true_arcs : tuple of float
-        The true contact (mm) at the same readings (NaN on a real rig).
-    segments : tuple of int
-        The contact segment of each reading (a regrasp or a bridge starts a new one).
-    """
-
-    belief: Belief
-    rotation: float
-    steps: int
-    stopped: str
-    reversals: int
-    regrasps: int = 0
-    bridges: int = 0
-    history: tuple = field(repr=False, default=())
-    arcs: tuple = field(repr=False, default=())
-    turns: tuple = field(repr=False, default=())
-    true_arcs: tuple = field(repr=False, default=())
-    segments: tuple = field(repr=False, default=())
-
-    @property
-    def estimate_arc(self) -> float:
-        return self.belief.map_arc
-
-
-def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = (0.0, 0.0), starts=None) -> tuple:
-    """(spread ccw, spread cw) in mm: how far apart hypotheses' predicted arcs move over the next
-    ``lookahead`` rad of *unexplored* rotation each way.
-
-    ``starts`` are the hypotheses (start arcs, mm), equally weighted; default: the two
-    most probable modes of the belief. For two modes the spread is half the difference
-    of their predicted travel: their radii of curvature's difference over the window,
-    integrated. ``explored`` is the (lowest, highest) net rotation rolled so far: rolling
-    back over it measures the same curvature again, so each way's window starts where
-    the rolled range ends. A hypothesis that would have to bridge a concavity that way
-    counts as not moving.
-    """
-    if starts is None:
-        starts = [m.start_arc for m in flt.belief().modes[:2]]
-    idx = flt.tracks.node_at(starts)
-    jaw = _jaw_now(flt, idx)
-    out = []
-    for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
-        a, ok_a = flt.tracks.roll(idx, edge, **jaw)
-        b, ok_b = flt.tracks.roll(idx, edge + sign * lookahead, **jaw)
-        moved = np.where(ok_a & ok_b, b - a, 0.0)
-        out.append(float(np.std(moved)))
-    return tuple(out)
-
-
-def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, at: float | None = None) -> float:
-    """Probability that the jaw can roll ``lookahead`` rad further ``direction``-wise without the
-    contact leaving its convex stretch (over every hypothesis with weight).
-
-    ``at`` is the net rotation (rad) to roll on from (default: the present one).
-    """
-    w = flt.posterior()
-    top = np.flatnonzero(w > 1e-9 * w.max())
-    _, ok = flt.tracks.roll(top, (flt.turn if at is None else at) + direction * lookahead, **_jaw_now(flt, top))
-    return float(np.sum(w[top][ok]) / np.sum(w[top]))
-
-
-def _jaw_now(flt: ContactFilter, idx) -> dict:
-    """Where the jaw touches now, as :meth:`localizer.ModeTracks.roll` takes it (nothing before a reading)."""
-    if not math.isfinite(flt.jaw_position):
-        return {}
-    return {"jaw": flt.jaw_position, "at": flt.current[idx]}
-
-
-@dataclass(frozen=True)
-class ReactivePolicy:
-    """How the reactive method rolls and when it stops (module notes, rules 1–7).
-
-    Attributes
-    ----------
-    step : float, rad
-        Rolling step (paper: 0.2°, :data:`localizer.ROLL_STEP`).
-    n : int
-        Samples averaged per reading.
-    confidence : float
-        Probability within the success radius that stops the rolling.
-    max_rotation : float, rad
-        Budget of rolled rotation, both directions counted.
-    direction : {1, -1, None}
-        First rolling direction (counter-clockwise is 1; None: 1).
-    check_every : int
-        Steps between checks of the stopping and direction rules.
-    lookahead : float, rad
-        Rotation over which the direction rule compares the two ways.
-    bridge_jump : float, mm
-        A step whose contact moves more than this on the jaw has bridged a concavity.
-    end_margin : float, mm
-        The contact is kept this far inside the calibrated span of the jaw; there the jaw
-        is lifted by ``backoff`` mm, slid along itself and put back (a regrasp).
-    backoff : float, mm
-        How far the jaw is lifted off for a regrasp or after a bridge.
-    min_spread : float, mm
-        The direction rule turns round when the window ahead separates the two leading
-        modes' predicted arcs by less than this and the other way's window by more than
-        three times this (0: never turn round by choice).
-    confirm : int
-        Checks in a row at which the belief must reach ``confidence`` before the rolling stops.
-    reread_jump : float, mm
-        A reading whose contact moved more than this on the jaw in one step is read twice more and the
-        middle of the three kept (a spike of the wrist's DAQ is one reading; a real jump reads the same).
-    """
-
-    step: float = ROLL_STEP
-    n: int = 32
-    confidence: float = CONFIDENCE
-    max_rotation: float = MAX_ROTATION
-    direction: int | None = None
-    check_every: int = 5
-    lookahead: float = math.radians(15.0)
-    bridge_jump: float = BRIDGE_JUMP
-    end_margin: float = 5.0
-    backoff: float = 2.0
-    min_spread: float = 0.05
-    confirm: int = CONFIRM
-    reread_jump: float = 1.0
-
-    def __post_init__(self):
-        if not (math.isfinite(self.step) and self.step > 0):
-            raise RigError(f"step={self.step!r} rad must be positive")
-        if not (math.isfinite(self.max_rotation) and self.max_rotation > 0):
-            raise RigError(f"max_rotation={self.max_rotation!r} rad must be positive")
-        if self.direction not in (1, -1, None):
-            raise RigError(f"direction={self.direction!r}: use 1 (counter-clockwise), -1 or None")
-        if not 0 < self.confidence < 1:
-            raise RigError(f"confidence={self.confidence!r} must be in (0, 1)")
-        for name in ("confirm", "check_every", "n"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-                raise RigError(f"{name}={value!r} must be a whole number ≥ 1")
-
 
 def localize_reactively(
     rig: Rig,
@@ -251,11 +56,12 @@ def localize_reactively(
     calibration: Calibration,
     approach_pose,
     filter: ContactFilter | None = None,
-    policy: ReactivePolicy = ReactivePolicy(),
+    policy: ReactivePolicy = REACTIVE_POLICY,
     pressing: PressSettings = PRESS,
     observer=None,
 ) -> ReactiveRun:
-    """Roll until the contact is known within the filter's radius with the ``policy``'s confidence (module notes).
+    """Roll until the contact is known within the filter's radius with the ``policy``'s confidence (the
+    rules: :mod:`driver.reactive_policy`).
 
     Parameters
     ----------
@@ -279,7 +85,7 @@ def localize_reactively(
     return _Roller(rig, flt, calibration, policy, pressing, observer).run(approach_pose)
 
 
-class _Roller:
+class _Roller(JawReadings):
     """One reactive localization: the hand, the filter, the counters and the traces it returns.
 
     :meth:`run` rolls step by step (:meth:`_step`); a step at the end of the jaw's span is a
@@ -322,61 +128,6 @@ class _Roller:
         self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
         self.segment_base = 0  # segments of the filters before a restart
         self.rereads = 0  # readings taken again because one jumped
-
-    # ------------------------------------------------------------------ sensing
-    def read(self) -> float:
-        """The contact's place on the jaw now, mm (logs the reading)."""
-        return _location(self.rig, self.baseline, self.calibration, self.policy.n, self.readings, self.truth, self.hand)
-
-    def read_or_inf(self) -> float:
-        """:meth:`read`, or inf where the place read lies outside the calibrated span (a bridge, or a spike)."""
-        try:
-            return self.read()
-        except DEVICE_FAULTS:
-            raise
-        except RigError:
-            return math.inf
-
-    def read_again(self, d: float) -> float:
-        """A reading ``d`` (mm) that jumped (or fell outside the calibrated span: inf): read twice more at the
-        same pose and keep the middle of the three, so that one spike of the wrist's DAQ is not taken for the
-        contact's move (a real jump reads the same again)."""
-        self.rereads += 1
-        three = sorted([d, self.read_or_inf(), self.read_or_inf()])
-        return float(three[1])
-
-    def read_base(self) -> float:
-        """A reading the next steps count from (the first contact, after a regrasp or a bridge undone): read
-        twice, and a third time if the two differ by more than ``reread_jump``, keeping the middle, so that
-        a spike does not shift every step after it."""
-        a, b = self.read(), self.read()
-        if abs(a - b) <= self.policy.reread_jump:
-            return a
-        self.rereads += 1
-        return float(np.median([a, b, self.read()]))
-
-    def pressed(self) -> bool:
-        """Press back to the force; False when the press was refused (overload, no contact)."""
-        try:
-            press(
-                self.rig,
-                self.hand,
-                self.baseline,
-                target=self.calibration.target,
-                n=self.policy.n,
-                pressing=self.pressing,
-            )
-            return True
-        except DEVICE_FAULTS:
-            raise
-        except RigError:
-            return False
-
-    def true_arc(self) -> float:
-        return self.truth[-1].contact_arc if self.truth else math.nan
-
-    def turn_now(self) -> float:
-        return self.hand.measured_angle() - self.phi0
 
     # ------------------------------------------------------------------ the run
     def run(self, approach_pose) -> ReactiveRun:

@@ -21,8 +21,9 @@ import numpy as np
 
 from localizer import arc_from_jaw_positions, check_size
 
-from .procedures import Calibration, RollingRun
+from .calibration import Calibration
 from .rig import RigError
+from .roll_result import RollingRun
 
 __all__ = ["Trace", "COLUMNS", "FORMAT", "read_archive", "trace_format"]
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from localizer import Belief, Outline, Part, WheelFilter, WheelJaw
 
-from .procedures import PRESS, PressSettings
+from .hand import PRESS, PressSettings
 from .rig import Rig, RigError
 from .wheel_calibration import (
     CALIBRATION_LENGTH,

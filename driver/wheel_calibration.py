@@ -11,7 +11,8 @@ import numpy as np
 
 from localizer import Outline, Part, WheelJaw, wheel_reach_for
 
-from .procedures import PRESS, Calibration, PressSettings
+from .calibration import Calibration
+from .hand import PRESS, PressSettings
 from .rig import Rig, RigError
 from .wheel_disc import WHEEL_POLICY, WheelCalibration, WheelDisc, WheelPolicy, axle_travel, corner_pivot, kappa_band
 

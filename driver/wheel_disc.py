@@ -44,7 +44,7 @@ import numpy as np
 
 from localizer import Outline, Part, WheelJaw, wheel_reach_for
 
-from .procedures import Hand, PressSettings, delta_voltages, press, zero
+from .hand import Hand, PressSettings, delta_voltages, press, zero
 from .reactive import CONFIDENCE, MAX_ROTATION
 from .rig import GroundTruth, Rig, RigError
 

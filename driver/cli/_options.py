@@ -20,8 +20,9 @@ from localizer import (
     parse_jaw,
 )
 
-from ..procedures import PRESS, STEP_RANGE_DEG, PressSettings, ServoSettings
+from ..hand import PRESS, PressSettings, ServoSettings
 from ..reactive import CONFIDENCE, MAX_ROTATION
+from ..rolling import STEP_RANGE_DEG
 
 __all__ = [
     "finite",
