@@ -29,8 +29,9 @@ def register(sub) -> None:
 
 
 def montecarlo_command(args) -> int:
-    from .montecarlo import print_summary, run_study
+    from .montecarlo import run_study
     from .study import load_study
+    from .summary import print_summary
 
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers} must be at least 1")

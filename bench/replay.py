@@ -28,7 +28,8 @@ import numpy as np
 
 from localizer import ContactFilter, Part
 
-from .study import TrialSpec, load_study, run_trial
+from .study import load_study
+from .trial import TrialSpec, run_trial
 
 __all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "VariantResult"]
 

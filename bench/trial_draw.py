@@ -26,7 +26,7 @@ class TrialDraw(NamedTuple):
 
 
 def draw_trial(spec) -> TrialDraw:
-    """The first draws of trial ``spec`` (a :class:`bench.study.TrialSpec`): the generator
+    """The first draws of trial ``spec`` (a :class:`bench.trial.TrialSpec`): the generator
     ``SeedSequence([seed, level, trial])``, then the part."""
     s = spec.study
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
@@ -54,7 +54,7 @@ def draw_world(spec, part_file: str, part, start: float):
 
 
 def world_cells(change, spikes: int | str = "") -> dict:
-    """The :data:`bench.study.WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
+    """The :data:`bench.columns.WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
     if change is None:
         return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
     return {

@@ -7,7 +7,7 @@ start: uniformly over the whole boundary, redrawn until the wheel surely reaches
 (:func:`driver.wheel.calibrate_wheel` on a rig of its own: the same wheel, another machined part and
 noise), then :func:`driver.wheel.localize_with_wheel` rolls from the start with the study's
 ``[reactive]`` confidence and rotation budget. The row has the straight jaw's columns, the
-``reactive_*`` method columns, and :data:`bench.study.FINGER_COLUMNS`.
+``reactive_*`` method columns, and :data:`bench.columns.FINGER_COLUMNS`.
 """
 
 from __future__ import annotations

@@ -13,7 +13,8 @@ import pytest
 
 from bench.benchmarks.baselines import per_second
 from bench.montecarlo import run_study
-from bench.study import TrialSpec, load_study, run_trial
+from bench.study import load_study
+from bench.trial import TrialSpec, run_trial
 
 STUDY = Path(__file__).resolve().parents[1] / "studies" / "paper.toml"
 

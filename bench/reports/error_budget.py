@@ -16,8 +16,9 @@ import tempfile
 from dataclasses import fields
 from pathlib import Path
 
-from bench.montecarlo import run_study, wilson
+from bench.montecarlo import run_study
 from bench.study import load_study
+from bench.summary import wilson
 from sim2d import PRESETS
 
 GROUPS = {

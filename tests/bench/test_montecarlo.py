@@ -13,8 +13,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bench.montecarlo import read_trials, run_study, wilson
+from bench.montecarlo import read_trials, run_study
 from bench.study import StudyError, load_study
+from bench.summary import wilson
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -263,7 +264,7 @@ particles = 500
 
 def test_one_methods_error_is_that_methods_failure_only(tmp_path, monkeypatch):
     import localizer
-    from bench.study import TrialSpec, run_trial
+    from bench.trial import TrialSpec, run_trial
 
     study = small_methods_study(tmp_path)
     real = localizer.localize
@@ -448,7 +449,7 @@ def test_a_world_study_writes_how_each_trials_world_differs_and_counts_mismatche
     # issue 29: a [world] table adds the world's columns; the trials are the same as without it (the same
     # start and noise), and a run that met the defect says so in <m>_stopped, <m>_mismatch_arc and the
     # summary's mismatch count
-    from bench.study import WORLD_COLUMNS
+    from bench.columns import WORLD_COLUMNS
 
     world = "[world]\ndefects = 1\ndefect_height_mm = 0.3\ndefect_length_mm = 4.0\n[reactive]\nmax_rotation_deg = 60.0"
     base = 'methods = ["reactive"]\n[reactive]\nmax_rotation_deg = 60.0'

@@ -2,7 +2,9 @@
 
 import math
 
-from bench.study import FINGER_COLUMNS, TrialSpec, load_study
+from bench.columns import FINGER_COLUMNS
+from bench.study import load_study
+from bench.trial import TrialSpec
 from bench.wheel_trial import run_wheel_trial
 
 

@@ -1,0 +1,235 @@
+"""A study's table summed up: success with its Wilson interval, sure and sure-and-wrong, rotation, the
+error over the bound, reliability (stated against actual), per level and method; summary.json's content
+and the lines printed at the end of a run."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .study import Study
+
+__all__ = [
+    "wilson",
+    "json_safe",
+    "summarize",
+    "method_detail",
+    "error_over_bound",
+    "summarize_methods",
+    "RELIABILITY_BINS",
+    "reliability",
+    "print_summary",
+]
+
+
+def wilson(successes: int, n: int, z: float = 1.96):
+    """Wilson 95% interval of a success rate, (low, high).
+
+    Examples
+    --------
+    >>> [round(v, 3) for v in wilson(45, 100)]
+    [0.356, 0.548]
+    >>> wilson(100, 100)[1]
+    1.0
+    """
+    if n == 0:
+        return (math.nan, math.nan)
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    # in exact arithmetic the interval holds p; rounding at p = 1 (or 0) must not put it outside
+    return (max(0.0, min(p, centre - half)), min(1.0, max(p, centre + half)))
+
+
+def json_safe(value):
+    """``value`` with every non-finite float as None: JSON has no NaN or Infinity."""
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _number(text) -> float:
+    """A trials.csv cell as a float (empty: nan)."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def summarize(study: Study, rows) -> dict:
+    """Success rate per level with its 95% interval, error quantiles, failures."""
+    levels = []
+    for level in range(study.levels):
+        sel = [r for r in rows if int(r["level"]) == level]
+        n = len(sel)
+        ok = sum(int(r["success"]) for r in sel)
+        err = np.array([float(r["error_mm"]) for r in sel]) if sel else np.array([])
+        levels.append(
+            {
+                "level": level,
+                "parameter": study.parameter,
+                "value": study.level_label(level),
+                "trials": n,
+                "success": ok,
+                "success_rate": ok / n if n else None,
+                "ci95": list(wilson(ok, n)),
+                "error_median_mm": float(np.median(err)) if n else None,
+                "error_p90_mm": float(np.quantile(err, 0.9)) if n else None,
+                "ambiguous": sum(int(r["ambiguous"]) for r in sel),
+                "broken": sum(bool(r["failure"]) for r in sel),
+                "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,
+                "mean_restarts": float(np.mean([float(r["restarts"]) for r in sel])) if n else None,
+            }
+        )
+        if study.methods:
+            levels[-1]["methods"] = {m: method_detail(study, m, sel) for m in study.methods}
+        if study.fingers and n:
+            arcs = np.array([_number(r.get("arc_mm", "")) for r in sel], dtype=float)
+            levels[-1].update(
+                {
+                    "jaw": study.level_jaw(level),
+                    "reachable": float(np.mean([float(r["reachable"]) for r in sel])),
+                    "mean_redraws": float(np.mean([float(r["redraws"]) for r in sel])),
+                    "mean_arc_mm": float(np.nanmean(arcs)) if np.isfinite(arcs).any() else None,
+                }
+            )
+    out = {
+        "study": study.name,
+        "method": study.method,
+        "engine": study.engine,
+        "noise": study.noise,
+        "success_radius": study.success_radius,
+        "levels": levels,
+    }
+    if study.methods:
+        out.update(summarize_methods(study, rows))
+    return out
+
+
+def method_detail(study: Study, m: str, rows) -> dict:
+    """One method's record over ``rows``: success, how it stopped, confident and wrong, per part."""
+    n = len(rows)
+    ok = sum(int(r[f"{m}_success"]) for r in rows)
+    rot = np.array([_number(r[f"{m}_rotation_deg"]) for r in rows], dtype=float)
+    err = np.array([_number(r[f"{m}_error_mm"]) for r in rows], dtype=float)
+    stopped = [r.get(f"{m}_stopped", "") for r in rows]
+    confident = [r for r, st in zip(rows, stopped) if st == "confident"]
+    per_part: dict = {}
+    for r in rows:
+        d = per_part.setdefault(r["part"], {"success": 0, "trials": 0})
+        d["trials"] += 1
+        d["success"] += int(r[f"{m}_success"])
+    wrong = sum(1 - int(r[f"{m}_success"]) for r in confident)
+    ratio = error_over_bound(m, rows)
+    return {
+        "success": ok,
+        "trials": n,
+        "ci95": list(wilson(ok, n)),
+        "mean_rotation_deg": float(np.nanmean(rot)) if n and np.isfinite(rot).any() else None,
+        "median_rotation_deg": float(np.nanmedian(rot)) if n and np.isfinite(rot).any() else None,
+        "error_median_mm": float(np.median(err)) if n else None,
+        "confident": len(confident),
+        "confident_wrong": wrong,
+        "mismatch": stopped.count("mismatch"),
+        "confident_wrong_ci95": list(wilson(wrong, len(confident))),
+        "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
+        "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
+        "per_part": dict(sorted(per_part.items())),
+        "error_over_bound_rms": float(np.sqrt(np.mean(ratio**2))) if ratio.size else None,
+        "error_over_bound_median": float(np.median(ratio)) if ratio.size else None,
+        "bounded_successes": int(ratio.size),
+    }
+
+
+def error_over_bound(m: str, rows) -> np.ndarray:
+    """Error / Cramér–Rao bound of method ``m`` over its successful trials that have a finite bound."""
+    out = []
+    for r in rows:
+        bound = _number(r.get(f"{m}_bound_mm", ""))
+        if int(r[f"{m}_success"]) and math.isfinite(bound) and bound > 0:
+            out.append(_number(r[f"{m}_error_mm"]) / bound)
+    return np.array(out, dtype=float)
+
+
+def summarize_methods(study: Study, rows) -> dict:
+    """``methods`` {name: success rate} over all trials, with details and success against rotation."""
+    from .methods import MARK_DEG, parse_curve
+
+    rates, details, curves = {}, {}, {}
+    n = len(rows)
+    for m in study.methods:
+        details[m] = method_detail(study, m, rows)
+        rates[m] = details[m]["success"] / n if n else None
+        per_mark: dict = {}
+        for r in rows:
+            pairs = parse_curve(r[f"{m}_curve"])
+            last = pairs[-1][1] if pairs else math.inf
+            marks = {round(k, 6): e for k, e in pairs}
+            # a method that rolled no further than its last mark keeps its last answer
+            top = max(marks) if marks else 0.0
+            k = MARK_DEG
+            while k <= max(study.reactive.max_rotation_deg, sum(abs(a) for a in study.rolls_deg)) + 1e-9:
+                e = marks.get(round(k, 6), last if k > top else math.inf)
+                per_mark.setdefault(k, []).append(e < study.success_radius)
+                k += MARK_DEG
+        curves[m] = {f"{k:g}": float(np.mean(v)) for k, v in sorted(per_mark.items())}
+    return {"methods": rates, "method_details": details, "success_by_rotation_deg": curves}
+
+
+#: Bins of stated confidence in the reliability diagram (fine near 1, where the stops are).
+RELIABILITY_BINS = (0.0, 0.5, 0.8, 0.9, 0.95, 0.97, 0.99, 0.999, 1.0 + 1e-12)
+
+
+def reliability(study: Study, m: str, rows) -> list:
+    """(mean stated mass, fraction within the success radius, trials) per bin of stated mass."""
+    mass = np.array([_number(r.get(f"{m}_mass", "")) for r in rows])
+    hit = np.array([int(r[f"{m}_success"]) for r in rows])
+    out = []
+    for lo, hi in zip(RELIABILITY_BINS[:-1], RELIABILITY_BINS[1:]):
+        sel = np.isfinite(mass) & (mass >= lo) & (mass < hi)
+        if sel.any():
+            out.append((float(mass[sel].mean()), float(hit[sel].mean()), int(sel.sum())))
+    return out
+
+
+def print_summary(summary: dict) -> None:
+    print(
+        f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
+        f"noise {Path(str(summary['noise'])).name}"
+    )
+    for lv in summary["levels"]:
+        v = "" if lv["value"] is None else f"{lv['parameter']} = {lv['value']}: "
+        rate = lv["success_rate"]
+        print(
+            f"  {v}{lv['success']}/{lv['trials']} within {summary['success_radius']} mm = "
+            f"{rate:.1%} (95% CI {lv['ci95'][0]:.1%}–{lv['ci95'][1]:.1%}), median error "
+            f"{lv['error_median_mm']:.3f} mm"
+            if rate is not None
+            else f"  {v}no trials"
+        )
+        if len(summary["levels"]) > 1:
+            for m, d in lv.get("methods", {}).items():
+                _print_method(m, d, indent="    ")
+    for m, d in summary.get("method_details", {}).items():
+        _print_method(m, d, indent="  ")
+
+
+def _print_method(m: str, d: dict, indent: str) -> None:
+    if not d["trials"]:
+        return
+    rot = "" if d["mean_rotation_deg"] is None else f"mean rotation {d['mean_rotation_deg']:.1f}°, "
+    print(
+        f"{indent}{m:10s} {d['success']}/{d['trials']} = {d['success'] / d['trials']:.1%} "
+        f"(95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), {rot}median error {d['error_median_mm']:.3f} mm; "
+        f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}"
+        + (f"; model mismatch {d['mismatch']}" if d.get("mismatch") else "")
+    )
