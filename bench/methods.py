@@ -4,7 +4,7 @@
 - ``particle``: :class:`localizer.ParticleFilter` over the fixed rolls' step-by-step readings.
 - ``grid``: :class:`localizer.ContactFilter` (the reactive method's filter) over the same readings:
   what the filter alone does with the paper's 35°, without the reactive rolling.
-- ``reactive``: :func:`driver.reactive.localize_reactively` on a fresh rig with the same seed (the
+- ``reactive``: :func:`driver.jaw.reactive.localize_reactively` on a fresh rig with the same seed (the
   same machined part and noise) from the same start.
 
 Each method also gets a curve: its error (mm) had it stopped after every 5° of rolled rotation,
@@ -315,8 +315,8 @@ def reactive_filter(study, part, noise, filter_class=None):
 
 
 def reactive_policy(study):
-    """The :class:`driver.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
-    from driver.reactive import CONFIRM, ReactivePolicy
+    """The :class:`driver.jaw.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
+    from driver.jaw import CONFIRM, ReactivePolicy
 
     o = study.reactive
     return ReactivePolicy(
@@ -358,7 +358,7 @@ def rotation_curve(part, history, rotation_deg: float, final: float, budget_deg:
 def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None, change=None) -> dict:
     """The reactive filter from the same start on a rig with the same seed (in world ``change``: the
     study's ``[world]``, :class:`sim2d.WorldChange`)."""
-    from driver.reactive import localize_reactively
+    from driver.jaw import localize_reactively
     from sim2d import SimRig
 
     o = study.reactive
@@ -415,7 +415,7 @@ def score_methods(
 ) -> dict:
     """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
 
-    ``rolls`` are the fixed rolls' :class:`driver.procedures.RollResult` (None where they could not run
+    ``rolls`` are the fixed rolls' :class:`driver.jaw.RollResult` (None where they could not run
     in the trial's world: ``fixed_failure`` says why, and the fixed-roll methods fail with it); ``rules``
     caches the localizer's results per rule within the trial; ``filter_class`` is the reactive method's
     filter (default :class:`localizer.ContactFilter`); ``change`` the trial's world

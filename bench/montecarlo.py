@@ -16,7 +16,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-from driver.lockfile import LockHeld, hold_lock
+from driver.link import LockHeld, hold_lock
 from localizer import fingerprint, load_part
 
 from .columns import TRIAL_COLUMNS

@@ -1,7 +1,7 @@
 """Soak run: ``rolltouch run`` against the emulator with injected faults, many times in a row.
 
 Every run must end, either localized (exit 0) or with one clear error line (exit 2), within its
-deadline, and leave a run log that reads back (:func:`driver.trace.Trace.from_log`). Each run is its
+deadline, and leave a run log that reads back (:func:`driver.records.trace.Trace.from_log`). Each run is its
 own process (as a user runs it) against an emulator in this process with its own seed; the faults
 default to ``drop=0.05,garble=0.05,delay=0.01``.
 
@@ -26,10 +26,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def soak(runs: int, out: Path, *, faults=DEFAULT_FAULTS, part: str = "parts/trefoil.json", deadline: float = 600.0):
     """Run ``runs`` runs; returns their records (``rc``, ``seconds``, ``outcome``, ``log_ok``, ``last``)."""
-    from driver.emulator import Emulator, Faults
+    from driver.link import Emulator, Faults
+    from driver.records import Trace, read_log
     from driver.rig import RigError
-    from driver.runlog import read_log
-    from driver.trace import Trace
     from localizer import load_part
     from sim2d import SimRig
 

@@ -33,9 +33,9 @@ Several methods on the same trials (instead of ``method``)::
 
     methods = ["paper", "particle", "reactive"]   # first one fills success/error_mm
 
-    [reactive]                           # the sequential filter (driver.reactive)
+    [reactive]                           # the sequential filter (driver.jaw.reactive)
     confidence = 0.95
-    max_rotation_deg = 240.0             # default driver.reactive.MAX_ROTATION
+    max_rotation_deg = 240.0             # default driver.jaw.reactive.MAX_ROTATION
     sd_position = 0.04                   # mm, one contact-location reading   } each optional: the
     sd_scale = 0.003                     # calibration scale                  } filter's own default,
     sd_slope = 0.003                     # rad, the part's slope error        } with its noise scale
@@ -90,9 +90,9 @@ import math
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
-from driver.procedures import STEP_RANGE_DEG
-from driver.reactive import CONFIDENCE, MAX_ROTATION
+from driver.jaw import MAX_ROTATION, STEP_RANGE_DEG
 from localizer import (
+    CONFIDENCE,
     MAX_GRID_POINTS,
     ROLL_STEP,
     SUCCESS_RADIUS,
@@ -142,12 +142,12 @@ _KEYS = {
 
 @dataclass(frozen=True)
 class ReactiveOptions:
-    """[reactive] of a study file (see :func:`driver.reactive.localize_reactively`)."""
+    """[reactive] of a study file (see :func:`driver.jaw.reactive.localize_reactively`)."""
 
     confidence: float = CONFIDENCE
     max_rotation_deg: float = round(math.degrees(MAX_ROTATION), 9)
     check_every: int = 5
-    confirm: int | None = None  # None: driver.reactive.CONFIRM (checks in a row at the confidence)
+    confirm: int | None = None  # None: driver.jaw.reactive.CONFIRM (checks in a row at the confidence)
     sd_position: float | None = None  # None: the filter's default
     sd_scale: float | None = None
     sd_slope: float | str | None = None  # "auto": from the study's noise model

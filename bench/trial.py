@@ -88,7 +88,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
     laid off the point) is redrawn, up to 20 times (``restarts``). With ``methods``, every
     method is scored on that same trial, each on its own.
     """
-    from driver.procedures import calibrate_simulated, laid_off, roll_sequence
+    from driver.jaw import calibrate_simulated, laid_off, roll_sequence
     from driver.rig import RigError
     from sim2d import SimRig
 

@@ -1,6 +1,6 @@
 """Rig protocol, procedures, pipeline, serial rig and the command line (depends on localizer)."""
 
-from .part_match import PartMismatch, check_same_part, part_record
+from .records import PartMismatch, check_same_part, part_record
 from .rig import (
     Clocked,
     ForceServo,

@@ -5,7 +5,18 @@ from pathlib import Path
 
 import pytest
 
-PACKAGES = ("localizer", "passivity", "sim2d", "driver", "driver.cli", "bench")
+PACKAGES = (
+    "localizer",
+    "passivity",
+    "sim2d",
+    "driver",
+    "driver.jaw",
+    "driver.wheel",
+    "driver.link",
+    "driver.records",
+    "driver.cli",
+    "bench",
+)
 
 
 @pytest.mark.parametrize("name", PACKAGES)

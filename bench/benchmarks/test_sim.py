@@ -8,7 +8,7 @@ import math
 import pytest
 
 from bench.benchmarks.baselines import PARTS_DIR
-from driver.procedures import Calibration, establish_contact, roll
+from driver.jaw import Calibration, establish_contact, roll
 from localizer import load_part
 from sim2d import SimRig
 from sim2d.pymunk_world import PymunkWorld

@@ -2,7 +2,7 @@
 
     python -m bench.reports.reactive_figure --out docs/generated/robustness/reactive [--part parts/trefoil.json]
 
-Runs :func:`driver.reactive.localize_reactively` on a simulated rig with the ``paper``
+Runs :func:`driver.jaw.reactive.localize_reactively` on a simulated rig with the ``paper``
 noise and draws (1) the probability of the present contact along the part's
 perimeter at several moments of the roll, and (2) the part with the belief at those
 moments. Writes ``belief.png`` and prints where the run stopped.
@@ -18,8 +18,7 @@ import numpy as np
 
 from bench.methods import reactive_filter, reactive_policy
 from bench.study import load_study
-from driver.procedures import calibrate_simulated
-from driver.reactive import localize_reactively
+from driver.jaw import calibrate_simulated, localize_reactively
 from localizer import load_part
 from sim2d import SimRig, load_noise
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.benchmarks.baselines import PARTS_DIR
-from driver.procedures import (
+from driver.jaw import (
     calibrate_simulated,
     delta_voltages,
     establish_contact,

@@ -21,7 +21,7 @@ from importlib import metadata
 
 from localizer import RolltouchError
 
-from ..signals import handling
+from ..link import handling
 from ._options import UsageError, add_command
 
 __all__ = [

@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 from localizer import (
+    CONFIDENCE,
     DEFAULT_JAW,
     ROLL_STEP,
     SUCCESS_RADIUS,
@@ -20,9 +21,7 @@ from localizer import (
     parse_jaw,
 )
 
-from ..hand import PRESS, PressSettings, ServoSettings
-from ..reactive import CONFIDENCE, MAX_ROTATION
-from ..rolling import STEP_RANGE_DEG
+from ..jaw import MAX_ROTATION, PRESS, STEP_RANGE_DEG, PressSettings, ServoSettings
 
 __all__ = [
     "finite",
@@ -116,7 +115,7 @@ def positive(text: str) -> float:
 
 
 #: What one command may ask the arm to do, checked before anything moves: a rolling step in
-#: :data:`driver.procedures.STEP_RANGE_DEG`; a fixed roll of at most half a turn; a reactive budget of
+#: :data:`driver.jaw.STEP_RANGE_DEG`; a fixed roll of at most half a turn; a reactive budget of
 #: at most two turns; and at most MAX_STEPS rolling steps in all (at the paper's 0.2° and about 0.3 s a
 #: step on a real arm, 20 000 steps is under two hours; with every command's reply deadline this
 #: bounds a run's time too).
@@ -203,7 +202,7 @@ def servo_arguments(p) -> None:
 
 
 def reactive_arguments(p) -> None:
-    """--reactive and its options: roll until the belief is sure (driver.reactive)."""
+    """--reactive and its options: roll until the belief is sure (driver.jaw.reactive)."""
     p.add_argument(
         "--reactive",
         action="store_true",

@@ -53,9 +53,9 @@ def ending_progress_line(log):
 
 def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:
     """Run the reactive localization on ``rig``: the JSON object of 'simulate|run --reactive', the
-    :class:`driver.reactive.ReactiveRun` and its filter's calls (:meth:`driver.filter_log.LoggedFilter.columns`)."""
-    from driver.filter_log import LoggedFilter
-    from driver.reactive import ReactivePolicy, localize_reactively
+    :class:`driver.jaw.ReactiveRun` and its filter's calls (:meth:`driver.records.LoggedFilter.columns`)."""
+    from driver.jaw import ReactivePolicy, localize_reactively
+    from driver.records import LoggedFilter
 
     policy = ReactivePolicy(
         step=math.radians(args.step), confidence=args.confidence, max_rotation=math.radians(args.max_rotation)
@@ -200,7 +200,7 @@ def emit_run(args, doc, part, trace, loc) -> int:
         if "trace" in doc:
             print(f"trace written to {doc['trace']}")
     if args.plot:
-        from driver.plotting import plot_run
+        from driver.records import plot_run
 
         plot_run(part, trace, loc, args.plot)
         if not args.json:

@@ -9,9 +9,9 @@ import sys
 
 from localizer import SUCCESS_RADIUS, QueryError, WheelJaw, wheel_reach_for
 
-from ..part_match import check_same_part, part_record
+from ..records import check_same_part, part_record
 from ..rig import RigError
-from ..wheel_calibration import wheel_calibration_arc
+from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
 from ._output import (
     CONNECTING,
@@ -38,7 +38,7 @@ __all__ = [
 
 def wheel_policy(args):
     """The wheel's rolling from the reactive options (``--confidence``, ``--max-rotation``)."""
-    from ..wheel_disc import WheelPolicy
+    from ..wheel import WheelPolicy
 
     return WheelPolicy(confidence=args.confidence, max_rotation=math.radians(args.max_rotation))
 
@@ -76,7 +76,7 @@ def _emit(args, doc, part, run, out: str | None) -> int:
     if out:
         doc["trace"] = str(out)
     if getattr(args, "plot", None):
-        from driver.plotting import plot_reactive
+        from driver.records import plot_reactive
 
         plot_reactive(part, run, args.plot)
         doc["plot"] = str(args.plot)
@@ -93,9 +93,8 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     """'simulate --jaw wheel:MM --reactive': calibrate a simulated wheel, roll it from --start, save the trace."""
     from sim2d import WheelRig, load_noise
 
-    from ..wheel import localize_with_wheel
-    from ..wheel_calibration import calibrate_wheel
-    from ..wheel_trace import WheelTrace
+    from ..records import WheelTrace
+    from ..wheel import calibrate_wheel, localize_with_wheel
 
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
@@ -146,7 +145,7 @@ def wheel_rig(part, wheel: WheelJaw, args):
 def calibrate_wheel_here(rig, wheel: WheelJaw):
     """'calibrate --jaw wheel:MM': roll 40 mm from the present pose (the hand's axis facing a smooth surface
     the wheel fits, clear of it) and measure the radius and the channels' rotation."""
-    from ..wheel_calibration import calibrate_wheel
+    from ..wheel import calibrate_wheel
 
     return calibrate_wheel(rig, wheel, tuple(rig.pose()))
 
@@ -154,10 +153,8 @@ def calibrate_wheel_here(rig, wheel: WheelJaw):
 def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
     """'run --jaw wheel:MM --reactive': from the present pose (the hand's axis facing the part, clear of it),
     calibrate there unless a calibration is given, then roll until sure."""
-    from ..serial_rig import SerialRig
-    from ..wheel import localize_with_wheel
-    from ..wheel_calibration import calibrate_wheel
-    from ..wheel_disc import WheelCalibration
+    from ..link import SerialRig
+    from ..wheel import WheelCalibration, calibrate_wheel, localize_with_wheel
 
     if not args.reactive:
         raise UsageError(f"a {wheel} rolls until it is sure: give --reactive (fixed --roll rolls are a straight jaw's)")
@@ -205,7 +202,7 @@ def locate_wheel(args, path) -> int:
     """'locate TRACE --part PART' of a wheel's trace: its readings replayed into the filter for its finger."""
     from localizer import load_part
 
-    from ..wheel_trace import WheelTrace
+    from ..records import WheelTrace
 
     trace = WheelTrace.load(path)
     if args.jaw is not None and str(args.jaw) != trace.metadata["jaw"]:

@@ -23,8 +23,15 @@ from localizer import (
     localize,
 )
 
-from ..filter_log import CALLS, LOG_COLUMNS, REACTIVE_FORMAT, calls_from_events, replay_log
-from ..part_match import SAME_PART_FLAG, check_same_part
+from ..records import (
+    CALLS,
+    LOG_COLUMNS,
+    REACTIVE_FORMAT,
+    SAME_PART_FLAG,
+    calls_from_events,
+    check_same_part,
+    replay_log,
+)
 from ..rig import RigError
 from ._options import (
     PLOT_SUFFIXES,
@@ -185,7 +192,7 @@ def localize_command(args) -> int:
             else:
                 print(no_fit_line(result.fit_pvalue))
     if args.plot:
-        from driver.plotting import plot_localization
+        from driver.records import plot_localization
 
         plot_localization(part, result, args.plot)
         if not args.json:
@@ -194,12 +201,11 @@ def localize_command(args) -> int:
 
 
 def locate_command(args) -> int:
-    from driver.trace import Trace, trace_format
-    from driver.wheel_trace import WHEEL_FORMAT
+    from driver.records import WHEEL_FORMAT, Trace, trace_format
 
     check_before_moving(args, {"plot": PLOT_SUFFIXES})
     if str(args.trace).endswith(".jsonl"):
-        from driver.runlog import read_log
+        from driver.records import read_log
 
         events = read_log(args.trace)
         if str(events[0].get("jaw", "straight")).startswith("wheel"):
@@ -217,7 +223,7 @@ def locate_command(args) -> int:
     elif trace_format(args.trace) == WHEEL_FORMAT:
         return locate_wheel(args, args.trace)
     elif trace_format(args.trace) == REACTIVE_FORMAT:
-        from driver.trace import read_archive
+        from driver.records import read_archive
 
         meta, columns = read_archive(args.trace, LOG_COLUMNS)
         truth = read_archive(args.trace, ("true_arcs",))[1]["true_arcs"]  # one per reading: another length
@@ -237,7 +243,7 @@ def locate_command(args) -> int:
 
 def locate_reactive(args, path, meta: dict, columns: dict, truth: np.ndarray) -> int:
     """'locate TRACE --part PART' of a reactive rolling's trace or run log (straight jaw): its filter calls
-    (``columns``, :data:`driver.filter_log.LOG_COLUMNS`) made again on a filter of the default settings, as
+    (``columns``, :data:`driver.records.filter_log.LOG_COLUMNS`) made again on a filter of the default settings, as
     the run's was, and the belief printed as the run printed it; ``meta``: the run's JSON object and part
     record; ``truth``: the true contact at each reading (empty on a real rig).
 

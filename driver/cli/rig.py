@@ -1,6 +1,6 @@
 """Commands on a real rig over serial lines: ``calibrate`` (the wrist sensor, paper §III-B) and ``run``
 (roll and localize). On any failure the run log records it and is closed; the rig itself is made safe
-by :class:`driver.serial_rig.SerialRig` on leaving."""
+by :class:`driver.link.serial_rig.SerialRig` on leaving."""
 
 from __future__ import annotations
 
@@ -10,8 +10,7 @@ import sys
 
 from localizer import SUCCESS_RADIUS, WheelJaw
 
-from ..filter_log import calls_event
-from ..part_match import part_record
+from ..records import calls_event, part_record
 from ._options import (
     PLOT_SUFFIXES,
     STEP_DEG,
@@ -87,8 +86,8 @@ def register(sub) -> None:
 
 
 def calibrate_command(args) -> int:
-    from driver.procedures import calibrate
-    from driver.serial_rig import SerialRig
+    from driver.jaw import calibrate
+    from driver.link import SerialRig
 
     check_before_moving(args, {"out": (".json",)})
     args.interrupted = CONNECTING
@@ -136,11 +135,10 @@ def _progress(event) -> None:
 
 
 def run_command(args) -> int:
-    from driver.procedures import Calibration, run_from_here
-    from driver.runlog import RunLog
-    from driver.serial_rig import SerialRig
-    from driver.trace import Trace
-    from driver.wheel_calibration import check_calibration, load_calibration
+    from driver.jaw import Calibration, run_from_here
+    from driver.link import SerialRig
+    from driver.records import RunLog, Trace
+    from driver.wheel import check_calibration, load_calibration
 
     check_before_moving(args, {"plot": PLOT_SUFFIXES, "log": ()})
     part = read_part(args)
@@ -219,8 +217,8 @@ def _wheel_header(args, part, calibration) -> dict:
 
 def _run_reactively(args, part, calibration, log, observer) -> int:
     """'run --reactive': from the present pose, calibrate if needed, slide 40 mm, roll until sure."""
-    from driver.procedures import Hand, calibrate
-    from driver.serial_rig import SerialRig
+    from driver.jaw import Hand, calibrate
+    from driver.link import SerialRig
 
     def progress(event):
         observer(event)
@@ -243,7 +241,7 @@ def _run_reactively(args, part, calibration, log, observer) -> int:
         doc, _, calls = run_reactive(args, rig, part, calibration, start, observer=progress)
     args.interrupted = RELEASED
     if log is not None:
-        # the filter's calls, for 'locate' to have the belief again (driver.filter_log)
+        # the filter's calls, for 'locate' to have the belief again (driver.records.filter_log)
         log(calls_event(calls))
         log({"event": "result", **doc})
         log.close()

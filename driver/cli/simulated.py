@@ -11,8 +11,7 @@ import numpy as np
 
 from localizer import Outline, QueryError, WheelJaw
 
-from ..filter_log import REACTIVE_FORMAT
-from ..part_match import part_record
+from ..records import REACTIVE_FORMAT, part_record
 from ..rig import RigError
 from ._options import (
     PLOT_SUFFIXES,
@@ -137,8 +136,8 @@ def register(sub) -> None:
 
 
 def simulate_command(args) -> int:
-    from driver.procedures import calibrate_simulated, laid_off, localize_by_rolling
-    from driver.trace import Trace
+    from driver.jaw import calibrate_simulated, laid_off, localize_by_rolling
+    from driver.records import Trace
     from sim2d import SimRig, load_noise
 
     check_before_moving(args, {"out": (".npz",), "plot": PLOT_SUFFIXES})
@@ -189,7 +188,7 @@ def simulate_command(args) -> int:
         )
         doc["trace"] = str(args.out)
         if args.plot:
-            from driver.plotting import plot_reactive
+            from driver.records import plot_reactive
 
             plot_reactive(part, res, args.plot)
             doc["plot"] = str(args.plot)
@@ -258,7 +257,7 @@ def emulate_command(args) -> int:
     import signal
     import threading
 
-    from driver.emulator import Emulator, Faults
+    from driver.link import Emulator, Faults
     from sim2d import SimRig
 
     part = read_part(args)

@@ -14,11 +14,10 @@ from pathlib import Path
 import pytest
 
 from driver.cli import main
-from driver.emulator import Emulator, Faults
-from driver.procedures import Hand, run_from_here
+from driver.jaw import Hand, run_from_here
+from driver.link import Emulator, Faults, SerialRig
+from driver.records import RunLog
 from driver.rig import ImplausibleReading, ProtocolError, RigError
-from driver.runlog import RunLog
-from driver.serial_rig import SerialRig
 from localizer import load_part
 from sim2d import SimRig
 
@@ -249,7 +248,7 @@ def test_arguments_are_refused_before_the_arm_moves(argv, words, capsys):
 
 
 def test_a_roll_of_too_many_steps_is_refused_by_the_procedure():
-    from driver.procedures import roll
+    from driver.jaw import roll
 
     rig = SimRig(PART, noise="none", seed=1)
     hand = Hand(rig, rig.approach_pose(START, jaw_position=0.0, standoff=5.0))
@@ -272,7 +271,7 @@ def test_damaged_and_crafted_traces_are_one_clear_error(tmp_path, monkeypatch):
 
     import numpy as np
 
-    from driver.trace import COLUMNS, Trace
+    from driver.records import COLUMNS, Trace
 
     good = {name: np.zeros(3) for name in COLUMNS}
     meta = np.array(json.dumps({"format": "rolltouch-trace/1", "steps": [], "offsets": [], "calibration": {}}))
@@ -295,9 +294,9 @@ def test_damaged_and_crafted_traces_are_one_clear_error(tmp_path, monkeypatch):
         assert str(path) in text and "pickle" not in text, text
     # a compressed bomb (here against a limit of 1 MB, so that the test writes little): refused from the
     # archive's directory, before anything is unpacked
-    import driver.trace
+    import driver.records.trace
 
-    monkeypatch.setattr(driver.trace, "MAX_TRACE_UNPACKED", 2**20)
+    monkeypatch.setattr(driver.records.trace, "MAX_TRACE_UNPACKED", 2**20)
     bomb = tmp_path / "bomb.npz"
     with zipfile.ZipFile(bomb, "w", compression=zipfile.ZIP_DEFLATED) as z:
         z.writestr("dv1.npy", bytes(8 * 2**20))
@@ -307,8 +306,7 @@ def test_damaged_and_crafted_traces_are_one_clear_error(tmp_path, monkeypatch):
 
 
 def test_bad_run_logs_are_one_clear_error(tmp_path):
-    from driver.runlog import LOG_FORMAT
-    from driver.trace import Trace
+    from driver.records import LOG_FORMAT, Trace
 
     start = json.dumps({"event": "start", "format": LOG_FORMAT, "calibration": {}})
     for name, lines in {

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from driver.cli import main
-from driver.filter_log import CALLS, LOG_COLUMNS, REACTIVE_FORMAT, LoggedFilter, replay_log
+from driver.records import CALLS, LOG_COLUMNS, REACTIVE_FORMAT, LoggedFilter, replay_log
 from localizer import ContactFilter, load_part
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -5,10 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from driver.emulator import Emulator
-from driver.procedures import PressSettings, ServoSettings, establish_contact, hold_force
+from driver.jaw import PressSettings, ServoSettings, establish_contact, hold_force
+from driver.link import Emulator, SerialRig
 from driver.rig import RigError
-from driver.serial_rig import SerialRig
 from localizer import load_part
 from sim2d import SimError, SimRig
 
@@ -119,8 +118,8 @@ def test_simulate_with_an_aggressive_servo_needs_the_guard(tmp_path, capsys):
 def test_a_serial_run_holds_every_press_with_the_guarded_servo(tmp_path):
     import math
 
-    from driver.procedures import run_from_here
-    from driver.runlog import RunLog
+    from driver.jaw import run_from_here
+    from driver.records import RunLog
 
     rig = SimRig(PART, noise="paper", seed=3)
     emu = Emulator(rig, start_pose=rig.approach_pose(120.0, jaw_position=0.0, standoff=1.0))

@@ -1,4 +1,4 @@
-"""A trace or a run log is scored only on the part it was made on (driver.part_match, locate)."""
+"""A trace or a run log is scored only on the part it was made on (driver.records.part_match, locate)."""
 
 import json
 import shutil
@@ -53,7 +53,7 @@ def test_records_without_a_fingerprint_are_checked_by_perimeter():
 
 
 def test_every_trace_kind_records_its_part(kidney_trace, tmp_path):
-    from driver.trace import Trace
+    from driver.records import Trace
 
     mark = part_record(load_part(PARTS / "kidney.csv"), "x")["fingerprint"]
     assert Trace.load(kidney_trace).metadata["part"]["fingerprint"] == mark

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.procedures import (
+from driver.jaw import (
     Calibration,
     Hand,
     calibrate,

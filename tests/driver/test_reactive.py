@@ -5,11 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from driver.emulator import Emulator
-from driver.procedures import calibrate
-from driver.reactive import ReactivePolicy, clear_ahead, localize_reactively, spread_by_direction
+from driver.jaw import ReactivePolicy, calibrate, clear_ahead, localize_reactively, spread_by_direction
+from driver.link import Emulator, SerialRig
 from driver.rig import RigError
-from driver.serial_rig import SerialRig
 from localizer import ContactFilter, load_part
 from sim2d import SimRig
 

@@ -14,13 +14,20 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver.emulator import Emulator, Faults
-from driver.procedures import run_from_here
-from driver.protocol import ARM_COMMANDS, encode_reply, encode_request, parse_reply, parse_request
+from driver.jaw import run_from_here
+from driver.link import (
+    ARM_COMMANDS,
+    Emulator,
+    Faults,
+    SerialRig,
+    Workspace,
+    encode_reply,
+    encode_request,
+    parse_reply,
+    parse_request,
+)
+from driver.records import RunLog, Trace
 from driver.rig import ProtocolError, RigError
-from driver.runlog import RunLog
-from driver.serial_rig import SerialRig, Workspace
-from driver.trace import Trace
 from localizer import load_part
 from sim2d import SimRig
 
@@ -363,7 +370,7 @@ def test_overload_stops_before_the_wrist_is_overloaded(tmp_path):
 
 def test_cli_calibrate_over_the_emulator(tmp_path, capsys):
     from driver.cli import main
-    from driver.procedures import Calibration
+    from driver.jaw import Calibration
 
     emu = emulator(noise="none")
     arm, daq = emu.serve_tcp(0)

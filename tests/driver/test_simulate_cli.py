@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from driver.cli import main
+from driver.records import COLUMNS, Trace
 from driver.rig import RigError
-from driver.trace import COLUMNS, Trace
 from localizer import CircularArc, load_part
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"

@@ -101,9 +101,8 @@ def test_a_mounting_rotation_is_taken_out_by_the_calibration():
 
 
 def test_the_same_wheel_localization_over_the_serial_protocol_and_a_straight_hand_refusing_the_axle():
-    from driver.emulator import Emulator
+    from driver.link import Emulator, SerialRig
     from driver.rig import ProtocolError
-    from driver.serial_rig import SerialRig
 
     part = load_part("parts/kidney.csv")
     wheel = WheelJaw(5.0)
@@ -131,7 +130,7 @@ def test_the_same_wheel_localization_over_the_serial_protocol_and_a_straight_han
 
 
 def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_the_part_itself(tmp_path):
-    from driver.procedures import Calibration
+    from driver.jaw import Calibration
     from driver.wheel import calibrate_wheel, load_calibration
 
     part = load_part("parts/kidney.csv")

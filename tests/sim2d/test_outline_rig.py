@@ -6,8 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.procedures import calibrate_simulated
-from driver.reactive import localize_reactively
+from driver.jaw import calibrate_simulated, localize_reactively
 from localizer import load_outline
 from sim2d import SimRig
 
@@ -138,7 +137,7 @@ def test_calibration_on_a_drawing_is_not_where_the_jaw_lies_flush_on_a_face():
     there works at every seed tried."""
     import math
 
-    from driver.procedures import calibrate_simulated
+    from driver.jaw import calibrate_simulated
     from localizer import CircularArc, Line, calibration_arc, outline_from_pieces
     from sim2d import load_noise
 

@@ -9,17 +9,17 @@ from typing import Any
 
 import numpy as np
 
+from ..rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 from .calibration import Calibration
 from .hand import Hand, PressSettings, press
 from .reactive_policy import ReactivePolicy
-from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 from .rolling import read_location
 
 __all__ = ["JawReadings"]
 
 
 class JawReadings:
-    """The sensing of a reactive run (:class:`driver.reactive` rolls with it): the rig, the hand pressed
+    """The sensing of a reactive run (:class:`driver.jaw.reactive` rolls with it): the rig, the hand pressed
     on the part, the wrist's baseline and calibration, and every reading taken with its truth."""
 
     rig: Rig

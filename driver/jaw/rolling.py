@@ -23,17 +23,7 @@ from localizer import (
     localize,
 )
 
-from .calibration import Calibration, calibrate
-from .hand import (
-    PRESS,
-    Hand,
-    PressSettings,
-    delta_voltages,
-    edge_offset,
-    establish_contact,
-    press,
-)
-from .rig import (
+from ..rig import (
     DEVICE_FAULTS,
     Clocked,
     GroundTruth,
@@ -44,6 +34,16 @@ from .rig import (
     RigError,
     SampleLog,
     Truth,
+)
+from .calibration import Calibration, calibrate
+from .hand import (
+    PRESS,
+    Hand,
+    PressSettings,
+    delta_voltages,
+    edge_offset,
+    establish_contact,
+    press,
 )
 from .roll_result import RollingRun, RollResult
 
@@ -131,7 +131,7 @@ def roll(
 
     ``observer``, if given, is called with a dict for the roll's start
     (``event="roll"``) and for every contact-location reading
-    (``event="reading"``), as they happen (see :mod:`driver.runlog`); ``index``
+    (``event="reading"``), as they happen (see :mod:`driver.records.runlog`); ``index``
     numbers the roll in those events.
     """
     if not (math.isfinite(angle) and angle != 0):

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..rig import ForceServo, ProtocolError, RigError
 from .protocol import ARM_COMMANDS, DAQ_COMMANDS, MAX_LINE, encode_reply, parse_request
-from .rig import ForceServo, ProtocolError, RigError
 
 __all__ = ["Faults", "Emulator"]
 

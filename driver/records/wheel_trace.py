@@ -5,7 +5,7 @@ the arc rolled since the segment's start L (mm, from the axle encoder), the hand
 and on a simulated rig the true contact (mm). The metadata names the
 finger (``jaw``) and holds its calibration, how the run was made and how it ended; a trace is read
 back only as a wheel's (:meth:`WheelTrace.load` refuses a straight jaw's trace, and
-:meth:`driver.trace.Trace.load` a wheel's), and relocalized from its readings with the finger it names.
+:meth:`driver.records.trace.Trace.load` a wheel's), and relocalized from its readings with the finger it names.
 """
 
 from __future__ import annotations
@@ -18,10 +18,9 @@ import numpy as np
 
 from localizer import Belief, Outline, Part, WheelFilter, WheelJaw, parse_jaw
 
-from .rig import RigError
+from ..rig import RigError
+from ..wheel import WheelCalibration, WheelRun
 from .trace import read_archive
-from .wheel import WheelRun
-from .wheel_disc import WheelCalibration
 
 __all__ = ["WheelTrace", "WHEEL_COLUMNS", "WHEEL_FORMAT"]
 
@@ -68,7 +67,7 @@ class WheelTrace:
 
     @classmethod
     def from_log(cls, path) -> WheelTrace:
-        """A trace from a wheel's run log (JSON Lines, :mod:`driver.runlog`), cut short or not: its
+        """A trace from a wheel's run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not: its
         ``reading`` events (L, Ω) and the calibration it logged."""
         from .runlog import read_log
 

@@ -1,5 +1,5 @@
 """Localizing with a wheel finger (the physics in docs/wheel.md; each step of the rolling is a
-:class:`~driver.wheel_disc.WheelDisc` step, checked there for jumps and slip).
+:class:`~driver.wheel.disc.WheelDisc` step, checked there for jumps and slip).
 
 :func:`localize_with_wheel` rolls one way, turning round at a jump, and gives the readings to a
 :class:`localizer.WheelFilter` until it is sure (or the budget is spent). When nothing on the part fits
@@ -15,20 +15,10 @@ from dataclasses import dataclass, field
 
 from localizer import Belief, Outline, Part, WheelFilter, WheelJaw
 
-from .hand import PRESS, PressSettings
-from .rig import Rig, RigError
-from .wheel_calibration import (
-    CALIBRATION_LENGTH,
-    calibrate_wheel,
-    check_calibration,
-    load_calibration,
-    wheel_calibration_arc,
-)
-from .wheel_disc import (
-    JUMP_FLOOR,
-    JUMP_MISMATCH,
+from ..jaw import PRESS, PressSettings
+from ..rig import Rig, RigError
+from .disc import (
     WHEEL_POLICY,
-    AxleEncoder,
     WheelCalibration,
     WheelDisc,
     WheelPolicy,
@@ -36,25 +26,7 @@ from .wheel_disc import (
     kappa_band,
 )
 
-# the rolling's own names, and the disc's and the calibration's that its users import from here
-__all__ = [
-    "AxleEncoder",
-    "WheelCalibration",
-    "WheelPolicy",
-    "WheelRun",
-    "localize_with_wheel",
-    "calibrate_wheel",
-    "load_calibration",
-    "check_calibration",
-    "kappa_band",
-    "corner_pivot",
-    "wheel_calibration_arc",
-    "CALIBRATION_LENGTH",
-    "MAX_RESTARTS",
-    "JUMP_FLOOR",
-    "JUMP_MISMATCH",
-    "WheelSlip",
-]
+__all__ = ["WheelRun", "WheelSlip", "localize_with_wheel", "MAX_RESTARTS"]
 
 #: Times the rolling may start afresh after nothing fit its readings, before it stops "blocked".
 MAX_RESTARTS = 2
@@ -85,7 +57,7 @@ class WheelRun:
         :class:`WheelSlip` instead.
     reversals, jumps : int
     slip : float, mm
-        The rim's slip summed over the run (:mod:`driver.wheel_disc`, step 5).
+        The rim's slip summed over the run (:mod:`driver.wheel.disc`, step 5).
     depth : float, mm
         The wrist's give at the target force (measured at the first press).
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)

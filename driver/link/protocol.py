@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .rig import ProtocolError, RigError
+from ..rig import ProtocolError, RigError
 
 __all__ = [
     "Reply",

@@ -1,6 +1,6 @@
 """A reactive rolling's filter calls, kept so that the belief can be had again from a saved trace.
 
-The reactive rolling (:mod:`driver.reactive`) tells its :class:`localizer.ContactFilter` what it read
+The reactive rolling (:mod:`driver.jaw.reactive`) tells its :class:`localizer.ContactFilter` what it read
 (``update``, ``touch``, ``regrasp``), what it saw (``bridged``), when it started afresh (``reset``) and
 when it asked (``belief``: the fit test and the quarantine it may start happen there). The belief at
 the end depends on all of them and on their order, so :class:`LoggedFilter` keeps them, the outermost

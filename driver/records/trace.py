@@ -21,9 +21,8 @@ import numpy as np
 
 from localizer import arc_from_jaw_positions, check_size
 
-from .calibration import Calibration
-from .rig import RigError
-from .roll_result import RollingRun
+from ..jaw import Calibration, RollingRun
+from ..rig import RigError
 
 __all__ = ["Trace", "COLUMNS", "FORMAT", "read_archive", "trace_format"]
 
@@ -130,7 +129,7 @@ class Trace:
 
     @classmethod
     def from_log(cls, path) -> Trace:
-        """A trace from a run log (JSON Lines, :mod:`driver.runlog`), cut short or not.
+        """A trace from a run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not.
 
         Rolls that the log shows begun but without two readings are dropped.
         """

@@ -1,7 +1,7 @@
 """Reactive localization's rules and its result: how the jaw rolls, turns round, regrasps and stops.
 
 Jia (2005, §V) names "reactive localization which conducts sensing and movement
-simultaneously" as the way forward. :func:`driver.reactive.localize_reactively` does it with
+simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactively` does it with
 :class:`localizer.ContactFilter`:
 
 1. establish contact and measure the wrist's give (the edge offset);
@@ -58,7 +58,7 @@ from localizer import (
     ContactFilter,
 )
 
-from .rig import RigError
+from ..rig import RigError
 
 __all__ = [
     "CONFIRM",

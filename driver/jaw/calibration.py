@@ -12,6 +12,10 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from ..rig import (
+    Rig,
+    RigError,
+)
 from .hand import (
     PRESS,
     Hand,
@@ -19,10 +23,6 @@ from .hand import (
     delta_voltages,
     press,
     zero,
-)
-from .rig import (
-    Rig,
-    RigError,
 )
 
 __all__ = ["Calibration", "calibrate"]

@@ -106,7 +106,7 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
     Parameters
     ----------
     part : localizer.Part
-    trace : driver.trace.Trace
+    trace : driver.records.trace.Trace
     result : localizer.Localization
     path : str or Path
         PNG file to write.
@@ -170,7 +170,7 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
 
 
 def plot_reactive(part, run, path, *, true_arcs=None) -> None:
-    """Draw a reactive localization (:class:`driver.reactive.ReactiveRun`): the part as it is, the stretch
+    """Draw a reactive localization (:class:`driver.jaw.reactive.ReactiveRun`): the part as it is, the stretch
     the contact rolled over (from the readings' truth where known), the estimate with its stated
     probability, and the truth.
 

@@ -11,10 +11,9 @@ import numpy as np
 
 from localizer import Outline, Part, WheelJaw, wheel_reach_for
 
-from .calibration import Calibration
-from .hand import PRESS, PressSettings
-from .rig import Rig, RigError
-from .wheel_disc import WHEEL_POLICY, WheelCalibration, WheelDisc, WheelPolicy, axle_travel, corner_pivot, kappa_band
+from ..jaw import PRESS, Calibration, PressSettings
+from ..rig import Rig, RigError
+from .disc import WHEEL_POLICY, WheelCalibration, WheelDisc, WheelPolicy, axle_travel, corner_pivot, kappa_band
 
 __all__ = ["calibrate_wheel", "load_calibration", "check_calibration", "wheel_calibration_arc", "CALIBRATION_LENGTH"]
 

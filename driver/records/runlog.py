@@ -27,7 +27,7 @@ import numpy as np
 
 from localizer import check_size
 
-from .rig import RigError
+from ..rig import RigError
 
 __all__ = ["RunLog", "read_log", "LOG_FORMAT"]
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rig import (
+from ..rig import (
     ForceServo,
     ImplausibleReading,
     Rig,

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import serial
 
+from ..rig import Pose, ProtocolError, RigError, TransportError
 from .lockfile import LockHeld, hold_lock
 from .protocol import MAX_LINE, Reply, encode_request, parse_reply
-from .rig import Pose, ProtocolError, RigError, TransportError
 from .signals import handling
 
 __all__ = ["SerialRig", "Workspace"]
@@ -65,7 +65,7 @@ class SerialRig:
     move_speed : float, mm/s
         The arm's speed, for MOVE deadlines.
     log : callable or None
-        Called with a dict for every command and reading (see :mod:`driver.runlog`).
+        Called with a dict for every command and reading (see :mod:`driver.records.runlog`).
     """
 
     def __init__(

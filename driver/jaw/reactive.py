@@ -2,7 +2,7 @@
 
 Jia (2005, §V) names "reactive localization which conducts sensing and movement simultaneously" as
 the way forward. :func:`localize_reactively` does it with :class:`localizer.ContactFilter`, by the
-rules of :class:`driver.reactive_policy.ReactivePolicy` (listed in :mod:`driver.reactive_policy`).
+rules of :class:`driver.jaw.reactive_policy.ReactivePolicy` (listed in :mod:`driver.jaw.reactive_policy`).
 
 Works on any :class:`driver.rig.Rig` (simulated or serial).
 """
@@ -15,7 +15,6 @@ from dataclasses import replace
 import numpy as np
 
 from localizer import (
-    CONFIDENCE,
     UNEXPLAINED,
     Belief,
     Boundary,
@@ -23,12 +22,11 @@ from localizer import (
     arc_from_jaw_positions,
 )
 
+from ..rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 from .calibration import Calibration
 from .hand import PRESS, PressSettings, edge_offset, establish_contact
 from .reactive_policy import (
-    CONFIRM,
     MAX_LEAVES,
-    MAX_ROTATION,
     REACTIVE_POLICY,
     ReactivePolicy,
     ReactiveRun,
@@ -36,17 +34,8 @@ from .reactive_policy import (
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
-from .rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 
-__all__ = [
-    "ReactiveRun",
-    "ReactivePolicy",
-    "localize_reactively",
-    "spread_by_direction",
-    "CONFIRM",
-    "CONFIDENCE",
-    "MAX_ROTATION",
-]
+__all__ = ["localize_reactively"]
 
 
 def localize_reactively(
@@ -61,7 +50,7 @@ def localize_reactively(
     observer=None,
 ) -> ReactiveRun:
     """Roll until the contact is known within the filter's radius with the ``policy``'s confidence (the
-    rules: :mod:`driver.reactive_policy`).
+    rules: :mod:`driver.jaw.reactive_policy`).
 
     Parameters
     ----------

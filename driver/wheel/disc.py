@@ -1,7 +1,7 @@
 """A wheel finger pressed on the part: its servo and one checked rolling step (the physics in docs/wheel.md).
 
 The hand pose (x, y, φ) is the axle's place and the hand's angle; the hand's axis m = (−sin φ, cos φ)
-points at the part, as the straight jaw's normal does, so :func:`driver.procedures.press` presses a
+points at the part, as the straight jaw's normal does, so :func:`driver.jaw.press` presses a
 wheel too. Each rolling step:
 
 1. moves the axle ``step`` mm along the hand's tangent e = (cos φ, sin φ) (times the direction);
@@ -28,7 +28,7 @@ wheel too. Each rolling step:
    :class:`WheelSlip`, as the L readings are no longer the part's arc).
 
 :class:`WheelDisc` is that step, :class:`WheelPolicy` its settings and the rolling's, :class:`WheelCalibration`
-the calibrated constants that turn its readings into (L, Ω) (:mod:`driver.wheel_calibration` finds them),
+the calibrated constants that turn its readings into (L, Ω) (:mod:`driver.wheel.calibration` finds them),
 and :func:`localize_with_wheel` (:mod:`driver.wheel`) rolls with it.
 """
 
@@ -42,11 +42,10 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from localizer import Outline, Part, WheelJaw, wheel_reach_for
+from localizer import CONFIDENCE, Outline, Part, WheelJaw, wheel_reach_for
 
-from .hand import Hand, PressSettings, delta_voltages, press, zero
-from .reactive import CONFIDENCE, MAX_ROTATION
-from .rig import GroundTruth, Rig, RigError
+from ..jaw import MAX_ROTATION, Hand, PressSettings, delta_voltages, press, zero
+from ..rig import GroundTruth, Rig, RigError
 
 __all__ = [
     "AxleEncoder",

@@ -1,0 +1,49 @@
+"""What a run leaves: traces (npz) of both fingers, run logs (JSON lines), the filter's logged calls
+and their replay, plots, and the part's record that keeps a trace from being scored on another part.
+"""
+
+from .filter_log import (
+    CALLS,
+    FILTER_CALLS_EVENT,
+    LOG_COLUMNS,
+    REACTIVE_FORMAT,
+    LoggedFilter,
+    calls_event,
+    calls_from_events,
+    replay_log,
+)
+from .part_match import SAME_PART_FLAG, PartMismatch, check_same_part, part_record
+from .plotting import draw_part, plot_localization, plot_reactive, plot_run
+from .runlog import LOG_FORMAT, RunLog, read_log
+from .trace import COLUMNS, FORMAT, Trace, read_archive, trace_format
+from .wheel_trace import WHEEL_COLUMNS, WHEEL_FORMAT, WheelTrace
+
+__all__ = [
+    "CALLS",
+    "FILTER_CALLS_EVENT",
+    "LOG_COLUMNS",
+    "LoggedFilter",
+    "REACTIVE_FORMAT",
+    "calls_event",
+    "calls_from_events",
+    "replay_log",
+    "PartMismatch",
+    "SAME_PART_FLAG",
+    "check_same_part",
+    "part_record",
+    "draw_part",
+    "plot_localization",
+    "plot_reactive",
+    "plot_run",
+    "LOG_FORMAT",
+    "RunLog",
+    "read_log",
+    "COLUMNS",
+    "FORMAT",
+    "Trace",
+    "read_archive",
+    "trace_format",
+    "WHEEL_COLUMNS",
+    "WHEEL_FORMAT",
+    "WheelTrace",
+]
