@@ -10,7 +10,7 @@ know the true contact (:class:`GroundTruth`: a simulated rig) and keep a log of 
 
 from __future__ import annotations
 
-from typing import NamedTuple, Protocol, runtime_checkable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 from localizer import RolltouchError
 
@@ -59,7 +59,7 @@ class ProtocolError(RigError):
         The request's sequence number (0 when it could not be read).
     """
 
-    def __init__(self, code: str, message: str, seq: int = 0):
+    def __init__(self, code: str, message: str, seq: int = 0) -> None:
         super().__init__(f"{code}: {message}")
         self.code = code
         self.message = message
@@ -77,10 +77,10 @@ class Rig(Protocol):
     def move(self, x: float, y: float, phi: float) -> None:
         """Move the hand to (``x``, ``y``) mm, jaw angle ``phi`` rad, and return when it is there."""
 
-    def pose(self) -> tuple:
+    def pose(self) -> tuple[float, float, float]:
         """The arm's reading of the hand pose, (x mm, y mm, φ rad) (a :class:`Pose` or any 3-tuple)."""
 
-    def read(self, n: int = 32) -> tuple:
+    def read(self, n: int = 32) -> tuple[float, float]:
         """The sensor's (v1, v2) in volts, averaged over ``n`` samples."""
 
 
@@ -130,7 +130,7 @@ class Truth(NamedTuple):
 class ForceServo(Protocol):
     """A rig whose arm can hold the contact force with its own servo loop."""
 
-    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5) -> dict:
+    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5) -> dict[str, Any]:
         """Hold Δv1 at ``target`` V with force-error ``gain`` for ``duration`` s, ``guard``: with the passivity
         controller. Returns ``dv1``, ``dv1_std``, ``contact_lost``, ``min_energy``, ``guard``."""
         ...
@@ -147,7 +147,7 @@ class Clocked(Protocol):
 class GroundTruth(Protocol):
     """A rig that knows where the contact really is (a simulated rig)."""
 
-    def truth(self) -> dict:
+    def truth(self) -> dict[str, Any]:
         """``contact_arc`` (mm on the part, NaN without contact) and ``jaw_position`` (mm), at least."""
         ...
 
@@ -156,7 +156,7 @@ class GroundTruth(Protocol):
 class SampleLog(Protocol):
     """A rig that keeps every raw sample it read (with ground truth on a simulated rig)."""
 
-    samples: list
+    samples: list[dict[str, Any]]
 
 
 #: What the rolling never takes for a bridge or a lost contact: a device that did not answer, a

@@ -17,7 +17,9 @@ import argparse
 import importlib
 import signal
 import sys
+from collections.abc import Callable, Sequence
 from importlib import metadata
+from typing import Any
 
 from localizer import RolltouchError
 
@@ -50,7 +52,7 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
-def _registrars() -> list:
+def _registrars() -> list[Callable[[Any], None]]:
     """The ``register`` functions: driver's groups, then the entry points' (by name)."""
     found = [importlib.import_module(name).register for name in COMMAND_GROUPS]
     for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
@@ -89,7 +91,7 @@ def _notes(exc: BaseException) -> str:
     return "; ".join(getattr(exc, "__notes__", []))
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Run ``rolltouch`` with ``argv`` (default: the process's); returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)

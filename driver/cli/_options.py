@@ -6,13 +6,16 @@ from __future__ import annotations
 import argparse
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from localizer import (
     CONFIDENCE,
     DEFAULT_JAW,
     ROLL_STEP,
     SUCCESS_RADIUS,
+    Finger,
     Outline,
     Part,
     RolltouchError,
@@ -59,15 +62,17 @@ class UsageError(RolltouchError, ValueError):
     """Flags that do not go together; the command line reports it as argparse's own error."""
 
 
-def add_command(sub, name: str, run, **kwargs) -> argparse.ArgumentParser:
+def add_command(
+    sub: Any, name: str, run: Callable[[argparse.Namespace], int], **kwargs: Any
+) -> argparse.ArgumentParser:
     """Add the subcommand ``name`` to ``sub`` (the subparsers of ``rolltouch``) with ``run(args) -> int``
     as what it does; ``kwargs`` go to ``add_parser`` (help, description)."""
-    p = sub.add_parser(name, **kwargs)
+    p: argparse.ArgumentParser = sub.add_parser(name, **kwargs)
     p.set_defaults(run=run, parser=p)
     return p
 
 
-def part_arguments(p, help: str = "part file") -> None:
+def part_arguments(p: argparse.ArgumentParser, help: str = "part file") -> None:
     """The part: a point file (JSON or CSV) or a CAD drawing (DXF or SVG), and which of the drawing's
     layers or elements holds the outline."""
     p.add_argument("part", help=f"{help}: JSON or CSV points, or a DXF or SVG drawing (its outer outline)")
@@ -75,12 +80,12 @@ def part_arguments(p, help: str = "part file") -> None:
     p.add_argument("--element", metavar="ID", help="SVG: read the outline from the element with this id")
 
 
-def read_part(args) -> Part | Outline:
+def read_part(args: argparse.Namespace) -> Part | Outline:
     """The part that :func:`part_arguments` named."""
     return load_part(args.part, layer=getattr(args, "layer", None), element=getattr(args, "element", None))
 
 
-def _number(text: str, ok, what: str) -> float:
+def _number(text: str, ok: Callable[[float], bool], what: str) -> float:
     """``text`` as a float that ``ok`` accepts (argparse type; else its error naming the value)."""
     try:
         value = float(text)
@@ -146,7 +151,7 @@ def budget_degrees(text: str) -> float:
     return _number(text, lambda v: 0 < v <= MAX_BUDGET_DEG, f"positive and at most {MAX_BUDGET_DEG:g}°")
 
 
-def check_before_moving(args, outputs: dict[str, tuple[str, ...]]) -> None:
+def check_before_moving(args: argparse.Namespace, outputs: dict[str, tuple[str, ...]]) -> None:
     """Refuse, before the first command reaches the arm, what would fail later: rolls that turn both
     ways, more than :data:`MAX_STEPS` rolling steps, and output files that cannot be written (``outputs``:
     argument name → the suffixes it must end in, empty for any). Raises :class:`UsageError`."""
@@ -182,14 +187,14 @@ def writable_file(path: str, flag: str, suffixes: tuple[str, ...] = ()) -> None:
         raise UsageError(f"{flag} {path}: not writable")
 
 
-def rig_arguments(p) -> None:
+def rig_arguments(p: argparse.ArgumentParser) -> None:
     """--arm, --daq and --timeout of the commands that talk to a rig."""
     p.add_argument("--arm", required=True, metavar="URL", help="arm controller: device path or pyserial URL")
     p.add_argument("--daq", required=True, metavar="URL", help="DAQ: device path or pyserial URL")
     p.add_argument("--timeout", type=positive, default=2.0, metavar="S", help="reply deadline (default 2 s)")
 
 
-def servo_arguments(p) -> None:
+def servo_arguments(p: argparse.ArgumentParser) -> None:
     """--servo-gain and --no-guard: hold the force with the arm's servo after every press."""
     p.add_argument(
         "--servo-gain",
@@ -201,7 +206,7 @@ def servo_arguments(p) -> None:
     p.add_argument("--no-guard", action="store_true", help="run that servo without its passivity observer/controller")
 
 
-def reactive_arguments(p) -> None:
+def reactive_arguments(p: argparse.ArgumentParser) -> None:
     """--reactive and its options: roll until the belief is sure (driver.jaw.reactive)."""
     p.add_argument(
         "--reactive",
@@ -225,7 +230,7 @@ def reactive_arguments(p) -> None:
     )
 
 
-def pressing(args) -> PressSettings:
+def pressing(args: argparse.Namespace) -> PressSettings:
     """The presses that --servo-gain and --no-guard ask for: the paper's, then the arm's servo if given."""
     if args.servo_gain is None:
         if args.no_guard:
@@ -234,7 +239,7 @@ def pressing(args) -> PressSettings:
     return PressSettings(servo=ServoSettings(gain=args.servo_gain, guard=not args.no_guard))
 
 
-def jaw_spec(text: str):
+def jaw_spec(text: str) -> Finger:
     """argparse type of ``--jaw``: a finger (:func:`localizer.parse_jaw`). The rig models the paper's 100 mm
     straight jaw (its wrist and the calibration's ±50 mm taps) and wheels of any radius."""
     try:
@@ -249,7 +254,7 @@ def jaw_spec(text: str):
     return finger
 
 
-def jaw_argument(p, default=DEFAULT_JAW) -> None:
+def jaw_argument(p: argparse.ArgumentParser, default: Finger | None = DEFAULT_JAW) -> None:
     """--jaw: the finger, the paper's straight jaw or a wheel on an axle encoder (docs/wheel.md)."""
     p.add_argument(
         "--jaw",

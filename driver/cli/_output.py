@@ -2,15 +2,24 @@
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import json
 import math
 import sys
+from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING, Any
 
-from localizer import FIT_ALPHA, SUCCESS_RADIUS
+from localizer import FIT_ALPHA, SUCCESS_RADIUS, Belief, Localization, Outline, Part
 
-from ..rig import GroundTruth
+from ..rig import GroundTruth, Rig
 from ._options import pressing
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..jaw import Calibration, ReactiveRun
+    from ..records import RunLog, Trace
 
 __all__ = [
     "CONNECTING",
@@ -37,7 +46,7 @@ RELEASED = "the arm's part of the run had ended: nothing was moving"
 
 
 @contextlib.contextmanager
-def ending_progress_line(log):
+def ending_progress_line(log: RunLog | None) -> Iterator[None]:
     """End the progress line on stderr; on any failure log it and close the run log, then re-raise."""
     try:
         yield
@@ -51,7 +60,14 @@ def ending_progress_line(log):
         raise
 
 
-def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> tuple:
+def run_reactive(
+    args: argparse.Namespace,
+    rig: Rig,
+    part: Part | Outline,
+    calibration: Calibration,
+    approach_pose: tuple[float, float, float],
+    observer: Callable[[dict[str, Any]], object] | None = None,
+) -> tuple[dict[str, Any], ReactiveRun, dict[str, np.ndarray]]:
     """Run the reactive localization on ``rig``: the JSON object of 'simulate|run --reactive', the
     :class:`driver.jaw.ReactiveRun` and its filter's calls (:meth:`driver.records.LoggedFilter.columns`)."""
     from driver.jaw import ReactivePolicy, localize_reactively
@@ -86,7 +102,7 @@ def run_reactive(args, rig, part, calibration, approach_pose, observer=None) -> 
     return doc, res, flt.columns()
 
 
-def belief_fields(b) -> dict:
+def belief_fields(b: Belief) -> dict[str, Any]:
     """``estimate_arc``, ``mass``, ``ambiguous``, ``informative``, ``consistent`` and ``mismatch`` of a belief,
     for a rolling's JSON object. ``mismatch`` is null, or where on the model the part seems to differ from
     it: ``{"from_arc", "to_arc"}`` (mm, counter-clockwise) and ``size_mm`` (how far the readings there are
@@ -110,7 +126,7 @@ def belief_fields(b) -> dict:
     }
 
 
-def mismatch_line(doc) -> str | None:
+def mismatch_line(doc: dict[str, Any]) -> str | None:
     """The ending's line when the part seems not to be its model (``doc["mismatch"]``), else None."""
     m = doc.get("mismatch")
     if m is None:
@@ -129,12 +145,12 @@ def mismatch_line(doc) -> str | None:
     )
 
 
-def exit_status(doc) -> int:
+def exit_status(doc: dict[str, Any]) -> int:
     """2 when a rolling found the part not to be its model (:func:`mismatch_line`), else 0."""
     return 2 if mismatch_line(doc) is not None else 0
 
 
-def truth_fields(part, b, rig) -> dict:
+def truth_fields(part: Part | Outline, b: Belief, rig: Rig) -> dict[str, Any]:
     """``true_arc`` and ``error_mm`` (mm) of a belief on a rig that knows the truth (nothing on a real rig)."""
     if not isinstance(rig, GroundTruth):
         return {}
@@ -143,7 +159,7 @@ def truth_fields(part, b, rig) -> dict:
     return {"true_arc": true_arc, "error_mm": error}
 
 
-def print_reactive(doc) -> None:
+def print_reactive(doc: dict[str, Any]) -> None:
     print(
         f"rolled {doc['rotation_deg']:.1f}° in {doc['steps']} steps ({doc['stopped']}, "
         f"{doc['reversals']} reversals, {doc['regrasps']} regrasps)"
@@ -151,7 +167,7 @@ def print_reactive(doc) -> None:
     print_belief(doc)
 
 
-def print_belief(doc) -> None:
+def print_belief(doc: dict[str, Any]) -> None:
     """The verdict, the other modes and the truth of a rolling's JSON object (either finger); a model
     mismatch last, as the ending."""
     verdict = "AMBIGUOUS" if doc["ambiguous"] else ("no information" if not doc["informative"] else "localized")
@@ -169,7 +185,7 @@ def print_belief(doc) -> None:
         print(line)
 
 
-def run_summary(part, trace, loc) -> dict:
+def run_summary(part: Part | Outline, trace: Trace, loc: Localization) -> dict[str, Any]:
     """The JSON object of 'simulate' and 'locate'."""
     best = loc.best
     estimate = best.end_arc if best is not None else None
@@ -189,7 +205,9 @@ def run_summary(part, trace, loc) -> dict:
     return doc
 
 
-def emit_run(args, doc, part, trace, loc) -> int:
+def emit_run(
+    args: argparse.Namespace, doc: dict[str, Any], part: Part | Outline, trace: Trace, loc: Localization
+) -> int:
     """Print a run's result (JSON or text) and draw it if asked: simulate, locate and run alike. Returns
     the exit status: 2 when the readings fit no place on the part (:func:`no_fit_line`), else 0."""
     if args.json:
@@ -217,7 +235,7 @@ def no_fit_line(pvalue: float) -> str:
     )
 
 
-def print_run(doc) -> None:
+def print_run(doc: dict[str, Any]) -> None:
     for k, e in enumerate(doc["estimates"]):
         print(f"roll {k + 1}: L = {e['length']:.3f} mm, Ω = {e['turn_deg']:.3f}°")
     if doc["estimate_arc"] is None:

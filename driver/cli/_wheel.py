@@ -3,14 +3,17 @@ emulate and locate, each the wheel's counterpart of the straight jaw's."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
-from localizer import SUCCESS_RADIUS, QueryError, WheelJaw, wheel_reach_for
+from localizer import SUCCESS_RADIUS, Outline, Part, QueryError, WheelJaw, wheel_reach_for
 
 from ..records import check_same_part, part_record
-from ..rig import RigError
+from ..rig import Rig, RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
 from ._output import (
@@ -24,6 +27,13 @@ from ._output import (
 )
 from ._world import world_change, world_fields
 
+if TYPE_CHECKING:
+    from sim2d import WheelRig
+
+    from ..jaw import Calibration
+    from ..records import RunLog
+    from ..wheel import WheelCalibration, WheelPolicy, WheelRun
+
 __all__ = [
     "wheel_policy",
     "wheel_doc",
@@ -36,14 +46,14 @@ __all__ = [
 ]
 
 
-def wheel_policy(args):
+def wheel_policy(args: argparse.Namespace) -> WheelPolicy:
     """The wheel's rolling from the reactive options (``--confidence``, ``--max-rotation``)."""
     from ..wheel import WheelPolicy
 
     return WheelPolicy(confidence=args.confidence, max_rotation=math.radians(args.max_rotation))
 
 
-def wheel_doc(part, run, rig, calibration) -> dict:
+def wheel_doc(part: Part | Outline, run: WheelRun, rig: Rig, calibration: WheelCalibration) -> dict[str, Any]:
     """The JSON object of a wheel's run."""
     b = run.belief
     return {
@@ -64,7 +74,7 @@ def wheel_doc(part, run, rig, calibration) -> dict:
     }
 
 
-def print_wheel(doc) -> None:
+def print_wheel(doc: dict[str, Any]) -> None:
     print(
         f"{doc['jaw']}: rolled {doc['arc_mm']:.1f} mm, the hand turned {doc['rotation_deg']:.1f}°, in {doc['steps']} "
         f"steps ({doc['stopped']}, {doc['jumps']} jumps undone, slip {doc['slip_mm']:+.3f} mm)"
@@ -72,7 +82,7 @@ def print_wheel(doc) -> None:
     print_belief(doc)
 
 
-def _emit(args, doc, part, run, out: str | None) -> int:
+def _emit(args: argparse.Namespace, doc: dict[str, Any], part: Part | Outline, run: WheelRun, out: str | None) -> int:
     if out:
         doc["trace"] = str(out)
     if getattr(args, "plot", None):
@@ -89,7 +99,7 @@ def _emit(args, doc, part, run, out: str | None) -> int:
     return exit_status(doc)
 
 
-def simulate_wheel(args, part, wheel: WheelJaw) -> int:
+def simulate_wheel(args: argparse.Namespace, part: Part | Outline, wheel: WheelJaw) -> int:
     """'simulate --jaw wheel:MM --reactive': calibrate a simulated wheel, roll it from --start, save the trace."""
     from sim2d import WheelRig, load_noise
 
@@ -133,7 +143,9 @@ def simulate_wheel(args, part, wheel: WheelJaw) -> int:
     return _emit(args, doc, part, run, args.out)
 
 
-def wheel_rig(part, wheel: WheelJaw, args):
+def wheel_rig(
+    part: Part | Outline, wheel: WheelJaw, args: argparse.Namespace
+) -> tuple[WheelRig, tuple[float, float, float]]:
     """The simulated wheel rig 'emulate --jaw wheel:MM' serves, and its start pose (the wheel 1 mm off)."""
     from sim2d import WheelRig
 
@@ -142,7 +154,7 @@ def wheel_rig(part, wheel: WheelJaw, args):
     return rig, rig.approach_pose(start)
 
 
-def calibrate_wheel_here(rig, wheel: WheelJaw):
+def calibrate_wheel_here(rig: Rig, wheel: WheelJaw) -> WheelCalibration:
     """'calibrate --jaw wheel:MM': roll 40 mm from the present pose (the hand's axis facing a smooth surface
     the wheel fits, clear of it) and measure the radius and the channels' rotation."""
     from ..wheel import calibrate_wheel
@@ -150,7 +162,14 @@ def calibrate_wheel_here(rig, wheel: WheelJaw):
     return calibrate_wheel(rig, wheel, tuple(rig.pose()))
 
 
-def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
+def run_wheel(
+    args: argparse.Namespace,
+    part: Part | Outline,
+    wheel: WheelJaw,
+    calibration: Calibration | WheelCalibration | None,
+    log: RunLog | None,
+    observer: Callable[[dict[str, Any]], object],
+) -> int:
     """'run --jaw wheel:MM --reactive': from the present pose (the hand's axis facing the part, clear of it),
     calibrate there unless a calibration is given, then roll until sure."""
     from ..link import SerialRig
@@ -163,7 +182,7 @@ def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
             raise RigError(f"the calibration is for {calibration.jaw}, the finger is {wheel}: calibrate this finger")
         calibration.check(wheel)
 
-    def progress(event):
+    def progress(event: dict[str, Any]) -> None:
         if event.get("event") == "reading" and log is not None:
             log(event)
         if event.get("event") == "belief":
@@ -198,7 +217,7 @@ def run_wheel(args, part, wheel: WheelJaw, calibration, log, observer) -> int:
     return _emit(args, doc, part, run, None)
 
 
-def locate_wheel(args, path) -> int:
+def locate_wheel(args: argparse.Namespace, path: str) -> int:
     """'locate TRACE --part PART' of a wheel's trace: its readings replayed into the filter for its finger."""
     from localizer import load_part
 

@@ -3,14 +3,21 @@
 
 from __future__ import annotations
 
+import argparse
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from ._options import UsageError
 
+if TYPE_CHECKING:
+    from localizer import Outline, Part
+    from sim2d import SimRig, WheelRig, WorldChange
+
 __all__ = ["world_change", "world_fields"]
 
 
-def world_change(args, part):
+def world_change(args: argparse.Namespace, part: Part | Outline) -> WorldChange | None:
     """The world ``--world`` or ``--world-part`` describes for this run (None: the model as machined)."""
     from localizer import load_part
     from sim2d import WorldChange, load_world
@@ -25,7 +32,7 @@ def world_change(args, part):
     return None
 
 
-def world_fields(change, rig) -> dict:
+def world_fields(change: WorldChange | None, rig: SimRig | WheelRig) -> dict[str, Any]:
     """How the simulated world differed from its model, for a trace's metadata and the JSON output."""
     if change is None:
         return {}

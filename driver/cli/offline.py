@@ -3,11 +3,14 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import sys
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from localizer import (
     DEFAULT_JAW,
@@ -49,7 +52,7 @@ from ._wheel import locate_wheel
 __all__ = ["register", "localize_command", "locate_command", "locate_reactive"]
 
 
-def register(sub) -> None:
+def register(sub: Any) -> None:
     """Add ``localize`` and ``locate`` to the subparsers ``sub``."""
     loc = add_command(
         sub,
@@ -134,7 +137,7 @@ def register(sub) -> None:
     lct.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
 
 
-def localize_command(args) -> int:
+def localize_command(args: argparse.Namespace) -> int:
     check_before_moving(args, {"plot": PLOT_SUFFIXES})
     part = read_part(args)
     rolls = [(args.length, np.radians(args.turn))] + [(L, np.radians(d)) for L, d in args.then]
@@ -149,7 +152,7 @@ def localize_command(args) -> int:
         turn_tol=float(np.radians(args.turn_tol)),
     )
 
-    def xy(arc):
+    def xy(arc: float) -> list[float]:
         return [float(v) for v in part.point_at_arc(arc)]
 
     if args.json:
@@ -200,7 +203,7 @@ def localize_command(args) -> int:
     return 0 if result.consistent else 2
 
 
-def locate_command(args) -> int:
+def locate_command(args: argparse.Namespace) -> int:
     from driver.records import WHEEL_FORMAT, Trace, trace_format
 
     check_before_moving(args, {"plot": PLOT_SUFFIXES})
@@ -212,7 +215,7 @@ def locate_command(args) -> int:
             return locate_wheel(args, args.trace)
         columns = calls_from_events(events)
         if columns is not None:
-            result: dict = next((e for e in reversed(events) if e.get("event") == "result"), {})
+            result: dict[str, Any] = next((e for e in reversed(events) if e.get("event") == "result"), {})
             meta = {**result, "part": events[0].get("part")}
             return locate_reactive(args, args.trace, meta, columns, np.array([], dtype=float))
         if any(e.get("event") == "belief" for e in events):
@@ -241,7 +244,13 @@ def locate_command(args) -> int:
     return emit_run(args, run_summary(part, trace, loc), part, trace, loc)
 
 
-def locate_reactive(args, path, meta: dict, columns: dict, truth: np.ndarray) -> int:
+def locate_reactive(
+    args: argparse.Namespace,
+    path: str,
+    meta: dict[str, Any],
+    columns: dict[str, np.ndarray],
+    truth: NDArray[np.float64],
+) -> int:
     """'locate TRACE --part PART' of a reactive rolling's trace or run log (straight jaw): its filter calls
     (``columns``, :data:`driver.records.filter_log.LOG_COLUMNS`) made again on a filter of the default settings, as
     the run's was, and the belief printed as the run printed it; ``meta``: the run's JSON object and part
@@ -259,7 +268,7 @@ def locate_reactive(args, path, meta: dict, columns: dict, truth: np.ndarray) ->
     part = load_part(args.part)
     check_same_part(meta.get("part"), part, args.part, f"trace {path}", same=args.same_part)
     b = replay_log(ContactFilter(part), columns)
-    doc = {
+    doc: dict[str, Any] = {
         "part": part.name,
         "method": "reactive",
         **{k: meta[k] for k in ("stopped", "rotation_deg", "steps", "reversals", "regrasps") if k in meta},

@@ -4,11 +4,14 @@ by :class:`driver.link.serial_rig.SerialRig` on leaving."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, cast
 
-from localizer import SUCCESS_RADIUS, WheelJaw
+from localizer import SUCCESS_RADIUS, Outline, Part, StraightJaw, WheelJaw
 
 from ..records import calls_event, part_record
 from ._options import (
@@ -38,10 +41,16 @@ from ._output import (
 )
 from ._wheel import calibrate_wheel_here, run_wheel
 
+if TYPE_CHECKING:
+    from ..jaw import Calibration
+    from ..link import SerialRig
+    from ..records import RunLog
+    from ..wheel import WheelCalibration
+
 __all__ = ["register", "calibrate_command", "run_command"]
 
 
-def register(sub) -> None:
+def register(sub: Any) -> None:
     """Add ``calibrate`` and ``run`` to the subparsers ``sub``."""
     cal = add_command(
         sub,
@@ -85,7 +94,7 @@ def register(sub) -> None:
     run.add_argument("--json", action="store_true", help="print the same object as 'rolltouch locate --json'")
 
 
-def calibrate_command(args) -> int:
+def calibrate_command(args: argparse.Namespace) -> int:
     from driver.jaw import calibrate
     from driver.link import SerialRig
 
@@ -113,7 +122,7 @@ def calibrate_command(args) -> int:
     return 0
 
 
-def _check_straight_hand(rig, jaw) -> None:
+def _check_straight_hand(rig: SerialRig, jaw: StraightJaw) -> None:
     """Refuse, before anything moves, to run a straight jaw's procedure on a hand with a wheel: its
     readings would say only "no contact"."""
     from driver.rig import RigError
@@ -125,7 +134,7 @@ def _check_straight_hand(rig, jaw) -> None:
         )
 
 
-def _progress(event) -> None:
+def _progress(event: dict[str, Any]) -> None:
     if event.get("event") == "reading":
         sys.stderr.write(
             f"\rroll {event['roll'] + 1}  step {event['step']:>4}/{event['steps']}  "
@@ -134,7 +143,7 @@ def _progress(event) -> None:
         sys.stderr.flush()
 
 
-def run_command(args) -> int:
+def run_command(args: argparse.Namespace) -> int:
     from driver.jaw import Calibration, run_from_here
     from driver.link import SerialRig
     from driver.records import RunLog, Trace
@@ -147,7 +156,7 @@ def run_command(args) -> int:
     if loaded is not None:
         check_calibration(loaded, args.jaw)
     if isinstance(args.jaw, WheelJaw):
-        log = RunLog(args.log, _wheel_header(args, part, loaded)) if args.log else None
+        log = RunLog(args.log, _wheel_header(args, part, cast("WheelCalibration | None", loaded))) if args.log else None
         return run_wheel(args, part, args.jaw, loaded, log, lambda event: None)
     calibration = loaded if isinstance(loaded, Calibration) else None
     header = {
@@ -166,7 +175,7 @@ def run_command(args) -> int:
         }
     log = RunLog(args.log, header) if args.log else None
 
-    def observer(event):
+    def observer(event: dict[str, Any]) -> None:
         if log is not None:
             log(event)
         _progress(event)
@@ -203,7 +212,9 @@ def run_command(args) -> int:
     return emit_run(args, doc, part, trace, run.localization)
 
 
-def _wheel_header(args, part, calibration) -> dict:
+def _wheel_header(
+    args: argparse.Namespace, part: Part | Outline, calibration: WheelCalibration | None
+) -> dict[str, Any]:
     header = {
         "jaw": str(args.jaw),
         "part": part_record(part, args.part),
@@ -215,12 +226,18 @@ def _wheel_header(args, part, calibration) -> dict:
     return header
 
 
-def _run_reactively(args, part, calibration, log, observer) -> int:
+def _run_reactively(
+    args: argparse.Namespace,
+    part: Part | Outline,
+    calibration: Calibration | None,
+    log: RunLog | None,
+    observer: Callable[[dict[str, Any]], object],
+) -> int:
     """'run --reactive': from the present pose, calibrate if needed, slide 40 mm, roll until sure."""
     from driver.jaw import Hand, calibrate
     from driver.link import SerialRig
 
-    def progress(event):
+    def progress(event: dict[str, Any]) -> None:
         observer(event)
         if event.get("event") == "belief":
             sys.stderr.write(

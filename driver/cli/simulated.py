@@ -3,13 +3,15 @@ arm's and the DAQ's serial protocols from a simulated rig)."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 from dataclasses import asdict
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from localizer import Outline, QueryError, WheelJaw
+from localizer import Outline, Part, QueryError, WheelJaw
 
 from ..records import REACTIVE_FORMAT, part_record
 from ..rig import RigError
@@ -34,10 +36,13 @@ from ._output import emit_run, exit_status, print_reactive, run_reactive, run_su
 from ._wheel import simulate_wheel, wheel_rig
 from ._world import world_change, world_fields
 
+if TYPE_CHECKING:
+    from sim2d import SimRig, WheelRig
+
 __all__ = ["register", "simulate_command", "emulate_command"]
 
 
-def register(sub) -> None:
+def register(sub: Any) -> None:
     """Add ``simulate`` and ``emulate`` to the subparsers ``sub``."""
     sim = add_command(
         sub,
@@ -135,7 +140,7 @@ def register(sub) -> None:
     )
 
 
-def simulate_command(args) -> int:
+def simulate_command(args: argparse.Namespace) -> int:
     from driver.jaw import calibrate_simulated, laid_off, localize_by_rolling
     from driver.records import Trace
     from sim2d import SimRig, load_noise
@@ -169,7 +174,7 @@ def simulate_command(args) -> int:
             true_arcs=np.array(res.true_arcs),
             segments=np.array(res.segments),
             history=np.array(res.history, dtype=float).reshape(-1, 4),
-            **calls,
+            **cast(dict[str, Any], calls),
             metadata=np.array(
                 json.dumps(
                     {
@@ -233,7 +238,7 @@ def simulate_command(args) -> int:
     return emit_run(args, doc, part, trace, run.localization)
 
 
-def _check_reach(part, start: float, jaw: float) -> None:
+def _check_reach(part: Part | Outline, start: float, jaw: float) -> None:
     """Refuse, before anything moves, a start the jaw cannot be laid on with the contact at ``jaw`` mm."""
     from localizer import DEFAULT_JAW, reach_for
 
@@ -253,7 +258,7 @@ def _check_reach(part, start: float, jaw: float) -> None:
     )
 
 
-def emulate_command(args) -> int:
+def emulate_command(args: argparse.Namespace) -> int:
     import signal
     import threading
 
@@ -262,7 +267,7 @@ def emulate_command(args) -> int:
 
     part = read_part(args)
     faults = Faults.parse(args.fault)
-    rig: object
+    rig: SimRig | WheelRig
     if isinstance(args.jaw, WheelJaw):
         rig, start_pose = wheel_rig(part, args.jaw, args)
     else:

@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from ..rig import (
@@ -52,14 +55,14 @@ class Calibration:
     10.0
     """
 
-    positions: tuple
-    ratios: tuple
+    positions: tuple[float, ...]
+    ratios: tuple[float, ...]
     target: float = 0.4
     jaw: str = "straight:100"
-    _r: np.ndarray = field(init=False, repr=False, compare=False)  # the ratios, ascending
-    _d: np.ndarray = field(init=False, repr=False, compare=False)  # the positions in that order, mm
+    _r: NDArray[np.float64] = field(init=False, repr=False, compare=False)  # the ratios, ascending
+    _d: NDArray[np.float64] = field(init=False, repr=False, compare=False)  # the positions in that order, mm
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         d = np.asarray(self.positions, float)
         r = np.asarray(self.ratios, float)
         if d.size < 4 or d.size != r.size or not np.all(np.isfinite(r)):
@@ -96,13 +99,13 @@ class Calibration:
             )
         return float(np.interp(r, self._r, self._d))
 
-    def save(self, path) -> None:
+    def save(self, path: str | os.PathLike[str]) -> None:
         """Write as JSON."""
         doc = {"jaw": self.jaw, "positions": list(self.positions), "ratios": list(self.ratios), "target": self.target}
         Path(path).write_text(json.dumps(doc, indent=2) + "\n")
 
     @classmethod
-    def load(cls, path) -> Calibration:
+    def load(cls, path: str | os.PathLike[str]) -> Calibration:
         """Read a calibration written by :meth:`save`."""
         try:
             data = json.loads(Path(path).read_text())
@@ -116,7 +119,7 @@ class Calibration:
 
 def calibrate(
     rig: Rig,
-    approach_pose,
+    approach_pose: Iterable[float],
     *,
     taps: int = 11,
     span: float = 50.0,
@@ -135,7 +138,7 @@ def calibrate(
     Hand(rig, (x0, y0, phi))
     baseline = zero(rig)  # clear of the object
     positions = np.linspace(-span, span, taps)
-    ratios = []
+    ratios: list[float] = []
     for d in positions:
         hand = Hand(rig, (x0 - d * math.cos(phi), y0 - d * math.sin(phi), phi))
         press(rig, hand, baseline, target=target, pressing=pressing)

@@ -7,7 +7,9 @@ means moving along m = (-sin φ, cos φ)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -45,12 +47,12 @@ class Hand:
     the commanded pose so that quantization does not accumulate.
     """
 
-    def __init__(self, rig: Rig, pose):
+    def __init__(self, rig: Rig, pose: Iterable[float]) -> None:
         self.rig = rig
-        self.pose = tuple(float(v) for v in pose)
+        self.pose: tuple[float, ...] = tuple(float(v) for v in pose)
         rig.move(*self.pose)
 
-    def go(self, x, y, phi) -> None:
+    def go(self, x: float, y: float, phi: float) -> None:
         self.pose = (float(x), float(y), float(phi))
         self.rig.move(*self.pose)
 
@@ -111,7 +113,7 @@ class ServoSettings:
     duration: float = 0.3
     max_std: float | None = 0.05
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not (math.isfinite(self.gain) and self.gain > 0):
             raise RigError(f"servo gain={self.gain!r} must be a positive number")
         if not (math.isfinite(self.duration) and self.duration > 0):
@@ -149,7 +151,7 @@ class PressSettings:
     max_steps: int = 60
     servo: ServoSettings | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name in ("tol", "slope", "search_step", "max_travel", "overload"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
@@ -162,7 +164,7 @@ class PressSettings:
 PRESS = PressSettings()
 
 
-def zero(rig: Rig, n: int = 256) -> tuple:
+def zero(rig: Rig, n: int = 256) -> tuple[float, float]:
     """The default readings (v1, v2) with the jaw clear of everything, V: the middle of three readings of
     ``n`` samples each, channel by channel, so that one spike of the DAQ does not shift every place read
     after it."""
@@ -170,7 +172,7 @@ def zero(rig: Rig, n: int = 256) -> tuple:
     return float(np.median(three[:, 0])), float(np.median(three[:, 1]))
 
 
-def delta_voltages(rig: Rig, baseline, n: int) -> tuple:
+def delta_voltages(rig: Rig, baseline: tuple[float, float], n: int) -> tuple[float, float]:
     """(Δv1, Δv2), V: the wrist's two channels averaged over ``n`` samples, against their ``baseline``
     (the jaw clear, :func:`zero`)."""
     v1, v2 = rig.read(n)
@@ -180,12 +182,12 @@ def delta_voltages(rig: Rig, baseline, n: int) -> tuple:
 def press(
     rig: Rig,
     hand: Hand,
-    baseline,
+    baseline: tuple[float, float],
     *,
     target: float = 0.4,
     n: int = 32,
     pressing: PressSettings = PRESS,
-) -> tuple:
+) -> tuple[float, float]:
     """Translate along the jaw normal until Δv1 = ``target`` ± ``pressing.tol`` V (the paper's feedback).
 
     Parameters
@@ -268,7 +270,7 @@ def hold_force(
     guard: bool = True,
     duration: float = 0.5,
     max_std: float | None = None,
-) -> dict:
+) -> dict[str, Any]:
     """Hold Δv1 = ``target`` V with the arm's own sampled force servo, optionally passivity-guarded.
 
     The paper's feedback (translate along the normal until Δv1 ≈ 0.4 V) as a
@@ -306,8 +308,14 @@ def hold_force(
 
 
 def establish_contact(
-    rig: Rig, approach_pose, *, baseline=None, target: float = 0.4, n: int = 32, pressing: PressSettings = PRESS
-):
+    rig: Rig,
+    approach_pose: Iterable[float],
+    *,
+    baseline: tuple[float, float] | None = None,
+    target: float = 0.4,
+    n: int = 32,
+    pressing: PressSettings = PRESS,
+) -> tuple[Hand, tuple[float, float], tuple[float, float]]:
     """Move to ``approach_pose`` (clear of the part), zero the sensor unless a ``baseline`` is given, press
     until Δv1 ≈ ``target`` V (``n`` samples a reading, as ``pressing`` says).
 
@@ -320,7 +328,7 @@ def establish_contact(
     return hand, baseline, reading
 
 
-def edge_offset(rig: Rig, hand: Hand, baseline, *, probe: float = 0.1, n: int = 64) -> float:
+def edge_offset(rig: Rig, hand: Hand, baseline: tuple[float, float], *, probe: float = 0.1, n: int = 64) -> float:
     """How far the wrist has given at the present force, mm: Δv1 over dΔv1/d(press).
 
     Presses ``probe`` mm in and out around the present pose (Δv1 is

@@ -10,7 +10,9 @@ Works on any :class:`driver.rig.Rig` (simulated or serial).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -43,11 +45,11 @@ def localize_reactively(
     part: Boundary,
     *,
     calibration: Calibration,
-    approach_pose,
+    approach_pose: Iterable[float],
     filter: ContactFilter | None = None,
     policy: ReactivePolicy = REACTIVE_POLICY,
     pressing: PressSettings = PRESS,
-    observer=None,
+    observer: Callable[[dict[str, Any]], object] | None = None,
 ) -> ReactiveRun:
     """Roll until the contact is known within the filter's radius with the ``policy``'s confidence (the
     rules: :mod:`driver.jaw.reactive_policy`).
@@ -89,7 +91,7 @@ class _Roller(JawReadings):
         calibration: Calibration,
         policy: ReactivePolicy,
         pressing: PressSettings,
-        observer,
+        observer: Callable[[dict[str, Any]], object] | None,
     ) -> None:
         self.rig, self.flt, self.calibration, self.policy = rig, flt, calibration, policy
         self.pressing, self.observer = pressing, observer
@@ -102,7 +104,7 @@ class _Roller(JawReadings):
         self.blocked = {1: False, -1: False}
         self.arcs: list[float] = [0.0]
         self.turns: list[float] = [0.0]
-        self.history: list[tuple] = []
+        self.history: list[tuple[float, float, float, float]] = []
         self.segments: list[int] = [0]
         # nothing is known yet: counter-clockwise, like the paper
         self.direction = 1 if policy.direction is None else policy.direction
@@ -119,7 +121,7 @@ class _Roller(JawReadings):
         self.rereads = 0  # readings taken again because one jumped
 
     # ------------------------------------------------------------------ the run
-    def run(self, approach_pose) -> ReactiveRun:
+    def run(self, approach_pose: Iterable[float]) -> ReactiveRun:
         """Establish contact at ``approach_pose`` and roll until sure, blocked, lost or out of budget."""
         rig, flt, p = self.rig, self.flt, self.policy
         flt.reset()

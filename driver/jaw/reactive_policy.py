@@ -46,9 +46,12 @@ Works on any :class:`driver.rig.Rig` (simulated or serial).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from localizer import (
     BRIDGE_JUMP,
@@ -123,18 +126,23 @@ class ReactiveRun:
     reversals: int
     regrasps: int = 0
     bridges: int = 0
-    history: tuple = field(repr=False, default=())
-    arcs: tuple = field(repr=False, default=())
-    turns: tuple = field(repr=False, default=())
-    true_arcs: tuple = field(repr=False, default=())
-    segments: tuple = field(repr=False, default=())
+    history: tuple[tuple[float, float, float, float], ...] = field(repr=False, default=())
+    arcs: tuple[float, ...] = field(repr=False, default=())
+    turns: tuple[float, ...] = field(repr=False, default=())
+    true_arcs: tuple[float, ...] = field(repr=False, default=())
+    segments: tuple[int, ...] = field(repr=False, default=())
 
     @property
     def estimate_arc(self) -> float:
         return self.belief.map_arc
 
 
-def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = (0.0, 0.0), starts=None) -> tuple:
+def spread_by_direction(
+    flt: ContactFilter,
+    lookahead: float,
+    explored: tuple[float, ...] = (0.0, 0.0),
+    starts: Sequence[float] | None = None,
+) -> tuple[float, ...]:
     """(spread ccw, spread cw) in mm: how far apart hypotheses' predicted arcs move over the next
     ``lookahead`` rad of *unexplored* rotation each way.
 
@@ -150,7 +158,7 @@ def spread_by_direction(flt: ContactFilter, lookahead: float, explored: tuple = 
         starts = [m.start_arc for m in flt.belief().modes[:2]]
     idx = flt.tracks.node_at(starts)
     jaw = _jaw_now(flt, idx)
-    out = []
+    out: list[float] = []
     for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
         a, ok_a = flt.tracks.roll(idx, edge, **jaw)
         b, ok_b = flt.tracks.roll(idx, edge + sign * lookahead, **jaw)
@@ -171,7 +179,7 @@ def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, at: float 
     return float(np.sum(w[top][ok]) / np.sum(w[top]))
 
 
-def _jaw_now(flt: ContactFilter, idx) -> dict:
+def _jaw_now(flt: ContactFilter, idx: NDArray[np.intp]) -> dict[str, Any]:
     """Where the jaw touches now, as :meth:`localizer.ModeTracks.roll` takes it (nothing before a reading)."""
     if not math.isfinite(flt.jaw_position):
         return {}
@@ -230,7 +238,7 @@ class ReactivePolicy:
     confirm: int = CONFIRM
     reread_jump: float = 1.0
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if not (math.isfinite(self.step) and self.step > 0):
             raise RigError(f"step={self.step!r} rad must be positive")
         if not (math.isfinite(self.max_rotation) and self.max_rotation > 0):

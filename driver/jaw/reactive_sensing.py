@@ -5,7 +5,6 @@ jaw's turn so far."""
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
@@ -24,7 +23,7 @@ class JawReadings:
 
     rig: Rig
     hand: Hand
-    baseline: Any
+    baseline: tuple[float, float]
     calibration: Calibration
     policy: ReactivePolicy
     pressing: PressSettings

@@ -4,10 +4,13 @@ and a whole rolling run's rolls and localization."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 from localizer import (
     Localization,
 )
+
+from ..rig import Reading, Truth
 
 __all__ = ["RollResult", "RollingRun"]
 
@@ -51,14 +54,14 @@ class RollResult:
 
     length: float
     turn: float
-    positions: tuple
-    angles: tuple
+    positions: tuple[float, ...]
+    angles: tuple[float, ...]
     largest_jump: float
     jaw_travel: float = 0.0
     offset: float = 0.0
     step: float = 0.0
-    readings: tuple = ()
-    truth: tuple = ()
+    readings: tuple[Reading, ...] = ()
+    truth: tuple[Truth, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -75,10 +78,10 @@ class RollingRun:
         The rig's log of readings (with ground truth on a simulated rig), if it keeps one.
     """
 
-    rolls: tuple
-    estimates: tuple
+    rolls: tuple[RollResult, ...]
+    estimates: tuple[tuple[float, float], ...]
     localization: Localization
-    samples: list = field(default_factory=list, repr=False)
+    samples: list[dict[str, Any]] = field(default_factory=list, repr=False)
 
     @property
     def estimate_arc(self) -> float:
@@ -86,7 +89,7 @@ class RollingRun:
         best = self.localization.best
         return float("nan") if best is None else best.end_arc
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         return {
             "estimates": [list(e) for e in self.estimates],
             "rolls": [asdict(r) for r in self.rolls],

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Iterable
+from typing import Any, cast
 
 import numpy as np
 
@@ -79,12 +81,20 @@ def laid_off(part: Boundary, first_contact: float, start: float, tolerance: floa
     return math.isfinite(first_contact) and abs(float(part.arc_offset(first_contact, start))) > tolerance
 
 
-def _clock(rig) -> float:
+def _clock(rig: Rig) -> float:
     """The rig's clock (s): a simulated rig's own time, else the process's monotonic clock."""
     return float(rig.time) if isinstance(rig, Clocked) else time.monotonic()
 
 
-def read_location(rig, baseline, calibration, n, readings=None, truth=None, hand=None):
+def read_location(
+    rig: Rig,
+    baseline: tuple[float, float],
+    calibration: Calibration,
+    n: int,
+    readings: list[Reading] | None = None,
+    truth: list[Truth] | None = None,
+    hand: Hand | None = None,
+) -> float:
     """Contact location on the jaw (mm) from one averaged reading; logs the reading."""
     dv1, dv2 = delta_voltages(rig, baseline, n)
     if readings is not None:
@@ -92,7 +102,7 @@ def read_location(rig, baseline, calibration, n, readings=None, truth=None, hand
         phi = hand.measured_angle() if hand is not None else rig.pose()[2]
         readings.append(Reading(dv1, dv2, phi, _clock(rig), x, y, phi_cmd))
         t = rig.truth() if isinstance(rig, GroundTruth) else {}
-        truth.append(Truth(t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
+        cast("list[Truth]", truth).append(Truth(t.get("contact_arc", math.nan), t.get("jaw_position", math.nan)))
     if dv1 <= 0.1 * calibration.target:
         raise RigError(f"lost contact while rolling (Δv1 = {dv1:.4g} V)")
     return calibration.position(dv2 / dv1)
@@ -101,7 +111,7 @@ def read_location(rig, baseline, calibration, n, readings=None, truth=None, hand
 def roll(
     rig: Rig,
     hand: Hand,
-    baseline,
+    baseline: tuple[float, float],
     calibration: Calibration,
     angle: float,
     *,
@@ -109,7 +119,7 @@ def roll(
     n: int = 32,
     offset: float | None = None,
     bridge_jump: float | None = BRIDGE_JUMP,
-    observer=None,
+    observer: Callable[[dict[str, Any]], object] | None = None,
     index: int = 0,
     pressing: PressSettings = PRESS,
     faces: tuple[tuple[float, float], ...] = (),
@@ -161,7 +171,7 @@ def roll(
             }
         )
 
-    def observe(j):
+    def observe(j: int) -> None:
         if observer is not None:
             r, t = readings[-1], truth[-1]
             observer(
@@ -238,7 +248,9 @@ FACE_ANGLE_TOL = math.radians(0.1)
 FACE_JUMP_TOL = 0.5
 
 
-def crossed_face(faces, phi_from: float, phi_to: float, jump: float, first: bool) -> bool:
+def crossed_face(
+    faces: Iterable[tuple[float, float]], phi_from: float, phi_to: float, jump: float, first: bool
+) -> bool:
     """Whether a jump of ``jump`` mm along the jaw, in a step that turned it from ``phi_from`` to
     ``phi_to`` (rad), is the jaw tipping over one of ``faces`` ((tangent angle rad, length mm) pairs).
 
@@ -261,17 +273,17 @@ def crossed_face(faces, phi_from: float, phi_to: float, jump: float, first: bool
 
 def roll_sequence(
     rig: Rig,
-    rolls,
+    rolls: Iterable[float],
     *,
     calibration: Calibration,
-    approach_pose,
+    approach_pose: Iterable[float],
     step: float = ROLL_STEP,
     n: int = 32,
     bridge_jump: float = BRIDGE_JUMP,
-    observer=None,
+    observer: Callable[[dict[str, Any]], object] | None = None,
     pressing: PressSettings = PRESS,
     faces: tuple[tuple[float, float], ...] = (),
-) -> tuple:
+) -> tuple[RollResult, ...]:
     """Establish contact and roll by each angle of ``rolls`` (rad), all the same way; no localization.
 
     Returns the tuple of :class:`RollResult`. A roll that bridges a concave stretch is
@@ -284,7 +296,7 @@ def roll_sequence(
     if len({a > 0 for a in rolls}) != 1:
         raise RigError(f"rolls {rolls!r} must all turn the same way")
     hand, baseline, _ = establish_contact(rig, approach_pose, target=calibration.target, n=n, pressing=pressing)
-    results = []
+    results: list[RollResult] = []
     for k, angle in enumerate(rolls):
         try:
             results.append(
@@ -323,17 +335,17 @@ def _in_roll(exc: RigError, k: int) -> RigError:
 def localize_by_rolling(
     rig: Rig,
     part: Part | Outline,
-    rolls,
+    rolls: Iterable[float],
     *,
     calibration: Calibration,
-    approach_pose,
+    approach_pose: Iterable[float],
     step: float = ROLL_STEP,
     n: int = 32,
     bridge_jump: float = BRIDGE_JUMP,
     rule: str = "likelihood",
     sd_length: float = SD_LENGTH,
     sd_turn: float = SD_TURN,
-    observer=None,
+    observer: Callable[[dict[str, Any]], object] | None = None,
     pressing: PressSettings = PRESS,
 ) -> RollingRun:
     """Establish contact, roll by each angle of ``rolls`` (rad), estimate (L, Ω), localize.
@@ -375,13 +387,13 @@ def localize_by_rolling(
 def run_from_here(
     rig: Rig,
     part: Part | Outline,
-    rolls,
+    rolls: Iterable[float],
     *,
     calibration: Calibration | None = None,
     slide: float = 40.0,
-    observer=None,
-    **options,
-):
+    observer: Callable[[dict[str, Any]], object] | None = None,
+    **options: Any,
+) -> tuple[RollingRun, Calibration]:
     """The whole job from the arm's present pose, as ``rolltouch run`` does it.
 
     The operator has jogged the jaw's centre to face the start point on the

@@ -13,12 +13,17 @@ import socket
 import threading
 import time
 import tty
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ..rig import ForceServo, ProtocolError, RigError
 from .protocol import ARM_COMMANDS, DAQ_COMMANDS, MAX_LINE, encode_reply, parse_request
+
+if TYPE_CHECKING:
+    from sim2d import SimRig, WheelRig
 
 __all__ = ["Faults", "Emulator"]
 
@@ -83,10 +88,10 @@ class Faults:
             raise bad("drift", self.drift, "a drift must be finite, within ±1 V/s")
 
     @classmethod
-    def parse(cls, specs) -> Faults:
+    def parse(cls, specs: Iterable[str] | None) -> Faults:
         """From strings ``name=value`` (the attributes, with ``-`` for ``_``: ``drop=0.05``,
         ``encoder-stuck=200``, ...)."""
-        kwargs = {}
+        kwargs: dict[str, Any] = {}
         names = {
             "drop": float,
             "garble": float,
@@ -127,7 +132,14 @@ class Emulator:
         Seeds the fault injection.
     """
 
-    def __init__(self, rig, *, start_pose=None, faults: Faults = Faults(), seed: int = 0):
+    def __init__(
+        self,
+        rig: SimRig | WheelRig,
+        *,
+        start_pose: tuple[float, float, float] | None = None,
+        faults: Faults = Faults(),
+        seed: int = 0,
+    ) -> None:
         self.rig = rig
         self.faults = faults
         self.rng = np.random.default_rng(seed)
@@ -136,14 +148,14 @@ class Emulator:
         self.stopped = threading.Event()
         self.zero = (0.0, 0.0)
         self.input_range = 10.0  # V: the DAQ's input range, reported by STATUS
-        self._closers: list = []
+        self._closers: list[Callable[..., object]] = []
         self._stuck_phi: float | None = None  # the angle a stuck encoder keeps reporting, rad
         self._t0 = time.monotonic()  # the drifting zero's clock
         if start_pose is not None:
             rig.move(*start_pose)
 
     # ------------------------------------------------------------ devices
-    def _arm(self, seq, cmd, args):
+    def _arm(self, seq: int, cmd: str, args: list[float]) -> list[bytes]:
         f = self.faults
         if f.encoder_stuck is not None and self.arm_commands > f.encoder_stuck and self._stuck_phi is None:
             self._stuck_phi = self.rig.pose()[2]
@@ -163,7 +175,7 @@ class Emulator:
         if cmd == "AXLE":
             if not callable(getattr(self.rig, "axle", None)):
                 return [encode_reply(seq, "ERR", "UNSUPPORTED", "this hand has no wheel on an axle encoder")]
-            return [encode_reply(seq, "OK", float(math.degrees(self.rig.axle())))]
+            return [encode_reply(seq, "OK", float(math.degrees(cast("WheelRig", self.rig).axle())))]
         if cmd == "SERVO":
             target, gain, guard, ms = args
             if not (target > 0 and gain >= 0 and guard in (0, 1) and 1 <= ms <= 10000):
@@ -177,7 +189,7 @@ class Emulator:
             return [encode_reply(seq, "OK", r["dv1"], r["dv1_std"], float(r["contact_lost"]), r["min_energy"])]
         return [encode_reply(seq, "OK", "READY")]
 
-    def _sample(self, n):
+    def _sample(self, n: int) -> tuple[float, float]:
         if self.faults.daq_constant is not None:
             return float(self.faults.daq_constant), float(self.faults.daq_constant)
         v1, v2 = self.rig.read(n)
@@ -188,7 +200,7 @@ class Emulator:
             v1, v2 = float(np.clip(v1, -s, s)), float(np.clip(v2, -s, s))
         return float(v1), float(v2)
 
-    def _daq(self, seq, cmd, args):
+    def _daq(self, seq: int, cmd: str, args: list[float]) -> list[bytes]:
         if cmd == "READ":
             n = int(args[0])
             if not 1 <= n <= 10000:
@@ -205,7 +217,7 @@ class Emulator:
             return [encode_reply(seq, "OK")]
         return [encode_reply(seq, "OK", "READY", float(self.faults.saturate or self.input_range))]
 
-    def handle(self, device: str, line: bytes) -> list:
+    def handle(self, device: str, line: bytes) -> list[bytes]:
         """Replies to one request line of ``device`` ("arm" or "daq")."""
         commands = ARM_COMMANDS if device == "arm" else DAQ_COMMANDS
         try:
@@ -221,7 +233,7 @@ class Emulator:
                 return self._arm(seq, cmd, args)
             return self._daq(seq, cmd, args)
 
-    def _faulty(self, replies):
+    def _faulty(self, replies: list[bytes]) -> list[bytes]:
         out = []
         for r in replies:
             if self.faults.drop and self.rng.random() < self.faults.drop:
@@ -234,7 +246,7 @@ class Emulator:
             out.append(r)
         return out
 
-    def _serve(self, device, read, write):
+    def _serve(self, device: str, read: Callable[[], bytes], write: Callable[[bytes], object]) -> None:
         buf = b""
         while not self.stopped.is_set():
             try:
@@ -262,7 +274,7 @@ class Emulator:
                 buf = b""
 
     # ---------------------------------------------------------- transports
-    def serve_tcp(self, port: int, host: str = "127.0.0.1"):
+    def serve_tcp(self, port: int, host: str = "127.0.0.1") -> tuple[str, ...]:
         """Listen on host:port (arm) and host:port+1 (DAQ); returns the two URLs.
 
         ``port=0`` lets the system pick two free ports (for tests).
@@ -287,7 +299,7 @@ class Emulator:
             urls.append(f"socket://{host}:{srv.getsockname()[1]}")
         return tuple(urls)
 
-    def _accept(self, device, srv):
+    def _accept(self, device: str, srv: socket.socket) -> None:
         while not self.stopped.is_set():
             try:
                 conn, _ = srv.accept()
@@ -298,7 +310,7 @@ class Emulator:
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             self._closers.append(conn.close)
 
-            def shutdown(c=conn):
+            def shutdown(c: socket.socket = conn) -> None:
                 with contextlib.suppress(OSError):
                     c.shutdown(socket.SHUT_RDWR)
 
@@ -307,7 +319,7 @@ class Emulator:
                 target=self._serve, args=(device, lambda c=conn: c.recv(4096), conn.sendall), daemon=True
             ).start()
 
-    def serve_pty(self):
+    def serve_pty(self) -> tuple[str, ...]:
         """Serve on two pseudo-terminals; returns their device paths (arm, DAQ)."""
         paths = []
         for device in ("arm", "daq"):

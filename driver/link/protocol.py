@@ -48,7 +48,7 @@ def _number(x: float) -> str:
     return repr(x)
 
 
-def encode_request(seq: int, command: str, *args) -> bytes:
+def encode_request(seq: int, command: str, *args: float) -> bytes:
     """``<seq> <COMMAND> [args...]\\n`` (numbers written exactly, as Python's repr).
 
     Examples
@@ -62,7 +62,7 @@ def encode_request(seq: int, command: str, *args) -> bytes:
     return (" ".join(parts) + "\n").encode("ascii")
 
 
-def encode_reply(seq: int, status: str, *fields) -> bytes:
+def encode_reply(seq: int, status: str, *fields: str | float) -> bytes:
     """``<seq> <OK|DATA|ERR> [fields...] *<cc>\\n``; float fields written exactly.
 
     Examples
@@ -92,9 +92,9 @@ class Reply:
 
     seq: int
     status: str
-    fields: tuple
+    fields: tuple[str, ...]
 
-    def numbers(self, count: int) -> tuple:
+    def numbers(self, count: int) -> tuple[float, ...]:
         """The first ``count`` fields as floats (RigError if they are not)."""
         if len(self.fields) < count:
             raise RigError(f"reply {self.seq} carries {len(self.fields)} values, expected {count}")
@@ -145,7 +145,7 @@ def parse_reply(line: bytes) -> Reply:
     return Reply(int(words[0]), words[1], tuple(words[2:]))
 
 
-def parse_request(line: bytes, commands: dict):
+def parse_request(line: bytes, commands: dict[str, int]) -> tuple[int, str, list[float]]:
     """(seq, command, args) of a request line, for the device side.
 
     Raises

@@ -17,8 +17,11 @@ import os
 import signal
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from types import TracebackType
+from typing import IO, Any, Literal, Self, cast
 
 import serial
 
@@ -34,11 +37,11 @@ __all__ = ["SerialRig", "Workspace"]
 class Workspace:
     """Reachable hand poses: x, y in mm, φ in rad (a box; defaults are generous)."""
 
-    x: tuple = (-500.0, 500.0)
-    y: tuple = (-500.0, 500.0)
-    phi: tuple = (-4 * math.pi, 4 * math.pi)
+    x: tuple[float, float] = (-500.0, 500.0)
+    y: tuple[float, float] = (-500.0, 500.0)
+    phi: tuple[float, float] = (-4 * math.pi, 4 * math.pi)
 
-    def check(self, x, y, phi) -> None:
+    def check(self, x: float, y: float, phi: float) -> None:
         for name, v, (lo, hi) in (("x", x, self.x), ("y", y, self.y), ("phi", phi, self.phi)):
             if not (math.isfinite(v) and lo <= v <= hi):
                 raise RigError(f"move refused: {name}={v!r} is outside the workspace [{lo}, {hi}]")
@@ -79,9 +82,9 @@ class SerialRig:
         backoff: float = 5.0,
         workspace: Workspace = Workspace(),
         move_speed: float = 20.0,
-        log=None,
+        log: Callable[[dict[str, Any]], object] | None = None,
         baudrate: int = 115200,
-    ):
+    ) -> None:
         self.timeout = float(timeout)
         self.retries = int(retries)
         self.overload = float(overload)
@@ -91,8 +94,8 @@ class SerialRig:
         self.log = log
         self._seq = 0
         self._commanded: tuple[float, float, float] | None = None
-        self.ports = {}
-        self._locks: list = []
+        self.ports: dict[str, Any] = {}
+        self._locks: list[IO[str]] = []
         try:
             for name, url in (("arm", arm_url), ("daq", daq_url)):
                 self._locks.append(_device_lock(name, url))
@@ -128,14 +131,14 @@ class SerialRig:
             raise
 
     # ------------------------------------------------------------ transport
-    def _readline(self, port, deadline):
+    def _readline(self, port: Any, deadline: float) -> bytes:
         remaining = deadline - time.monotonic()
         if remaining <= 0:
             return b""
         port.timeout = remaining
-        return port.read_until(b"\n", MAX_LINE + 1)
+        return cast(bytes, port.read_until(b"\n", MAX_LINE + 1))
 
-    def _transact(self, device: str, command: str, *args, timeout: float | None = None) -> Reply:
+    def _transact(self, device: str, command: str, *args: float, timeout: float | None = None) -> Reply:
         port = self.ports[device]
         timeout = self.timeout if timeout is None else timeout
         problem = "no reply"
@@ -178,7 +181,7 @@ class SerialRig:
             self._emit({"event": "retry", "device": device, "command": command, "try": attempt + 1, "problem": problem})
         raise TransportError(f"the {device} did not answer {command} after {self.retries + 1} tries: {problem}")
 
-    def _emit(self, event: dict) -> None:
+    def _emit(self, event: dict[str, Any]) -> None:
         if self.log is not None:
             self.log(dict(event, time=time.time()))
 
@@ -214,7 +217,7 @@ class SerialRig:
             return False
         return True
 
-    def read(self, n: int = 32) -> tuple:
+    def read(self, n: int = 32) -> tuple[float, float]:
         """READ n: averaged (v1, v2) in volts; stops the run above the overload limit."""
         v1, v2 = self._transact("daq", "READ", int(n)).numbers(2)
         self._emit({"event": "sample", "v1": v1, "v2": v2, "n": int(n)})
@@ -229,7 +232,7 @@ class SerialRig:
             raise RigError(f"v1 = {v1:.4g} V is above the overload limit {self.overload} V: stopped and backed off")
         return v1, v2
 
-    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5) -> dict:
+    def servo(self, target: float, gain: float, *, guard: bool = True, duration: float = 0.5) -> dict[str, Any]:
         """SERVO: the arm holds Δv1 = ``target`` V with its own 1 kHz force loop for ``duration`` s.
 
         ``guard`` switches on the controller's passivity observer/controller on
@@ -252,7 +255,7 @@ class SerialRig:
         """Best effort: stop the arm and back the jaw ``backoff`` mm off the part. Never raises; a
         Ctrl-C or SIGTERM while it runs is held until it is done. Returns what really happened, as a
         sentence for the user (also logged as the ``safe_stop`` event)."""
-        done = {}
+        done: dict[str, str] = {}
         # a second Ctrl-C (or SIGTERM) must not cut the safe stop short; it is always on the way out
         # (its caller raises next), so a signal that came meanwhile has nothing left to stop
         with handling(("SIGINT", "SIGTERM", "SIGHUP"), signal.SIG_IGN):
@@ -274,7 +277,7 @@ class SerialRig:
         self._emit({"event": "safe_stop", "stop_problem": done["stop"], "back_off_problem": done["back_off"]})
         return f"{stopped}; {backed}"
 
-    def _back_off(self):
+    def _back_off(self) -> None:
         if self._commanded is None:
             return
         x, y, phi = self._commanded
@@ -290,10 +293,12 @@ class SerialRig:
                 lock.close()
         self._locks = []
 
-    def __enter__(self):
+    def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, exc_type, exc, tb):
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> Literal[False]:
         if exc_type is not None:
             outcome = self.safe_stop()
             if isinstance(exc, BaseException):
@@ -319,7 +324,7 @@ def _open_problem(url: str, exc: Exception) -> str:
     return str(exc)
 
 
-def _device_lock(name: str, url: str):
+def _device_lock(name: str, url: str) -> IO[str]:
     """An exclusive lock on ``url`` for this process (a lock file in the temporary folder, whatever
     the transport): two host processes driving one arm would interleave their commands and replies.
     Raises :class:`RigError` naming the holder when another process has it."""

@@ -12,7 +12,7 @@ settings give the same belief.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -99,7 +99,7 @@ class LoggedFilter(ContactFilter):
 
     def belief(self, radius: float | None = None) -> Belief:
         self._keep("belief", value=radius)
-        return self._call(super().belief, radius)
+        return cast(Belief, self._call(super().belief, radius))
 
     def columns(self) -> dict[str, np.ndarray]:
         """The calls kept so far, as the arrays :data:`LOG_COLUMNS` names (``call``: int8 codes of

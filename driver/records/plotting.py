@@ -2,14 +2,27 @@
 
 from __future__ import annotations
 
-import numpy as np
+import os
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, cast
 
-from localizer import SUCCESS_RADIUS, Outline
+import numpy as np
+from numpy.typing import NDArray
+
+from localizer import SUCCESS_RADIUS, Localization, Outline, Part
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..jaw import ReactiveRun
+    from ..wheel import WheelRun
+    from .trace import Trace
 
 __all__ = ["plot_localization", "plot_run", "plot_reactive", "draw_part"]
 
 
-def draw_part(ax, part) -> None:
+def draw_part(ax: Axes, part: Part | Outline) -> None:
     """The part's boundary as it is: a spline densely, an outline from CAD piece by piece with its corners
     marked (convex ones, where the jaw pivots, and concave ones, which a straight jaw cannot touch),
     and its first point (arc 0)."""
@@ -27,7 +40,7 @@ def draw_part(ax, part) -> None:
     ax.plot(*part.point_at_arc(0.0), "k^", ms=6, label="arc 0 (first point)")
 
 
-def _finish(fig, ax, path) -> None:
+def _finish(fig: Figure, ax: Axes, path: str | os.PathLike[str]) -> None:
     """Equal axes in mm, legend, grid; write the PNG and close the figure."""
     import matplotlib.pyplot as plt
 
@@ -41,12 +54,14 @@ def _finish(fig, ax, path) -> None:
     plt.close(fig)
 
 
-def _arc_points(part, start, length, sign, n=80):
+def _arc_points(part: Part | Outline, start: float, length: float, sign: float, n: int = 80) -> NDArray[np.float64]:
     s = start + sign * np.linspace(0.0, length, n)
     return part.point_at_arc(s)
 
 
-def plot_localization(part, result, path, *, title: str | None = None):
+def plot_localization(
+    part: Part | Outline, result: Localization, path: str | os.PathLike[str], *, title: str | None = None
+) -> None:
     """Draw the part, every feasible first-roll segment, each candidate's chain and the chosen contact.
 
     Parameters
@@ -85,7 +100,12 @@ def plot_localization(part, result, path, *, title: str | None = None):
         end = part.point_at_arc(cand.end_arc)
         if cand.probability >= 0.01:
             ax.annotate(
-                f"p={cand.probability:.2f}", end, textcoords="offset points", xytext=(6, 6), fontsize=8, color=colour
+                f"p={cand.probability:.2f}",
+                cast("tuple[float, float]", end),
+                textcoords="offset points",
+                xytext=(6, 6),
+                fontsize=8,
+                color=colour,
             )
     best = result.best
     if best is not None:
@@ -100,7 +120,9 @@ def plot_localization(part, result, path, *, title: str | None = None):
     _finish(fig, ax, path)
 
 
-def plot_run(part, trace, result, path, *, half_span: float = 50.0):
+def plot_run(
+    part: Part | Outline, trace: Trace, result: Localization, path: str | os.PathLike[str], *, half_span: float = 50.0
+) -> None:
     """Draw a rolling run: the part, the jaw at each roll's start and end, true and estimated contacts.
 
     Parameters
@@ -169,7 +191,13 @@ def plot_run(part, trace, result, path, *, half_span: float = 50.0):
     _finish(fig, ax, path)
 
 
-def plot_reactive(part, run, path, *, true_arcs=None) -> None:
+def plot_reactive(
+    part: Part | Outline,
+    run: ReactiveRun | WheelRun,
+    path: str | os.PathLike[str],
+    *,
+    true_arcs: Sequence[float] | None = None,
+) -> None:
     """Draw a reactive localization (:class:`driver.jaw.reactive.ReactiveRun`): the part as it is, the stretch
     the contact rolled over (from the readings' truth where known), the estimate with its stated
     probability, and the truth.

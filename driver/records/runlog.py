@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import time
+from typing import Any
 
 import numpy as np
 
@@ -34,7 +36,7 @@ __all__ = ["RunLog", "read_log", "LOG_FORMAT"]
 LOG_FORMAT = "rolltouch-log/1"
 
 
-def _clean(value):
+def _clean(value: object) -> object:
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, (np.floating, np.integer)):
@@ -56,7 +58,7 @@ class RunLog:
         Written as the ``start`` event (with ``format``).
     """
 
-    def __init__(self, path, header: dict):
+    def __init__(self, path: str | os.PathLike[str], header: dict[str, Any]) -> None:
         self.path = str(path)
         try:
             # open for the run's whole length, closed by close() (on success and on every failure)
@@ -65,7 +67,7 @@ class RunLog:
             raise RigError(f"cannot write the run log {self.path}: {exc.strerror or exc}") from None
         self({"event": "start", "format": LOG_FORMAT, **header})
 
-    def __call__(self, event: dict) -> None:
+    def __call__(self, event: dict[str, Any]) -> None:
         if self._f.closed:
             return
         event = dict(event)
@@ -82,7 +84,7 @@ class RunLog:
 MAX_LOG_BYTES = 256 * 2**20
 
 
-def read_log(path):
+def read_log(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """The events of a run log, skipping a truncated last line.
 
     Raises
@@ -98,7 +100,7 @@ def read_log(path):
         raise RigError(f"run log {path}: not a text file; not a rolltouch run log") from None
     except OSError as exc:
         raise RigError(f"run log {path}: {exc.strerror or exc}") from None
-    events = []
+    events: list[dict[str, Any]] = []
     for k, line in enumerate(lines):
         if not line.strip():
             continue

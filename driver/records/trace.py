@@ -14,10 +14,14 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import zipfile
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from localizer import arc_from_jaw_positions, check_size
 
@@ -34,7 +38,7 @@ MAX_TRACE_BYTES = 256 * 2**20
 MAX_TRACE_UNPACKED = 512 * 2**20
 
 
-def read_archive(path, names) -> tuple[dict, dict]:
+def read_archive(path: str | os.PathLike[str], names: Sequence[str]) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """The metadata (a JSON object) and the named columns (equal-length 1-D numbers) of a trace archive,
     read safely: its size checked before it is opened, never unpickled.
 
@@ -75,7 +79,7 @@ def read_archive(path, names) -> tuple[dict, dict]:
     return meta, columns
 
 
-def trace_format(path) -> str:
+def trace_format(path: str | os.PathLike[str]) -> str:
     """The ``format`` a trace archive's metadata names ("" when it names none)."""
     meta, _ = read_archive(path, ())
     return str(meta.get("format", ""))
@@ -93,11 +97,11 @@ class Trace:
         JSON-able description of the run (see module notes).
     """
 
-    columns: dict
-    metadata: dict
+    columns: dict[str, np.ndarray]
+    metadata: dict[str, Any]
 
     @classmethod
-    def from_run(cls, run: RollingRun, calibration: Calibration, **metadata) -> Trace:
+    def from_run(cls, run: RollingRun, calibration: Calibration, **metadata: Any) -> Trace:
         """Collect the readings of a :class:`RollingRun` with ``metadata`` about how it was made."""
         rows = []
         for k, r in enumerate(run.rolls):
@@ -123,12 +127,12 @@ class Trace:
         )
         return cls(columns, meta)
 
-    def save(self, path) -> None:
+    def save(self, path: str | os.PathLike[str]) -> None:
         """Write ``path`` (.npz): the columns and a ``metadata`` JSON string."""
-        np.savez(path, metadata=np.array(json.dumps(self.metadata)), **self.columns)
+        np.savez(path, metadata=np.array(json.dumps(self.metadata)), **cast(dict[str, Any], self.columns))
 
     @classmethod
-    def from_log(cls, path) -> Trace:
+    def from_log(cls, path: str | os.PathLike[str]) -> Trace:
         """A trace from a run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not.
 
         Rolls that the log shows begun but without two readings are dropped.
@@ -141,7 +145,10 @@ class Trace:
         if not jaw.startswith("straight"):
             raise RigError(f"run log {path}: a {jaw} finger's log, not a straight jaw's")
         for k, e in enumerate(events):
-            need = {"roll": ("roll", "step", "offset"), "reading": ("roll", "step", "dv1", "dv2", "phi")}
+            need: dict[str | None, tuple[str, ...]] = {
+                "roll": ("roll", "step", "offset"),
+                "reading": ("roll", "step", "dv1", "dv2", "phi"),
+            }
             missing = [key for key in need.get(e.get("event"), ()) if key not in e]
             if missing:
                 raise RigError(f"run log {path}: event {k + 1} ({e.get('event')}) has no {', '.join(missing)}")
@@ -176,7 +183,7 @@ class Trace:
         return cls(columns, meta)
 
     @classmethod
-    def load(cls, path) -> Trace:
+    def load(cls, path: str | os.PathLike[str]) -> Trace:
         """Read a trace written by :meth:`save`, or a run log (``.jsonl``).
 
         Raises
@@ -201,7 +208,7 @@ class Trace:
         c = self.metadata["calibration"]
         return Calibration(tuple(c["positions"]), tuple(c["ratios"]), float(c["target"]))
 
-    def estimates(self) -> list:
+    def estimates(self) -> list[tuple[float, float]]:
         """(L mm, Ω rad) of each roll, recomputed from the readings and the calibration."""
         cal = self.calibration
         out = []
@@ -227,7 +234,7 @@ class Trace:
         arc = self.columns["true_arc"]
         return float(arc[0]) if arc.size else math.nan
 
-    def jaw_positions(self) -> np.ndarray:
+    def jaw_positions(self) -> NDArray[np.float64]:
         """Calibrated contact locations on the jaw of every reading, mm."""
         cal = self.calibration
         return np.array([cal.position(a / b) for a, b in zip(self.columns["dv2"], self.columns["dv1"])])

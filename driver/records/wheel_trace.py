@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 
@@ -40,11 +42,11 @@ class WheelTrace:
         ``format``, ``jaw``, ``calibration`` (:meth:`WheelCalibration.as_dict`) and how the run was made.
     """
 
-    columns: dict
-    metadata: dict
+    columns: dict[str, np.ndarray]
+    metadata: dict[str, Any]
 
     @classmethod
-    def from_run(cls, run: WheelRun, calibration: WheelCalibration, **metadata) -> WheelTrace:
+    def from_run(cls, run: WheelRun, calibration: WheelCalibration, **metadata: Any) -> WheelTrace:
         """The readings of a :class:`driver.wheel.WheelRun` with ``metadata`` about how it was made."""
         columns = {
             "segment": np.asarray(run.segments, dtype=np.int64),
@@ -66,7 +68,7 @@ class WheelTrace:
         return cls(columns, meta)
 
     @classmethod
-    def from_log(cls, path) -> WheelTrace:
+    def from_log(cls, path: str | os.PathLike[str]) -> WheelTrace:
         """A trace from a wheel's run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not: its
         ``reading`` events (L, Ω) and the calibration it logged."""
         from .runlog import read_log
@@ -109,12 +111,12 @@ class WheelTrace:
             raise RigError(f"a wheel trace that names a {finger} finger")
         return finger
 
-    def save(self, path) -> None:
+    def save(self, path: str | os.PathLike[str]) -> None:
         """Write ``path`` (.npz): the columns and a ``metadata`` JSON string."""
-        np.savez(path, metadata=np.array(json.dumps(self.metadata)), **self.columns)
+        np.savez(path, metadata=np.array(json.dumps(self.metadata)), **cast(dict[str, Any], self.columns))
 
     @classmethod
-    def load(cls, path) -> WheelTrace:
+    def load(cls, path: str | os.PathLike[str]) -> WheelTrace:
         """Read a trace written by :meth:`save`, or a wheel's run log (``.jsonl``).
 
         Raises
@@ -133,7 +135,7 @@ class WheelTrace:
         _ = trace.wheel  # the finger it names must be a wheel
         return trace
 
-    def relocalize(self, part: Part | Outline, **filter_options) -> Belief:
+    def relocalize(self, part: Part | Outline, **filter_options: Any) -> Belief:
         """The belief from the trace's readings, replayed into a :class:`localizer.WheelFilter` for its finger."""
         flt = WheelFilter(part, self.wheel, **filter_options)
         last = self.columns["segment"][-1] if self.columns["segment"].size else 0

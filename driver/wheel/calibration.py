@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 
-from localizer import Outline, Part, WheelJaw, wheel_reach_for
+from localizer import Finger, Outline, Part, WheelJaw, wheel_reach_for
 
 from ..jaw import PRESS, Calibration, PressSettings
 from ..rig import Rig, RigError
@@ -24,7 +26,7 @@ CALIBRATION_LENGTH = 40.0
 def calibrate_wheel(
     rig: Rig,
     wheel: WheelJaw,
-    approach_pose,
+    approach_pose: Iterable[float],
     *,
     part: Part | Outline | None = None,
     length: float = CALIBRATION_LENGTH,
@@ -93,7 +95,7 @@ def calibrate_wheel(
     )
 
 
-def load_calibration(path) -> Calibration | WheelCalibration:
+def load_calibration(path: str | os.PathLike[str]) -> Calibration | WheelCalibration:
     """Read a calibration file of either finger (:meth:`Calibration.save`, :meth:`WheelCalibration.save`)."""
     try:
         data = json.loads(Path(path).read_text())
@@ -115,7 +117,7 @@ def load_calibration(path) -> Calibration | WheelCalibration:
     return Calibration.load(path)
 
 
-def check_calibration(calibration: Calibration | WheelCalibration, finger) -> None:
+def check_calibration(calibration: Calibration | WheelCalibration, finger: Finger) -> None:
     """Refuse a calibration made for another finger than ``finger`` (a StraightJaw or WheelJaw)."""
     jaw = calibration.jaw
     if jaw != str(finger):

@@ -36,11 +36,14 @@ from __future__ import annotations
 
 import json
 import math
+import os
+from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, cast, overload, runtime_checkable
 
 import numpy as np
+from numpy.typing import NDArray
 
 from localizer import CONFIDENCE, Outline, Part, WheelJaw, wheel_reach_for
 
@@ -120,10 +123,10 @@ class WheelCalibration:
         if self.jaw != str(wheel):
             raise RigError(f"the calibration is for {self.jaw}, the finger is {wheel}: calibrate this finger first")
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in asdict(self).items()}
 
-    def save(self, path) -> None:
+    def save(self, path: str | os.PathLike[str]) -> None:
         """Write as JSON (the finger named, so that it is refused for another)."""
         Path(path).write_text(json.dumps(self.as_dict(), indent=2) + "\n")
 
@@ -196,14 +199,20 @@ class WheelDisc:
     """A wheel pressed on the part: the servo, the settled readings and one checked step (module notes)."""
 
     def __init__(
-        self, rig, cal: WheelCalibration, policy: WheelPolicy, pressing: PressSettings, kappa_band, pivot: float = 0.0
-    ):
+        self,
+        rig: Rig,
+        cal: WheelCalibration,
+        policy: WheelPolicy,
+        pressing: PressSettings,
+        kappa_band: tuple[float, float],
+        pivot: float = 0.0,
+    ) -> None:
         if not isinstance(rig, AxleEncoder):
             raise RigError(f"{type(rig).__name__} has no axle encoder: a wheel finger needs one (docs/wheel.md)")
         self.rig, self.cal, self.policy, self.pressing = rig, cal, policy, pressing
         self.kappa_band, self.pivot = kappa_band, float(pivot)
 
-    def begin(self, approach_pose) -> tuple[float, float, float, float, float]:
+    def begin(self, approach_pose: Iterable[float]) -> tuple[float, float, float, float, float]:
         """Zero the wrist clear of the part, press from ``approach_pose``, measure the wrist's stiffness;
         the first settled state (φ, α, ψ_e, x, y)."""
         pol = self.policy
@@ -279,12 +288,21 @@ class WheelDisc:
         return float(self.rig.truth()["contact_arc"]) if isinstance(self.rig, GroundTruth) else math.nan
 
 
-def axle_travel(a, b, zero: float = 0.0):
+@overload
+def axle_travel(a: Sequence[float], b: Sequence[float], zero: float = 0.0) -> np.float64: ...
+@overload
+def axle_travel(a: NDArray[np.float64], b: NDArray[np.float64], zero: float = 0.0) -> NDArray[np.float64]: ...
+def axle_travel(
+    a: Sequence[float] | NDArray[np.float64], b: Sequence[float] | NDArray[np.float64], zero: float = 0.0
+) -> np.float64 | NDArray[np.float64]:
     """The axle's travel from state ``a`` to ``b`` (rows of (φ, α, ψ_e, x, y)) along the contact's mean
     tangent (mm, signed): the servo's force corrections move the axle along the normal too, which a
     chord's length would count (by n²/2t, a bias of a per cent of a step)."""
     beta = 0.5 * (np.asarray(a[0]) + np.asarray(a[1]) + np.asarray(b[0]) + np.asarray(b[1])) + zero
-    return (np.asarray(b[3]) - np.asarray(a[3])) * np.cos(beta) + (np.asarray(b[4]) - np.asarray(a[4])) * np.sin(beta)
+    return cast(
+        "np.float64 | NDArray[np.float64]",
+        (np.asarray(b[3]) - np.asarray(a[3])) * np.cos(beta) + (np.asarray(b[4]) - np.asarray(a[4])) * np.sin(beta),
+    )
 
 
 def kappa_band(part: Part | Outline, wheel: WheelJaw) -> tuple[float, float]:

@@ -11,7 +11,9 @@ the wheel turned to after that jump), else the other way.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 from localizer import Belief, Outline, Part, WheelFilter, WheelJaw
 
@@ -79,11 +81,11 @@ class WheelRun:
     jumps: int
     slip: float
     depth: float
-    history: tuple = field(repr=False, default=())
-    lengths: tuple = field(repr=False, default=())
-    turns: tuple = field(repr=False, default=())
-    true_arcs: tuple = field(repr=False, default=())
-    segments: tuple = field(repr=False, default=())
+    history: tuple[tuple[float, float, float, float], ...] = field(repr=False, default=())
+    lengths: tuple[float, ...] = field(repr=False, default=())
+    turns: tuple[float, ...] = field(repr=False, default=())
+    true_arcs: tuple[float, ...] = field(repr=False, default=())
+    segments: tuple[int, ...] = field(repr=False, default=())
 
     @property
     def restarts(self) -> int:
@@ -100,12 +102,12 @@ def localize_with_wheel(
     part: Part | Outline,
     wheel: WheelJaw,
     *,
-    approach_pose,
+    approach_pose: Iterable[float],
     calibration: WheelCalibration | None = None,
     filter: WheelFilter | None = None,
     policy: WheelPolicy = WHEEL_POLICY,
     pressing: PressSettings = PRESS,
-    observer=None,
+    observer: Callable[[dict[str, Any]], object] | None = None,
 ) -> WheelRun:
     """Roll the wheel from ``approach_pose`` until the contact is known (module notes).
 
@@ -138,6 +140,7 @@ def localize_with_wheel(
     # the filter keeps a reading every ``thin`` mm rolled, up to its memory's max_readings: stop before
     max_arc = min(max_arc, (flt.max_readings - 1) * flt.thin)
     start = disc.begin(approach_pose)
+    history: list[tuple[float, float, float, float]]
     lengths, turns, truths, segments, history = [0.0], [0.0], [disc.truth()], [0], []
     flt.update(0.0, 0.0)
     direction, reversals, jumps, steps, segment = 1, 0, 0, 0, 0
