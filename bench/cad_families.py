@@ -25,8 +25,10 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import cast
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = ["CAD_KINDS", "CAD_HELDOUT_SEED", "draw", "write_cad_family"]
 
@@ -34,7 +36,7 @@ CAD_KINDS = ("plate", "cam", "dee", "nurbs")
 CAD_HELDOUT_SEED = 20261202
 
 
-def _polygon(rng: np.random.Generator) -> np.ndarray:
+def _polygon(rng: np.random.Generator) -> npt.NDArray[np.float64]:
     corners = int(rng.integers(5, 9))
     ang = np.sort(rng.uniform(0, 2 * np.pi, corners))
     while np.min(np.diff(np.r_[ang, ang[0] + 2 * np.pi])) < 0.5:
@@ -42,7 +44,7 @@ def _polygon(rng: np.random.Generator) -> np.ndarray:
     rad = rng.uniform(45.0, 90.0, corners)
     if rng.random() < 0.5:
         rad[int(rng.integers(corners))] *= 0.5
-    return np.c_[rad * np.cos(ang), rad * np.sin(ang)]
+    return cast(npt.NDArray[np.float64], np.c_[rad * np.cos(ang), rad * np.sin(ang)])
 
 
 def _plate(rng: np.random.Generator, path: Path) -> str:
@@ -67,7 +69,7 @@ def _plate(rng: np.random.Generator, path: Path) -> str:
             filleted += 1
         else:
             verts.append((float(q[0]), float(q[1]), 0.0))
-    doc = ezdxf.new()
+    doc = ezdxf.new()  # type: ignore[attr-defined,unused-ignore]
     doc.header["$INSUNITS"] = 4
     msp = doc.modelspace()
     msp.add_lwpolyline(verts, format="xyb", close=True, dxfattribs={"layer": "OUTLINE"})
@@ -100,7 +102,7 @@ def _cam(rng: np.random.Generator, path: Path) -> str:
             tangents_out.append(t / 3 * 1.0)
 
     # y down in SVG: write -y so that the part read back (y flipped) is this one
-    def svg(p: np.ndarray) -> str:
+    def svg(p: npt.NDArray[np.float64]) -> str:
         return f"{p[0] + 100:.6f} {-p[1] + 100:.6f}"
 
     d = [f"M {svg(pts[0])}"]
@@ -130,7 +132,7 @@ def _dee(rng: np.random.Generator, path: Path) -> str:
     w = np.array([-math.sin(tilt), math.cos(tilt)]) * b
     end = u * math.cos(t0 + sweep) + w * math.sin(t0 + sweep)
     start = u * math.cos(t0) + w * math.sin(t0)
-    doc = ezdxf.new()
+    doc = ezdxf.new()  # type: ignore[attr-defined,unused-ignore]
     doc.header["$INSUNITS"] = 4
     msp = doc.modelspace()
     msp.add_ellipse((0, 0), major_axis=(float(u[0]), float(u[1])), ratio=b / a, start_param=t0, end_param=t0 + sweep)
@@ -152,7 +154,7 @@ def _nurbs(rng: np.random.Generator, path: Path) -> str:
     cps = [(float(r * math.cos(t)), float(r * math.sin(t))) for r, t in zip(rad, ang, strict=True)]
     weights = rng.uniform(0.5, 2.0, k)
     weights[0] = weights[-1] = 1.0
-    doc = ezdxf.new()
+    doc = ezdxf.new()  # type: ignore[attr-defined,unused-ignore]
     doc.header["$INSUNITS"] = 4
     msp = doc.modelspace()
     msp.add_rational_spline(cps, weights.tolist(), degree=3)

@@ -3,12 +3,14 @@
 
 from __future__ import annotations
 
+import argparse
+
 from driver.cli import UsageError, add_command
 
 __all__ = ["register", "montecarlo_command"]
 
 
-def register(sub) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``montecarlo`` to the subparsers ``sub``."""
     mc = add_command(
         sub,
@@ -28,7 +30,7 @@ def register(sub) -> None:
     mc.set_defaults(interrupted="finished trials are kept; rerun with --resume")
 
 
-def montecarlo_command(args) -> int:
+def montecarlo_command(args: argparse.Namespace) -> int:
     from .montecarlo import run_study
     from .study import load_study
     from .summary import print_summary

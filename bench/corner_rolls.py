@@ -25,7 +25,9 @@ import json
 import math
 import sys
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -106,7 +108,9 @@ class CornerRoll:
     end: bool
 
 
-def corner_rolls(outline: Outline, ref: TurningReference, lengths, fraction: float = 0.3) -> list[CornerRoll]:
+def corner_rolls(
+    outline: Outline, ref: TurningReference, lengths: Iterable[float], fraction: float = 0.3
+) -> list[CornerRoll]:
     """The four rolls (start or end at the corner, ccw or cw) at every convex corner of ``outline`` for
     each of ``lengths`` (mm), the jaw at ``fraction`` of the corner's range of angles."""
     rolls = []
@@ -148,7 +152,7 @@ def feasible(ref: TurningReference, seg: Segment) -> bool:
     return True
 
 
-def holds(segs, start: float, perimeter: float) -> bool:
+def holds(segs: Iterable[Segment], start: float, perimeter: float) -> bool:
     """Whether one of ``segs`` starts at ``start`` (mm), or is a continuum of starts over it."""
     for g in segs:
         if abs((g.start_arc - start + perimeter / 2) % perimeter - perimeter / 2) <= ARC_TOL:
@@ -160,12 +164,12 @@ def holds(segs, start: float, perimeter: float) -> bool:
     return False
 
 
-def check_rolls(outline: Outline, rolls, ref: TurningReference | None = None) -> dict:
+def check_rolls(outline: Outline, rolls: Iterable[CornerRoll], ref: TurningReference | None = None) -> dict[str, Any]:
     """Ask every roll of ``rolls`` of the solver: counts of rolls, starts ``missed`` and segments
     ``infeasible``, with the first few of each in ``examples``."""
     ref = TurningReference(outline) if ref is None else ref
     P = ref.perimeter
-    out: dict = {"rolls": 0, "missed": 0, "segments": 0, "infeasible": 0, "examples": []}
+    out: dict[str, Any] = {"rolls": 0, "missed": 0, "segments": 0, "infeasible": 0, "examples": []}
     for r in rolls:
         segs = feasible_segments(outline, r.length, r.turn, direction=r.direction)
         out["rolls"] += 1
@@ -181,7 +185,7 @@ def check_rolls(outline: Outline, rolls, ref: TurningReference | None = None) ->
     return out
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.corner_rolls", description=__doc__.split("\n\n")[0])
     ap.add_argument("drawings", nargs="+", help="DXF or SVG files")
     ap.add_argument("--lengths", type=int, default=12, help="lengths per corner, 8%%–60%% of the perimeter")

@@ -30,9 +30,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 from pathlib import Path
+from typing import Any, TypeAlias, cast
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = ["KINDS", "generate", "family", "write_family", "TUNING_SEED", "HELDOUT_SEED", "HELDOUT_A_SEED"]
 
@@ -47,22 +50,24 @@ HELDOUT_A_SEED = 20261201
 #: ellipse in the tests).
 GLYPHS = "CGJLMUVWcfhmnruw2357"
 
+FloatArray: TypeAlias = npt.NDArray[np.float64]
 
-def _resample(closed: np.ndarray, n: int) -> np.ndarray:
+
+def _resample(closed: FloatArray, n: int) -> FloatArray:
     """``n`` points at equal arc length along a closed polyline (first point first)."""
     seg = np.linalg.norm(np.diff(closed, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     t = np.linspace(0.0, s[-1], n, endpoint=False)
-    return np.c_[np.interp(t, s, closed[:, 0]), np.interp(t, s, closed[:, 1])]
+    return cast(FloatArray, np.c_[np.interp(t, s, closed[:, 0]), np.interp(t, s, closed[:, 1])])
 
 
-def _ccw(points: np.ndarray) -> np.ndarray:
+def _ccw(points: FloatArray) -> FloatArray:
     x, y = points[:, 0], points[:, 1]
     area = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
     return points if area > 0 else points[::-1].copy()
 
 
-def _star(rng) -> tuple:
+def _star(rng: np.random.Generator) -> tuple[FloatArray, str]:
     lobes = int(rng.integers(3, 9))
     radius = float(rng.uniform(55.0, 95.0))
     a = np.linspace(0.0, 2 * np.pi, 2000, endpoint=False)
@@ -75,7 +80,7 @@ def _star(rng) -> tuple:
     return pts, f"random star, {lobes} lobes, mean radius {radius:.0f} mm, {n} points"
 
 
-def _superellipse(rng) -> tuple:
+def _superellipse(rng: np.random.Generator) -> tuple[FloatArray, str]:
     p = float(rng.uniform(2.5, 5.0))
     ax, by = float(rng.uniform(35.0, 70.0)), float(rng.uniform(25.0, 55.0))
     a = np.linspace(0.0, 2 * np.pi, 2000, endpoint=False)
@@ -91,7 +96,7 @@ def _superellipse(rng) -> tuple:
     return pts, f"superellipse p={p:.2f}, {2 * ax:.0f} x {2 * by:.0f} mm, perturbed, {n} points"
 
 
-def _glyph(rng) -> tuple:
+def _glyph(rng: np.random.Generator) -> tuple[FloatArray, str]:
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import TextPath
 
@@ -100,7 +105,7 @@ def _glyph(rng) -> tuple:
     path = TextPath((0, 0), ch, size=height, prop=FontProperties(family="DejaVu Sans"))
     loops = [np.asarray(p) for p in path.to_polygons(closed_only=True)]
 
-    def area(q):
+    def area(q: FloatArray) -> float:
         return abs(0.5 * float(np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1])))
 
     outer = max(loops, key=area)
@@ -113,7 +118,7 @@ def _glyph(rng) -> tuple:
     return pts - pts.mean(axis=0), f"glyph {ch!r} (DejaVu Sans) at {height:.0f} mm, {n} points"
 
 
-def _filleted(rng) -> tuple:
+def _filleted(rng: np.random.Generator) -> tuple[FloatArray, str]:
     corners = int(rng.integers(5, 9))
     ang = np.sort(rng.uniform(0, 2 * np.pi, corners))
     while np.min(np.diff(np.r_[ang, ang[0] + 2 * np.pi])) < 0.5:
@@ -146,7 +151,7 @@ def _filleted(rng) -> tuple:
 _MAKERS = {"star": _star, "superellipse": _superellipse, "glyph": _glyph, "filleted": _filleted}
 
 
-def generate(kind: str, rng: np.random.Generator) -> dict:
+def generate(kind: str, rng: np.random.Generator) -> dict[str, Any]:
     """One part of ``kind`` as a part-file document ``{"name", "description", "units", "points"}``."""
     from localizer import PartError, part_from_points
 
@@ -165,7 +170,7 @@ def generate(kind: str, rng: np.random.Generator) -> dict:
     raise RuntimeError(f"no valid {kind} part in 50 draws")
 
 
-def family(seed: int, count: int) -> list:
+def family(seed: int, count: int) -> list[dict[str, Any]]:
     """``count`` part documents, the kinds in turn, from ``numpy.random.SeedSequence(seed)``."""
     rngs = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(count)]
     docs = []
@@ -177,7 +182,7 @@ def family(seed: int, count: int) -> list:
     return docs
 
 
-def write_family(seed: int, count: int, out) -> list:
+def write_family(seed: int, count: int, out: str | os.PathLike[str]) -> list[Path]:
     """Write the family's part files ``NN-kind.json`` into ``out``; returns the paths."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -190,7 +195,7 @@ def write_family(seed: int, count: int, out) -> list:
     return paths
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.families", description=__doc__.split("\n")[0])
     ap.add_argument("--seed", type=int, required=True)
     ap.add_argument("--count", type=int, default=12)

@@ -15,8 +15,21 @@ its final place from the readings it took (``<method>_bound_mm``, :func:`method_
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Sequence
+from typing import TYPE_CHECKING, Any, TypeAlias, cast
 
 import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    from driver.jaw import Calibration, ReactivePolicy, ReactiveRun, RollResult
+    from driver.wheel import WheelRun
+    from localizer import Belief, Candidate, ContactFilter, Localization, Outline, Part
+    from sim2d import NoiseModel, WorldChange
+
+    from .study import Study
+
+FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 MARK_DEG = 5.0
 #: Where the jaw is laid on the part: the contact this far (mm) from the jaw's centre, behind it in
@@ -26,11 +39,11 @@ JAW_START = 40.0
 ENCODER_SLACK_DEG = 0.05
 
 
-def _curve(pairs) -> str:
+def _curve(pairs: Iterable[tuple[float, float]]) -> str:
     return " ".join(f"{r:g}:{e:.4f}" for r, e in pairs)
 
 
-def parse_curve(text: str) -> list:
+def parse_curve(text: str) -> list[tuple[float, float]]:
     """[(rotation deg, error mm), ...] of a ``<method>_curve`` cell."""
     out = []
     for item in str(text or "").split():
@@ -39,7 +52,7 @@ def parse_curve(text: str) -> list:
     return out
 
 
-def fixed_readings(rolls, part) -> dict:
+def fixed_readings(rolls: Sequence[RollResult], part: Part | Outline) -> dict[str, FloatArray]:
     """The fixed rolls as one step sequence: cumulative signed arc z (mm), net measured turn (rad),
     the true contact (mm), each step's signed arc, and the contact's place on the jaw (mm)."""
     from localizer import arc_from_jaw_positions
@@ -64,7 +77,7 @@ def fixed_readings(rolls, part) -> dict:
     }
 
 
-def reading_noise(seq, part, noise) -> tuple:
+def reading_noise(seq: dict[str, FloatArray], part: Part | Outline, noise: NoiseModel) -> tuple[float, float]:
     """(sd_position mm, sd_turn rad): one reading's own noise on this trial's rig, for the bound.
 
     The travel's: the fixed rolls' readings against the truth, first differences (which cancel the
@@ -80,7 +93,14 @@ def reading_noise(seq, part, noise) -> tuple:
     return sd_position, sd_turn
 
 
-def method_bound(part, path, segments, sds: tuple, sd_scale: float, noise) -> float:
+def method_bound(
+    part: Part | Outline,
+    path: npt.ArrayLike,
+    segments: npt.ArrayLike | None,
+    sds: tuple[float, float],
+    sd_scale: float,
+    noise: NoiseModel,
+) -> float:
     """The Cramér–Rao bound (mm) of a method's final place from the readings along ``path``
     (:func:`localizer.trial_bound`), with the rig's ``noise`` model's machining deviation as a nuisance;
     nan where the noise has no level to bound with."""
@@ -102,7 +122,7 @@ def method_bound(part, path, segments, sds: tuple, sd_scale: float, noise) -> fl
         return math.nan
 
 
-def _sd_scale(study) -> float:
+def _sd_scale(study: Study) -> float:
     """The scale's prior standard deviation: the study's [reactive] sd_scale, else the filter's default."""
     from localizer import SCALE_SD
 
@@ -110,13 +130,13 @@ def _sd_scale(study) -> float:
     return float(given if given is not None else SCALE_SD)
 
 
-def _err(part, est, truth) -> float:
+def _err(part: Part | Outline, est: float, truth: float) -> float:
     if not (math.isfinite(est) and math.isfinite(truth)):
         return math.inf
     return abs(float(part.arc_offset(est, truth)))
 
 
-def _marks(turns) -> list:
+def _marks(turns: FloatArray) -> list[tuple[float, int]]:
     """(mark deg, index of the first reading at or past it) for every 5° of |turn|.
 
     A mark counts as reached within the arm encoder's resolution (0.03°): the measured turn of a
@@ -131,7 +151,13 @@ def _marks(turns) -> list:
     return out
 
 
-def _localize(study, part, rolls, rule: str, cache: dict):
+def _localize(
+    study: Study,
+    part: Part | Outline,
+    rolls: Sequence[RollResult],
+    rule: str,
+    cache: dict[str, Localization | Exception],
+) -> Localization | Exception:
     """The localizer's rule on the fixed rolls' (L, Ω), once per trial and rule (a failure is kept too)."""
     from localizer import localize
 
@@ -150,14 +176,14 @@ def _localize(study, part, rolls, rule: str, cache: dict):
     return cache[rule]
 
 
-def _mass(part, candidates, best, radius: float) -> float:
+def _mass(part: Part | Outline, candidates: Iterable[Candidate], best: Candidate, radius: float) -> float:
     """Stated probability of the candidates whose present contact is within ``radius`` of the best's."""
     return float(
         sum(c.probability for c in candidates if abs(float(part.arc_offset(c.end_arc, best.end_arc))) < radius)
     )
 
 
-def broken_rule(text: str) -> dict:
+def broken_rule(text: str) -> dict[str, Any]:
     """The study's own columns of a localizer rule that failed, or had no rolls to take: ``text`` why."""
     return {
         "estimate_arc": math.nan,
@@ -170,7 +196,14 @@ def broken_rule(text: str) -> dict:
     }
 
 
-def score_rule(study, part, rolls, rule: str, true_arc: float, cache: dict) -> dict:
+def score_rule(
+    study: Study,
+    part: Part | Outline,
+    rolls: Sequence[RollResult],
+    rule: str,
+    true_arc: float,
+    cache: dict[str, Localization | Exception],
+) -> dict[str, Any]:
     """The localizer's ``rule`` on the fixed rolls: the study's own columns, and a method's cells."""
     loc = _localize(study, part, rolls, rule, cache)
     if isinstance(loc, Exception):
@@ -197,7 +230,14 @@ def score_rule(study, part, rolls, rule: str, true_arc: float, cache: dict) -> d
     }
 
 
-def score_paper(study, part, rolls, seq, rule: str, cache: dict) -> dict:
+def score_paper(
+    study: Study,
+    part: Part | Outline,
+    rolls: Sequence[RollResult],
+    seq: dict[str, FloatArray],
+    rule: str,
+    cache: dict[str, Localization | Exception],
+) -> dict[str, Any]:
     """The fixed rolls under a localizer rule, and the same rule on shorter prefixes."""
     from localizer import localize
 
@@ -238,7 +278,13 @@ class _MethodError(Exception):
     """A method's own failure, its text already formatted."""
 
 
-def _score_sequential(study, part, seq, update, estimate) -> dict:
+def _score_sequential(
+    study: Study,
+    part: Part | Outline,
+    seq: dict[str, FloatArray],
+    update: Callable[[float, float, float], object],
+    estimate: Callable[[], tuple[float, float]],
+) -> dict[str, Any]:
     """A filter fed the fixed rolls' readings one by one, its estimate at every 5° and at the end.
 
     ``update(z, turn, jaw)``; ``estimate()`` gives (present contact mm, stated mass)."""
@@ -259,7 +305,7 @@ def _score_sequential(study, part, seq, update, estimate) -> dict:
     }
 
 
-def score_particle(study, part, seq, seed: int) -> dict:
+def score_particle(study: Study, part: Part | Outline, seq: dict[str, FloatArray], seed: int) -> dict[str, Any]:
     """The particle filter over the fixed rolls' readings."""
     from localizer import ParticleFilter
 
@@ -275,19 +321,21 @@ def score_particle(study, part, seq, seed: int) -> dict:
     return _score_sequential(study, part, seq, lambda z, t, d: pf.update(z, t), pf.estimate)
 
 
-def score_grid(study, part, noise, seq) -> dict:
+def score_grid(study: Study, part: Part | Outline, noise: NoiseModel, seq: dict[str, FloatArray]) -> dict[str, Any]:
     """The reactive method's grid filter over the fixed rolls' readings (no reactive rolling)."""
     flt = reactive_filter(study, part, noise)
     flt.touch(float(seq["jaw"][0]))
 
-    def estimate():
+    def estimate() -> tuple[float, float]:
         b = flt.belief()
         return b.map_arc, b.mass
 
     return _score_sequential(study, part, seq, flt.update, estimate)
 
 
-def reactive_filter(study, part, noise, filter_class=None):
+def reactive_filter(
+    study: Study, part: Part | Outline, noise: NoiseModel, filter_class: type[ContactFilter] | None = None
+) -> ContactFilter:
     """The ContactFilter a study's [reactive] options describe (``filter_class``: a subclass to build
     instead, e.g. :class:`bench.replay.FilterRecorder`).
 
@@ -314,7 +362,7 @@ def reactive_filter(study, part, noise, filter_class=None):
     return cls(part, radius=study.success_radius, confidence=o.confidence, **given)
 
 
-def reactive_policy(study):
+def reactive_policy(study: Study) -> ReactivePolicy:
     """The :class:`driver.jaw.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
     from driver.jaw import CONFIRM, ReactivePolicy
 
@@ -329,7 +377,7 @@ def reactive_policy(study):
     )
 
 
-def reactive_stop(run) -> str:
+def reactive_stop(run: ReactiveRun | WheelRun) -> str:
     """A reactive run's stop as trials.csv says it: confident, mismatch (the readings did not fit the part),
     ambiguous (the belief ended with two or more strong modes) or budget (not sure otherwise: the
     rotation budget, or blocked both ways)."""
@@ -338,7 +386,13 @@ def reactive_stop(run) -> str:
     return "ambiguous" if run.belief.ambiguous else "budget"
 
 
-def rotation_curve(part, history, rotation_deg: float, final: float, budget_deg: float) -> list:
+def rotation_curve(
+    part: Part | Outline,
+    history: Sequence[tuple[float, float, float, float]],
+    rotation_deg: float,
+    final: float,
+    budget_deg: float,
+) -> list[tuple[float, float]]:
     """(mark deg, error mm) at every 5° of a rolling's rotation up to ``budget_deg``: the belief's error at
     the last check before the mark (``history``: (rotation rad, map_arc, mass, true_arc) per check), the
     final error once the rolling stopped."""
@@ -355,7 +409,16 @@ def rotation_curve(part, history, rotation_deg: float, final: float, budget_deg:
     return curve
 
 
-def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_class=None, change=None) -> dict:
+def score_reactive(
+    study: Study,
+    part: Part | Outline,
+    noise: NoiseModel,
+    cal: Calibration,
+    start: float,
+    rig_seed: int,
+    filter_class: type[ContactFilter] | None = None,
+    change: WorldChange | None = None,
+) -> dict[str, Any]:
     """The reactive filter from the same start on a rig with the same seed (in world ``change``: the
     study's ``[world]``, :class:`sim2d.WorldChange`)."""
     from driver.jaw import localize_reactively
@@ -388,7 +451,7 @@ def score_reactive(study, part, noise, cal, start: float, rig_seed: int, filter_
     }
 
 
-def mismatch_cell(belief) -> str:
+def mismatch_cell(belief: Belief) -> str:
     """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), "unknown" where the run
     found one but could not tell where, empty when none."""
     arcs = getattr(belief, "mismatch", None)
@@ -400,19 +463,19 @@ def mismatch_cell(belief) -> str:
 
 
 def score_methods(
-    study,
-    part,
-    noise,
-    cal,
-    rolls,
+    study: Study,
+    part: Part | Outline,
+    noise: NoiseModel,
+    cal: Calibration,
+    rolls: Sequence[RollResult] | None,
     start: float,
     rig_seed: int,
     true_arc: float,
-    rules: dict | None = None,
-    filter_class=None,
-    change=None,
+    rules: dict[str, Localization | Exception] | None = None,
+    filter_class: type[ContactFilter] | None = None,
+    change: WorldChange | None = None,
     fixed_failure: str = "",
-) -> dict:
+) -> dict[str, Any]:
     """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
 
     ``rolls`` are the fixed rolls' :class:`driver.jaw.RollResult` (None where they could not run
@@ -426,18 +489,20 @@ def score_methods(
     rules = {} if rules is None else rules
     sds = reading_noise(seq, part, noise) if seq is not None else (math.nan, math.nan)
     sd_scale = _sd_scale(study)
-    fixed_bound: list = []  # the fixed-roll methods share one path, so one bound
-    out = {}
+    fixed_bound: list[float] = []  # the fixed-roll methods share one path, so one bound
+    out: dict[str, Any] = {}
     for m in study.methods:
         try:
             if seq is None and m != "reactive":
                 raise _MethodError(fixed_failure)
             if m in ("paper", "likelihood"):
-                r = score_paper(study, part, rolls, seq, m, rules)
+                r = score_paper(
+                    study, part, cast("Sequence[RollResult]", rolls), cast("dict[str, FloatArray]", seq), m, rules
+                )
             elif m == "particle":
-                r = score_particle(study, part, seq, seed=rig_seed)
+                r = score_particle(study, part, cast("dict[str, FloatArray]", seq), seed=rig_seed)
             elif m == "grid":
-                r = score_grid(study, part, noise, seq)
+                r = score_grid(study, part, noise, cast("dict[str, FloatArray]", seq))
             else:
                 r = score_reactive(study, part, noise, cal, start, rig_seed, filter_class, change)
                 out["_spikes"] = r["spikes"]

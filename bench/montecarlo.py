@@ -13,8 +13,10 @@ import os
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
+from typing import Any, TextIO
 
 from driver.link import LockHeld, hold_lock
 from localizer import fingerprint, load_part
@@ -35,7 +37,7 @@ __all__ = ["run_study", "read_trials"]
 SCHEDULER_TIMEOUT = 10.0
 
 
-def read_trials(path, *, warn: bool = False) -> list:
+def read_trials(path: str | os.PathLike[str], *, warn: bool = False) -> list[dict[str, Any]]:
     """Rows of a trials.csv, one per (level, trial): a truncated last line (a killed run) is dropped, a
     repeated trial keeps its first row, and a row whose level, trial or success is not a whole number
     (a damaged file) is dropped, so that it runs again on ``--resume``; ``warn`` says so on stderr."""
@@ -48,7 +50,7 @@ def read_trials(path, *, warn: bool = False) -> list:
     complete = text.endswith("\n")
     if not complete:
         lines = lines[:-1]
-    rows = []
+    rows: list[dict[str, Any]] = []
     seen: set[tuple[int, int]] = set()
     damaged, repeated = [], 0
     reader = csv.DictReader(lines)
@@ -77,7 +79,7 @@ def read_trials(path, *, warn: bool = False) -> list:
     return rows
 
 
-def _fmt(v):
+def _fmt(v: object) -> str:
     if isinstance(v, float):
         return repr(v)
     return "" if v is None else str(v)
@@ -85,13 +87,13 @@ def _fmt(v):
 
 def run_study(
     study: Study,
-    out,
+    out: str | os.PathLike[str],
     *,
     workers: int | None = None,
     scheduler: str | None = None,
     resume: bool = False,
     progress: bool = True,
-) -> dict:
+) -> dict[str, Any]:
     """Run every (level, trial) of ``study`` not yet in ``out/trials.csv``; write the summary and plots.
 
     Parameters
@@ -110,12 +112,14 @@ def run_study(
         return _run_locked(study, out, workers=workers, scheduler=scheduler, resume=resume, progress=progress)
 
 
-def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, progress: bool) -> dict:
+def _run_locked(
+    study: Study, out: Path, *, workers: int | None, scheduler: str | None, resume: bool, progress: bool
+) -> dict[str, Any]:
     table = out / "trials.csv"
     if resume and table.exists():
         _check_same_study(study, out)
     (out / "study.json").write_text(json.dumps(_study_record(study), indent=2) + "\n")
-    done = set()
+    done: set[tuple[int, int]] = set()
     if resume and table.exists():
         rows = read_trials(table, warn=True)
         done = {(int(r["level"]), int(r["trial"])) for r in rows}
@@ -139,7 +143,7 @@ def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, pr
     successes = sum(int(r["success"]) for r in read_trials(table)) if done else 0
     t0 = time.monotonic()
 
-    def record(row, f, writer):
+    def record(row: dict[str, Any], f: TextIO, writer: csv.DictWriter[str]) -> None:
         nonlocal finished, successes
         writer.writerow({k: _fmt(row.get(k)) for k in study.columns})
         f.flush()
@@ -163,14 +167,14 @@ def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, pr
             except ImportError:
                 raise StudyError("--scheduler needs dask.distributed: pip install 'rolltouch[dask]'") from None
             try:
-                client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+                client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)  # type: ignore[no-untyped-call,unused-ignore]
             except OSError as exc:
                 raise StudyError(
                     f"--scheduler {scheduler}: no Dask scheduler answered within {SCHEDULER_TIMEOUT:g} s ({exc}); "
                     "is it running, and is the address tcp://HOST:PORT?"
                 ) from None
             with client:
-                executor = client.get_executor(pure=False)
+                executor = client.get_executor(pure=False)  # type: ignore[no-untyped-call,unused-ignore]
                 futures = [executor.submit(run_trial, s) for s in specs]
                 for fut in as_completed(futures):
                     record(fut.result(), f, writer)
@@ -199,7 +203,7 @@ def _run_locked(study: Study, out: Path, *, workers, scheduler, resume: bool, pr
     return _write_summary(study, table, out, t0)
 
 
-def _write_summary(study: Study, table: Path, out: Path, t0: float) -> dict:
+def _write_summary(study: Study, table: Path, out: Path, t0: float) -> dict[str, Any]:
     """summary.json and the plots from the finished rows of ``table``."""
     summary = summarize(study, read_trials(table))
     summary["wall_s"] = time.monotonic() - t0
@@ -208,7 +212,7 @@ def _write_summary(study: Study, table: Path, out: Path, t0: float) -> dict:
     return summary
 
 
-def _study_record(study: Study) -> dict:
+def _study_record(study: Study) -> dict[str, Any]:
     """study.json: the study's settings, and the fingerprint (:func:`localizer.fingerprint`) of each of its
     part files and world part files, by path: a part file edited between runs is another study."""
     files = list(study.parts) + list(study.world.world_parts if study.world is not None else ())
@@ -251,7 +255,7 @@ def _check_same_study(study: Study, out: Path) -> None:
 
 
 @contextlib.contextmanager
-def _folder_lock(out: Path):
+def _folder_lock(out: Path) -> Iterator[None]:
     """Hold ``out/.lock`` for the run: two runs writing one folder would interleave their rows."""
     try:
         handle = hold_lock(out / ".lock", f"rolltouch montecarlo pid {os.getpid()}")

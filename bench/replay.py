@@ -19,10 +19,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -46,8 +47,8 @@ class FilterRecorder(ContactFilter):
 
     last: ClassVar[FilterRecorder | None] = None
 
-    def __init__(self, *args, **kwargs):
-        self.calls: list = []
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self.calls: list[tuple[str, tuple[Any, ...], dict[str, Any]]] = []
         self._depth = 0
         self.settings = dict(kwargs)
         super().__init__(*args, **kwargs)
@@ -57,7 +58,7 @@ class FilterRecorder(ContactFilter):
         self.calls = []
         super().reset()
 
-    def _record(self, name, args, kwargs):
+    def _record(self, name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> Any:
         if self._depth == 0:
             self.calls.append((name, args, kwargs))
         self._depth += 1
@@ -66,17 +67,17 @@ class FilterRecorder(ContactFilter):
         finally:
             self._depth -= 1
 
-    def update(self, *args, **kwargs):
-        return self._record("update", args, kwargs)
+    def update(self, *args: Any, **kwargs: Any) -> None:
+        return cast(None, self._record("update", args, kwargs))
 
-    def touch(self, *args, **kwargs):
-        return self._record("touch", args, kwargs)
+    def touch(self, *args: Any, **kwargs: Any) -> None:
+        return cast(None, self._record("touch", args, kwargs))
 
-    def bridged(self, *args, **kwargs):
-        return self._record("bridged", args, kwargs)
+    def bridged(self, *args: Any, **kwargs: Any) -> float:
+        return cast(float, self._record("bridged", args, kwargs))
 
-    def regrasp(self, *args, **kwargs):
-        return self._record("regrasp", args, kwargs)
+    def regrasp(self, *args: Any, **kwargs: Any) -> None:
+        return cast(None, self._record("regrasp", args, kwargs))
 
 
 @dataclass(frozen=True)
@@ -85,9 +86,9 @@ class Recorded:
     row of trials.csv and its start (mm)."""
 
     part: Part
-    settings: dict
-    calls: tuple
-    row: dict
+    settings: dict[str, Any]
+    calls: tuple[tuple[str, tuple[Any, ...], dict[str, Any]], ...]
+    row: dict[str, Any]
     start_arc: float
 
 
@@ -100,14 +101,14 @@ class VariantResult:
     the best start within :data:`NEAR` mm of the true one minus the best elsewhere (untempered;
     inf if no other is left); noise_scale : the λ the readings say."""
 
-    settings: dict
+    settings: dict[str, Any]
     mass: float
     error_mm: float
     margin: float
     noise_scale: float
 
 
-def record_trial(study_path, level: int, trial: int) -> Recorded:
+def record_trial(study_path: str | os.PathLike[str], level: int, trial: int) -> Recorded:
     """Rerun trial ``trial`` of level ``level`` of a study, recording its reactive filter's calls."""
     study = load_study(study_path)
     if "reactive" not in study.methods:
@@ -127,7 +128,7 @@ def record_trial(study_path, level: int, trial: int) -> Recorded:
     )
 
 
-def replay(rec: Recorded, **changes) -> VariantResult:
+def replay(rec: Recorded, **changes: Any) -> VariantResult:
     """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied."""
     settings = {**rec.settings, **changes}
     flt = ContactFilter(rec.part, **settings)
@@ -152,7 +153,7 @@ def replay(rec: Recorded, **changes) -> VariantResult:
     )
 
 
-def _value(text: str):
+def _value(text: str) -> int | float | tuple[float, ...] | str:
     for kind in (int, float):
         try:
             return kind(text)
@@ -163,7 +164,7 @@ def _value(text: str):
     return text
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.replay", description=__doc__.split("\n\n")[0])
     ap.add_argument("study", type=Path)
     ap.add_argument("--level", type=int, required=True, help="level index (0 = the first swept value)")
@@ -176,7 +177,7 @@ def main(argv=None) -> int:
         help="a ContactFilter setting for one variant (repeat for more variants)",
     )
     args = ap.parse_args(argv)
-    variants: list[dict] = [{}]
+    variants: list[dict[str, Any]] = [{}]
     for item in args.set:
         name, sep, value = item.partition("=")
         if not sep:

@@ -17,19 +17,20 @@ import json
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 
 from localizer import Part, load_part
 
 __all__ = ["resampled", "write_resampled"]
 
 
-def resampled(part: Part, per_knot: int = 2) -> np.ndarray:
+def resampled(part: Part, per_knot: int = 2) -> npt.NDArray[np.float64]:
     """The points (mm) of ``part`` at ``per_knot`` equal steps of arc between each two of its knots (its
     knots among them), first point first."""
     knots = np.asarray(part.arc_at_param(np.arange(part.n_knots, dtype=float)), dtype=float)
     gaps = np.diff(np.append(knots, part.perimeter))
     arcs = (knots[:, None] + gaps[:, None] * np.arange(per_knot)[None, :] / per_knot).ravel()
-    out: np.ndarray = np.asarray(part.point_at_arc(part.wrap_arc(arcs)), dtype=float)
+    out: npt.NDArray[np.float64] = np.asarray(part.point_at_arc(part.wrap_arc(arcs)), dtype=float)
     return out
 
 

@@ -16,7 +16,9 @@ import json
 import subprocess
 import sys
 import time
+from collections.abc import Iterable
 from pathlib import Path
+from typing import Any, cast
 
 __all__ = ["soak", "main"]
 
@@ -24,7 +26,14 @@ DEFAULT_FAULTS = ("drop=0.05", "garble=0.05", "delay=0.01")
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def soak(runs: int, out: Path, *, faults=DEFAULT_FAULTS, part: str = "parts/trefoil.json", deadline: float = 600.0):
+def soak(
+    runs: int,
+    out: Path,
+    *,
+    faults: Iterable[str] = DEFAULT_FAULTS,
+    part: str = "parts/trefoil.json",
+    deadline: float = 600.0,
+) -> list[dict[str, Any]]:
     """Run ``runs`` runs; returns their records (``rc``, ``seconds``, ``outcome``, ``log_ok``, ``last``)."""
     from driver.link import Emulator, Faults
     from driver.records import Trace, read_log
@@ -34,7 +43,7 @@ def soak(runs: int, out: Path, *, faults=DEFAULT_FAULTS, part: str = "parts/tref
 
     out.mkdir(parents=True, exist_ok=True)
     model = load_part(ROOT / part)
-    records = []
+    records: list[dict[str, Any]] = []
     for k in range(runs):
         rig = SimRig(model, noise="paper", seed=k)
         emu = Emulator(
@@ -54,7 +63,7 @@ def soak(runs: int, out: Path, *, faults=DEFAULT_FAULTS, part: str = "parts/tref
         except subprocess.TimeoutExpired:
             rc, stdout, stderr = None, "", "hung"
         finally:
-            force = float(emu.rig.world.contact().force)
+            force = float(cast(SimRig, emu.rig).world.contact().force)
             emu.close()
         seconds = time.monotonic() - t0
         errors = [line for line in stderr.splitlines() if line.startswith("rolltouch:")]
@@ -91,7 +100,7 @@ def soak(runs: int, out: Path, *, faults=DEFAULT_FAULTS, part: str = "parts/tref
     return records
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.soak", description=__doc__.split("\n")[0])
     ap.add_argument("--runs", type=int, default=50)
     ap.add_argument("--out", default="out/soak", metavar="DIR")

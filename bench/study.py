@@ -87,8 +87,10 @@ method's failure (``<method>_stopped = "error"``, ``<method>_failure``), never t
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar, cast
 
 from driver.jaw import MAX_ROTATION, STEP_RANGE_DEG
 from localizer import (
@@ -103,6 +105,9 @@ from localizer import (
 from sim2d import WorldSpec
 
 from .columns import FINGER_COLUMNS, METHOD_COLUMNS, METHODS, TRIAL_COLUMNS, WORLD_COLUMNS
+
+if TYPE_CHECKING:
+    from sim2d import NoiseModel
 
 #: The rolling step, degrees, from its one home.
 STEP_DEG = round(math.degrees(ROLL_STEP), 9)
@@ -152,10 +157,10 @@ class ReactiveOptions:
     sd_scale: float | None = None
     sd_slope: float | str | None = None  # "auto": from the study's noise model
     min_spread: float = 0.05
-    noise_scales: tuple | None = None  # None: localizer.NOISE_SCALES
+    noise_scales: tuple[float, ...] | None = None  # None: localizer.NOISE_SCALES
     temper: float | None = None  # None: the filter's default
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
-    slope_envelope: tuple | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
+    slope_envelope: tuple[float, ...] | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
     defect_window: float | None = None  # None: localizer.DEFECT_WINDOW (mm); 0: trust every stretch, test none
     lookalike_slope: float | None = None  # None: localizer.LOOKALIKE_SLOPE; 0: no look-alike check
     corner_ends: bool | None = None  # None: the filter's default (True); false: the uniform prior over a corner
@@ -200,8 +205,8 @@ class Study:
     """
 
     name: str
-    parts: tuple
-    rolls_deg: tuple
+    parts: tuple[str, ...]
+    rolls_deg: tuple[float, ...]
     step_deg: float = STEP_DEG
     method: str = "paper"
     engine: str = "kinematic"
@@ -210,11 +215,11 @@ class Study:
     success_radius: float = SUCCESS_RADIUS
     noise: str = "paper"
     parameter: str | None = None
-    values: tuple = ()
+    values: tuple[str | float, ...] = ()
     sd_length: float = STUDY_SD_LENGTH
     sd_turn_deg: float = STUDY_SD_TURN_DEG
     source: str = ""
-    methods: tuple = ()
+    methods: tuple[str, ...] = ()
     reactive: ReactiveOptions = ReactiveOptions()
     particle: ParticleOptions = ParticleOptions()
     jaw: str = "straight:100"
@@ -227,7 +232,7 @@ class Study:
         return self.parameter == "jaw" or self.jaw != "straight:100"
 
     @property
-    def columns(self) -> tuple:
+    def columns(self) -> tuple[str, ...]:
         """The columns of this study's trials.csv."""
         extra = tuple(f"{m}_{c}" for m in self.methods for c in METHOD_COLUMNS) if self.methods else ()
         world = WORLD_COLUMNS if self.world is not None else ()
@@ -241,16 +246,16 @@ class Study:
     def levels(self) -> int:
         return max(1, len(self.values))
 
-    def level_value(self, level: int):
+    def level_value(self, level: int) -> str | float | None:
         """The swept parameter's value at ``level`` (None without a sweep)."""
         return self.values[level] if self.values else None
 
-    def level_label(self, level: int):
+    def level_label(self, level: int) -> str | float | None:
         """The value of ``level`` as trials.csv and summary.json write it (a noise file by its name)."""
         v = self.level_value(level)
-        return Path(v).stem if self.parameter == "noise" and v is not None else v
+        return Path(cast(str, v)).stem if self.parameter == "noise" and v is not None else v
 
-    def level_noise(self, level: int):
+    def level_noise(self, level: int) -> NoiseModel:
         """The noise model of ``level``."""
         from sim2d import load_noise
 
@@ -258,10 +263,10 @@ class Study:
             return load_noise(self.values[level])
         noise = load_noise(self.noise)
         if self.parameter not in (None, "jaw"):
-            noise = replace(noise, **{self.parameter: self.values[level]})
+            noise = replace(noise, **{self.parameter: cast(float, self.values[level])})
         return noise
 
-    def with_overrides(self, *, trials=None, engine=None) -> Study:
+    def with_overrides(self, *, trials: int | None = None, engine: str | None = None) -> Study:
         """The study with ``trials`` per level and the ``engine`` replaced where given (the command line's flags)."""
         s = self
         if trials is not None:
@@ -274,12 +279,12 @@ class Study:
             s = replace(s, engine=engine)
         return s
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain-JSON form (study.json)."""
         return asdict(self)
 
 
-def load_study(path) -> Study:
+def load_study(path: str | os.PathLike[str]) -> Study:
     """Read and check the study file at ``path`` (TOML, see the module notes).
 
     Raises
@@ -294,7 +299,7 @@ def load_study(path) -> Study:
         raise StudyError(f"study {path}: unknown key(s) {unknown}; valid keys: {sorted(_KEYS)}")
     here = path.resolve().parent
 
-    def resolve(p):
+    def resolve(p: str) -> str:
         q = Path(p)
         return str(q if q.is_absolute() else (here / q).resolve())
 
@@ -361,7 +366,7 @@ def load_study(path) -> Study:
     except SimError as exc:
         raise StudyError(f"study {path}: noise: {exc}") from None
     parameter: str | None = None
-    values: tuple = ()
+    values: tuple[str | float, ...] = ()
     sweep = data.get("sweep")
     if sweep is not None:
         if not isinstance(sweep, dict) or set(sweep) - {"parameter", "values"}:
@@ -396,7 +401,7 @@ def load_study(path) -> Study:
                     raise StudyError(f"study {path}: sweep value {v!r} of {parameter}: {exc}") from None
             values = tuple(float(v) for v in given)
     jaw = _finger(path, data.get("jaw", "straight:100"))
-    fingers = values if parameter == "jaw" else (jaw,)
+    fingers = cast(tuple[str, ...], values) if parameter == "jaw" else (jaw,)
     if any(f.startswith("wheel") for f in fingers) and methods != ["reactive"]:
         raise StudyError(f'study {path}: a wheel localizes reactively: give methods = ["reactive"]')
     world = None
@@ -432,7 +437,7 @@ def load_study(path) -> Study:
     )
 
 
-def _finger(path, spec) -> str:
+def _finger(path: Path, spec: str) -> str:
     """A study's finger spec, checked and written as :func:`localizer.parse_jaw` names it."""
     from localizer import DEFAULT_JAW, StraightJaw, parse_jaw
 
@@ -445,7 +450,10 @@ def _finger(path, spec) -> str:
     return str(finger)
 
 
-def _options(path, table, cls, name):
+_Options = TypeVar("_Options", ReactiveOptions, ParticleOptions)
+
+
+def _options(path: Path, table: object, cls: type[_Options], name: str) -> _Options:
     """A [reactive] or [particle] table as its options dataclass, checked."""
     if not isinstance(table, dict):
         raise StudyError(f"study {path}: [{name}] must be a table")
@@ -453,7 +461,7 @@ def _options(path, table, cls, name):
     unknown = sorted(set(table) - known)
     if unknown:
         raise StudyError(f"study {path}: [{name}] unknown key(s) {unknown}; valid: {sorted(known)}")
-    values = {}
+    values: dict[str, Any] = {}
     for key, value in table.items():
         if key == "sd_slope" and value == "auto":
             values[key] = "auto"

@@ -4,7 +4,9 @@ bound, success against rotation per method, and the reliability diagram."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +24,7 @@ from .summary import (
 __all__ = ["plot_study"]
 
 
-def plot_study(study: Study, rows, out: Path) -> None:
+def plot_study(study: Study, rows: Sequence[dict[str, Any]], out: Path) -> None:
     """success.png (rate against the swept value), errors.png, failures.png (where on the parts)."""
     import matplotlib
 
@@ -102,7 +104,7 @@ def plot_study(study: Study, rows, out: Path) -> None:
         plt.close(fig)
 
 
-def _plot_fingers(study: Study, rows, levels: list, out: Path) -> None:
+def _plot_fingers(study: Study, rows: Sequence[dict[str, Any]], levels: list[dict[str, Any]], out: Path) -> None:
     """fingers.png for a sweep over fingers: success against the rotation used, per finger (left), and
     where each can start and how far it rolled (right)."""
     import matplotlib.pyplot as plt
@@ -147,7 +149,7 @@ def _plot_fingers(study: Study, rows, levels: list, out: Path) -> None:
     plt.close(fig)
 
 
-def _plot_bound(study: Study, rows, out: Path) -> None:
+def _plot_bound(study: Study, rows: Sequence[dict[str, Any]], out: Path) -> None:
     """bound.png: each method's final error against the Cramér–Rao bound of its readings, trial by trial
     (successes filled, failures hollow), with the bound itself and 1.3 times it."""
     import matplotlib.pyplot as plt
@@ -188,7 +190,7 @@ def _plot_bound(study: Study, rows, out: Path) -> None:
     plt.close(fig)
 
 
-def _plot_methods(study: Study, summary: dict, out: Path) -> None:
+def _plot_methods(study: Study, summary: dict[str, Any], out: Path) -> None:
     """methods.png: success rate against rotation rolled for each method."""
     import matplotlib.pyplot as plt
 
@@ -218,7 +220,7 @@ def _plot_methods(study: Study, summary: dict, out: Path) -> None:
     plt.close(fig)
 
 
-def _plot_reliability(study: Study, rows, out: Path) -> None:
+def _plot_reliability(study: Study, rows: Sequence[dict[str, Any]], out: Path) -> None:
     """reliability.png: stated confidence at the stop against the fraction within the radius, per level.
 
     For each method that states one: the whole range, and the range from 0.9 up, where a promise

@@ -5,11 +5,16 @@ and the lines printed at the end of a run."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any, TypeAlias
 
 import numpy as np
+import numpy.typing as npt
 
 from .study import Study
+
+FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 __all__ = [
     "wilson",
@@ -24,7 +29,7 @@ __all__ = [
 ]
 
 
-def wilson(successes: int, n: int, z: float = 1.96):
+def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
     """Wilson 95% interval of a success rate, (low, high).
 
     Examples
@@ -44,7 +49,7 @@ def wilson(successes: int, n: int, z: float = 1.96):
     return (max(0.0, min(p, centre - half)), min(1.0, max(p, centre + half)))
 
 
-def json_safe(value):
+def json_safe(value: object) -> object:
     """``value`` with every non-finite float as None: JSON has no NaN or Infinity."""
     if isinstance(value, dict):
         return {k: json_safe(v) for k, v in value.items()}
@@ -57,7 +62,7 @@ def json_safe(value):
     return value
 
 
-def _number(text) -> float:
+def _number(text: Any) -> float:
     """A trials.csv cell as a float (empty: nan)."""
     try:
         return float(text)
@@ -65,9 +70,9 @@ def _number(text) -> float:
         return math.nan
 
 
-def summarize(study: Study, rows) -> dict:
+def summarize(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """Success rate per level with its 95% interval, error quantiles, failures."""
-    levels = []
+    levels: list[dict[str, Any]] = []
     for level in range(study.levels):
         sel = [r for r in rows if int(r["level"]) == level]
         n = len(sel)
@@ -115,7 +120,7 @@ def summarize(study: Study, rows) -> dict:
     return out
 
 
-def method_detail(study: Study, m: str, rows) -> dict:
+def method_detail(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """One method's record over ``rows``: success, how it stopped, confident and wrong, per part."""
     n = len(rows)
     ok = sum(int(r[f"{m}_success"]) for r in rows)
@@ -123,7 +128,7 @@ def method_detail(study: Study, m: str, rows) -> dict:
     err = np.array([_number(r[f"{m}_error_mm"]) for r in rows], dtype=float)
     stopped = [r.get(f"{m}_stopped", "") for r in rows]
     confident = [r for r, st in zip(rows, stopped) if st == "confident"]
-    per_part: dict = {}
+    per_part: dict[str, dict[str, int]] = {}
     for r in rows:
         d = per_part.setdefault(r["part"], {"success": 0, "trials": 0})
         d["trials"] += 1
@@ -150,7 +155,7 @@ def method_detail(study: Study, m: str, rows) -> dict:
     }
 
 
-def error_over_bound(m: str, rows) -> np.ndarray:
+def error_over_bound(m: str, rows: Sequence[dict[str, Any]]) -> FloatArray:
     """Error / Cramér–Rao bound of method ``m`` over its successful trials that have a finite bound."""
     out = []
     for r in rows:
@@ -160,7 +165,7 @@ def error_over_bound(m: str, rows) -> np.ndarray:
     return np.array(out, dtype=float)
 
 
-def summarize_methods(study: Study, rows) -> dict:
+def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """``methods`` {name: success rate} over all trials, with details and success against rotation."""
     from .methods import MARK_DEG, parse_curve
 
@@ -169,7 +174,7 @@ def summarize_methods(study: Study, rows) -> dict:
     for m in study.methods:
         details[m] = method_detail(study, m, rows)
         rates[m] = details[m]["success"] / n if n else None
-        per_mark: dict = {}
+        per_mark: dict[float, list[bool]] = {}
         for r in rows:
             pairs = parse_curve(r[f"{m}_curve"])
             last = pairs[-1][1] if pairs else math.inf
@@ -189,7 +194,7 @@ def summarize_methods(study: Study, rows) -> dict:
 RELIABILITY_BINS = (0.0, 0.5, 0.8, 0.9, 0.95, 0.97, 0.99, 0.999, 1.0 + 1e-12)
 
 
-def reliability(study: Study, m: str, rows) -> list:
+def reliability(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> list[tuple[float, float, int]]:
     """(mean stated mass, fraction within the success radius, trials) per bin of stated mass."""
     mass = np.array([_number(r.get(f"{m}_mass", "")) for r in rows])
     hit = np.array([int(r[f"{m}_success"]) for r in rows])
@@ -201,7 +206,7 @@ def reliability(study: Study, m: str, rows) -> list:
     return out
 
 
-def print_summary(summary: dict) -> None:
+def print_summary(summary: dict[str, Any]) -> None:
     print(
         f"study {summary['study']}: {summary['method']} rule, {summary['engine']} engine, "
         f"noise {Path(str(summary['noise'])).name}"
@@ -223,7 +228,7 @@ def print_summary(summary: dict) -> None:
         _print_method(m, d, indent="  ")
 
 
-def _print_method(m: str, d: dict, indent: str) -> None:
+def _print_method(m: str, d: dict[str, Any], indent: str) -> None:
     if not d["trials"]:
         return
     rot = "" if d["mean_rotation_deg"] is None else f"mean rotation {d['mean_rotation_deg']:.1f}°, "

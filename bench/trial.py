@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from localizer import (
     Outline,
@@ -18,6 +21,11 @@ from localizer import (
 from .part_cache import cached_part
 from .study import Study
 from .trial_draw import draw_trial, draw_world, world_cells
+
+if TYPE_CHECKING:
+    from driver.jaw import RollResult
+    from localizer import Localization, ModeTracks, Part
+    from sim2d import SimRig
 
 __all__ = ["TrialSpec", "start_sampler", "run_trial"]
 
@@ -33,10 +41,12 @@ class TrialSpec:
     study: Study
     level: int
     trial: int
-    extra: dict = field(default_factory=dict)
+    extra: dict[str, Any] = field(default_factory=dict)
 
 
-def start_sampler(part, rolls, jaw_start: float):
+def start_sampler(
+    part: Part | Outline, rolls: Sequence[float], jaw_start: float
+) -> tuple[npt.NDArray[np.intp], ModeTracks]:
     """Boundary points (grid indices) and grid step of the filter's tracks from which the jaw, laid with
     the contact at ``jaw_start`` mm on it, rolls through ``rolls`` (rad, one sign) without bridging,
     with a millimetre to spare (:meth:`localizer.ModeTracks.rollable`), and not on a flat face."""
@@ -50,7 +60,7 @@ def start_sampler(part, rolls, jaw_start: float):
     return ok, tracks
 
 
-def run_trial(spec: TrialSpec) -> dict:
+def run_trial(spec: TrialSpec) -> dict[str, Any]:
     """One simulated localization: calibrate, pick a start, roll, localize, score. Never raises.
 
     With a wheel (:mod:`bench.wheel_trial`) the start is drawn over the whole boundary instead; a study
@@ -80,7 +90,7 @@ def run_trial(spec: TrialSpec) -> dict:
     return row
 
 
-def _run_straight_trial(spec: TrialSpec) -> dict:
+def _run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
     """:func:`run_trial` with the paper's straight jaw.
 
     The start is drawn uniformly over the boundary points from which the fixed rolls can run
@@ -106,7 +116,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
         if candidates.size == 0:
             raise RigError(f"no start on {part.name} lets the {s.rolls_deg} degree rolls run without bridging")
 
-        def roll_fixed(rig, start: float):
+        def roll_fixed(rig: SimRig, start: float) -> tuple[RollResult, ...]:
             return roll_sequence(
                 rig,
                 rolls,
@@ -188,7 +198,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict:
             "turns": " ".join(f"{r.turn:.8f}" for r in run) if run is not None else "",
         }
     )
-    rules: dict = {}
+    rules: dict[str, Localization | Exception] = {}
     own = score_rule(s, part, run, rule, true_arc, rules) if run is not None else broken_rule(fixed_failure)
     row.update(
         {

@@ -5,11 +5,17 @@ draw the same part for the same seeds."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from .part_cache import cached_part
+
+if TYPE_CHECKING:
+    from localizer import Outline, Part
+    from sim2d import NoiseModel, WorldChange
+
+    from .trial import TrialSpec
 
 __all__ = ["TrialDraw", "draw_trial", "draw_world", "world_cells"]
 
@@ -20,18 +26,18 @@ class TrialDraw(NamedTuple):
 
     rng: np.random.Generator
     part_file: str
-    part: Any
-    noise: Any
-    row: dict
+    part: Part | Outline
+    noise: NoiseModel
+    row: dict[str, Any]
 
 
-def draw_trial(spec) -> TrialDraw:
+def draw_trial(spec: TrialSpec) -> TrialDraw:
     """The first draws of trial ``spec`` (a :class:`bench.trial.TrialSpec`): the generator
     ``SeedSequence([seed, level, trial])``, then the part."""
     s = spec.study
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial]))
     part_file = s.parts[int(rng.integers(len(s.parts)))]
-    row = {
+    row: dict[str, Any] = {
         "level": spec.level,
         "trial": spec.trial,
         "parameter": s.parameter or "",
@@ -41,7 +47,7 @@ def draw_trial(spec) -> TrialDraw:
     return TrialDraw(rng, part_file, cached_part(part_file), s.level_noise(spec.level), row)
 
 
-def draw_world(spec, part_file: str, part, start: float):
+def draw_world(spec: TrialSpec, part_file: str, part: Part | Outline, start: float) -> WorldChange | None:
     """The world of trial ``spec`` (its study's ``[world]`` table, :meth:`sim2d.WorldSpec.draw`) for a
     rolling that starts at ``start`` mm on ``part``, from a stream of its own
     (``SeedSequence([seed, level, trial, 2])``): the trial's other draws are the same in every world,
@@ -53,7 +59,7 @@ def draw_world(spec, part_file: str, part, start: float):
     return s.world.draw(part, start, rng, s.parts.index(part_file))
 
 
-def world_cells(change, spikes: int | str = "") -> dict:
+def world_cells(change: WorldChange | None, spikes: int | str = "") -> dict[str, Any]:
     """The :data:`bench.columns.WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
     if change is None:
         return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}

@@ -14,8 +14,12 @@ from __future__ import annotations
 
 import math
 import time
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .trial import TrialSpec
 
 __all__ = ["run_wheel_trial", "RADIUS_SD", "MAX_REDRAWS"]
 
@@ -25,7 +29,7 @@ RADIUS_SD = 0.01
 MAX_REDRAWS = 1000
 
 
-def run_wheel_trial(spec) -> dict:
+def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
     """One wheel trial (module notes). Never raises: a failure is the row's ``failure``."""
     from driver.wheel import WheelPolicy, calibrate_wheel, localize_with_wheel, wheel_calibration_arc
     from localizer import WheelJaw, parse_jaw, wheel_reach_for
