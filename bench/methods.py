@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Sequence
-from typing import TYPE_CHECKING, Any, TypeAlias, cast
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, NamedTuple, TypeAlias, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -451,6 +452,55 @@ def score_reactive(
     }
 
 
+@dataclass(frozen=True)
+class TrialInputs:
+    """What every method of a trial is scored from: the study, the part and its noise model, the wrist's
+    calibration, the fixed rolls and their step-by-step readings (None where they could not run), the
+    start (mm) and the rig's seed the reactive method rolls from, the rules' results cached within the
+    trial, the reactive method's filter class (None: :class:`localizer.ContactFilter`) and the world."""
+
+    study: Study
+    part: Part | Outline
+    noise: NoiseModel
+    cal: Calibration
+    rolls: Sequence[RollResult] | None
+    seq: dict[str, FloatArray] | None
+    start: float
+    rig_seed: int
+    rules: dict[str, Localization | Exception]
+    filter_class: type[ContactFilter] | None
+    change: WorldChange | None
+
+
+class Scorer(NamedTuple):
+    """One method of the registry: how it is scored on a trial (its result cells, :func:`score_methods`
+    completes them), and whether it needs the fixed rolls (it fails with them where they could not run)."""
+
+    score: Callable[[TrialInputs, str], dict[str, Any]]
+    fixed_rolls: bool
+
+
+def _rule(t: TrialInputs, m: str) -> dict[str, Any]:
+    return score_paper(
+        t.study, t.part, cast("Sequence[RollResult]", t.rolls), cast("dict[str, FloatArray]", t.seq), m, t.rules
+    )
+
+
+#: Every method a study may name, by name (:data:`bench.columns.METHODS` is the same list, in order).
+SCORERS: dict[str, Scorer] = {
+    "paper": Scorer(_rule, True),
+    "likelihood": Scorer(_rule, True),
+    "particle": Scorer(
+        lambda t, m: score_particle(t.study, t.part, cast("dict[str, FloatArray]", t.seq), seed=t.rig_seed), True
+    ),
+    "grid": Scorer(lambda t, m: score_grid(t.study, t.part, t.noise, cast("dict[str, FloatArray]", t.seq)), True),
+    "reactive": Scorer(
+        lambda t, m: score_reactive(t.study, t.part, t.noise, t.cal, t.start, t.rig_seed, t.filter_class, t.change),
+        False,
+    ),
+}
+
+
 def mismatch_cell(belief: Belief) -> str:
     """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), "unknown" where the run
     found one but could not tell where, empty when none."""
@@ -486,25 +536,20 @@ def score_methods(
     ``_spikes`` holds its rig's spiked readings.
     """
     seq = fixed_readings(rolls, part) if rolls is not None else None
-    rules = {} if rules is None else rules
+    trial = TrialInputs(
+        study, part, noise, cal, rolls, seq, start, rig_seed, {} if rules is None else rules, filter_class, change
+    )
     sds = reading_noise(seq, part, noise) if seq is not None else (math.nan, math.nan)
     sd_scale = _sd_scale(study)
     fixed_bound: list[float] = []  # the fixed-roll methods share one path, so one bound
     out: dict[str, Any] = {}
     for m in study.methods:
+        scorer = SCORERS[m]
         try:
-            if seq is None and m != "reactive":
+            if seq is None and scorer.fixed_rolls:
                 raise _MethodError(fixed_failure)
-            if m in ("paper", "likelihood"):
-                r = score_paper(
-                    study, part, cast("Sequence[RollResult]", rolls), cast("dict[str, FloatArray]", seq), m, rules
-                )
-            elif m == "particle":
-                r = score_particle(study, part, cast("dict[str, FloatArray]", seq), seed=rig_seed)
-            elif m == "grid":
-                r = score_grid(study, part, noise, cast("dict[str, FloatArray]", seq))
-            else:
-                r = score_reactive(study, part, noise, cal, start, rig_seed, filter_class, change)
+            r = scorer.score(trial, m)
+            if "spikes" in r:
                 out["_spikes"] = r["spikes"]
             r["failure"] = ""
         except Exception as exc:  # noqa: BLE001 - this method failed on this trial; the others still count

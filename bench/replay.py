@@ -116,7 +116,7 @@ def record_trial(study_path: str | os.PathLike[str], level: int, trial: int) -> 
     if not 0 <= level < study.levels:
         raise ValueError(f"level={level!r}: the study has levels 0 to {study.levels - 1}")
     FilterRecorder.last = None
-    row = run_trial(TrialSpec(study, level, trial, extra={"filter_class": FilterRecorder}))
+    row = run_trial(TrialSpec(study, level, trial, filter_class=FilterRecorder))
     rec = FilterRecorder.last
     if rec is None or row.get("reactive_failure"):
         raise RuntimeError(

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,7 +24,7 @@ from .trial_draw import draw_trial, draw_world, world_cells
 
 if TYPE_CHECKING:
     from driver.jaw import RollResult
-    from localizer import Localization, ModeTracks, Part
+    from localizer import ContactFilter, Localization, ModeTracks, Part
     from sim2d import SimRig
 
 __all__ = ["TrialSpec", "start_sampler", "run_trial"]
@@ -32,16 +32,15 @@ __all__ = ["TrialSpec", "start_sampler", "run_trial"]
 
 @dataclass(frozen=True)
 class TrialSpec:
-    """Everything one trial needs (picklable, sent to worker processes).
-
-    ``extra`` may hold ``filter_class``: the reactive method's filter class (default
-    :class:`localizer.ContactFilter`; :mod:`bench.replay` records the filter's calls with it).
+    """Everything one trial needs (picklable, sent to worker processes): the study, the level and the
+    trial's number, and the reactive method's filter class (None: :class:`localizer.ContactFilter`;
+    :mod:`bench.replay` records the filter's calls with a subclass of it).
     """
 
     study: Study
     level: int
     trial: int
-    extra: dict[str, Any] = field(default_factory=dict)
+    filter_class: type[ContactFilter] | None = None
 
 
 def start_sampler(
@@ -223,7 +222,7 @@ def _run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
                 rig_seed,
                 true_arc,
                 rules,
-                filter_class=spec.extra.get("filter_class"),
+                filter_class=spec.filter_class,
                 change=change,
                 fixed_failure=fixed_failure,
             )
