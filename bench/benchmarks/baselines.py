@@ -2,7 +2,17 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, TypeAlias, cast
+
 import numpy as np
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    from pytest_benchmark.fixture import BenchmarkFixture
+
+    from localizer import Part
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 __all__ = ["trapezoid_perimeter", "trefoil_part", "PARTS_DIR", "per_second", "random_outline", "traced_outline"]
 
@@ -11,7 +21,7 @@ from pathlib import Path
 PARTS_DIR = Path(__file__).resolve().parents[2] / "parts"
 
 
-def trapezoid_perimeter(part, h: float = 1e-5, chunk: int = 1_000_000) -> float:
+def trapezoid_perimeter(part: Part, h: float = 1e-5, chunk: int = 1_000_000) -> float:
     """Perimeter by the trapezoid rule at step ``h`` in the parameter domain, mm.
 
     The paper's unit of cost (§II-B: "acquiring the perimeter of α by
@@ -27,14 +37,14 @@ def trapezoid_perimeter(part, h: float = 1e-5, chunk: int = 1_000_000) -> float:
     return float(total)
 
 
-def trefoil_part():
+def trefoil_part() -> Part:
     """The 90-knot non-convex benchmark part."""
     from localizer import load_part
 
-    return load_part(PARTS_DIR / "trefoil.json")
+    return cast("Part", load_part(PARTS_DIR / "trefoil.json"))
 
 
-def random_outline(rng, n: int = 40, amplitude: float = 3.0, radius: float = 40.0):
+def random_outline(rng: np.random.Generator, n: int = 40, amplitude: float = 3.0, radius: float = 40.0) -> FloatArray:
     """A random smooth star-shaped outline (simple by construction), mm.
 
     ``radius`` plus harmonics 2..5 of total size ``amplitude``: about 1.5 mm and
@@ -44,10 +54,12 @@ def random_outline(rng, n: int = 40, amplitude: float = 3.0, radius: float = 40.
     r = np.full(n, float(radius))
     for k in range(2, 6):
         r += amplitude / k * rng.uniform(-1, 1) * np.cos(k * a + rng.uniform(0, 2 * np.pi))
-    return np.c_[r * np.cos(a), r * np.sin(a)]
+    return cast("FloatArray", np.c_[r * np.cos(a), r * np.sin(a)])
 
 
-def traced_outline(rng, n: int = 90, radius: float = 40.0, harmonics: int = 24, pixel: float = 0.5):
+def traced_outline(
+    rng: np.random.Generator, n: int = 90, radius: float = 40.0, harmonics: int = 24, pixel: float = 0.5
+) -> FloatArray:
     """A random outline as if traced from a silhouette: ``n`` points, mm.
 
     A star-shaped shape with harmonics 2..``harmonics`` of amplitude 6 mm / k (a rough outline, not
@@ -61,10 +73,10 @@ def traced_outline(rng, n: int = 90, radius: float = 40.0, harmonics: int = 24, 
     for k in range(2, harmonics + 1):
         r += 6.0 / k * rng.uniform(-1, 1) * np.cos(k * a + rng.uniform(0, 2 * np.pi))
     r += rng.uniform(-0.5, 0.5, n) * pixel
-    return np.c_[r * np.cos(a), r * np.sin(a)]
+    return cast("FloatArray", np.c_[r * np.cos(a), r * np.sin(a)])
 
 
-def per_second(benchmark, key: str, count: float = 1.0) -> None:
+def per_second(benchmark: BenchmarkFixture, key: str, count: float = 1.0) -> None:
     """Put the benchmark's figure of merit in its ``extra_info``: ``count`` units per second of its fastest
     round (nothing when the benchmark is disabled, as in the test run's smoke pass)."""
     stats = getattr(benchmark, "stats", None)

@@ -6,7 +6,10 @@ prunes hypotheses 40 nats below the best), so that it is timed in the state it h
 mid-localization.
 """
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING, Any, TypeAlias, cast
 
 import numpy as np
 import pytest
@@ -14,20 +17,29 @@ import pytest
 from bench.benchmarks.baselines import PARTS_DIR, per_second
 from localizer import ContactFilter, ParticleFilter, WheelFilter, WheelJaw, load_part, part_from_points
 
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    from pytest_benchmark.fixture import BenchmarkFixture
+    from pytest_benchmark.stats import Metadata
+
+    from localizer import Belief, Part
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
+
 STEP = math.radians(0.2)
 
 
 @pytest.fixture(scope="module")
-def part100():
+def part100() -> Part:
     """A smooth convex 100-knot part (an egg with a few lobes), about 240 mm round."""
     a = np.linspace(0, 2 * np.pi, 100, endpoint=False)
     r = 38 + 4 * np.cos(a) + 2.0 * np.cos(3 * a + 0.4) + 0.8 * np.sin(5 * a)
     return part_from_points(np.c_[r * np.cos(a), r * np.sin(a)], name="egg100")
 
 
-def _roll(flt, part, start=40.0, steps=125):
+def _roll(flt: ContactFilter, part: Part, start: float = 40.0, steps: int = 125) -> tuple[float, float]:
     i = int(round(start / flt.tracks.h))
-    turns = STEP * np.arange(1, steps + 1)
+    turns = cast("FloatArray", STEP * np.arange(1, steps + 1))
     arcs, ok = flt.tracks.advance(np.full(steps, i), turns)
     assert ok.all()
     for k, (a, t) in enumerate(zip(arcs - flt.grid[i], turns)):
@@ -37,7 +49,7 @@ def _roll(flt, part, start=40.0, steps=125):
     return float(arcs[-1] - flt.grid[i]), float(turns[-1])
 
 
-def test_grid_filter_update(benchmark, part100):
+def test_grid_filter_update(benchmark: BenchmarkFixture, part100: Part) -> None:
     flt = ContactFilter(part100)
     z, turn = _roll(flt, part100)
     benchmark.extra_info.update({"part": "egg100 (100 knots)", "hypotheses": int(flt.grid.size)})
@@ -45,7 +57,7 @@ def test_grid_filter_update(benchmark, part100):
     per_second(benchmark, "updates_per_second")
 
 
-def test_grid_filter_belief(benchmark, part100):
+def test_grid_filter_belief(benchmark: BenchmarkFixture, part100: Part) -> None:
     flt = ContactFilter(part100)
     _roll(flt, part100)
     b = benchmark(flt.belief)
@@ -54,7 +66,7 @@ def test_grid_filter_belief(benchmark, part100):
 
 
 @pytest.mark.parametrize("particles", [2000, 20000, 200000])
-def test_particle_filter_update(benchmark, part100, particles):
+def test_particle_filter_update(benchmark: BenchmarkFixture, part100: Part, particles: int) -> None:
     pf = ParticleFilter(part100, particles=particles, seed=1)
     grid = ContactFilter(part100)
     z, turn = _roll(grid, part100)
@@ -64,14 +76,14 @@ def test_particle_filter_update(benchmark, part100, particles):
 
 
 @pytest.mark.parametrize("scales", ["weighed", "told"])
-def test_grid_filter_roll(benchmark, part100, scales):
+def test_grid_filter_roll(benchmark: BenchmarkFixture, part100: Part, scales: str) -> None:
     """A whole 25° roll, 125 readings with a belief every 5: what weighing the noise scale out costs
     (``weighed``: the default grid of 25 factors; ``told``: the settings taken at their word)."""
-    kwargs = {} if scales == "weighed" else {"noise_scales": (1.0,)}
+    kwargs: dict[str, Any] = {} if scales == "weighed" else {"noise_scales": (1.0,)}
     i = int(round(40.0 / ContactFilter(part100).tracks.h))
-    turns = STEP * np.arange(1, 126)
+    turns = cast("FloatArray", STEP * np.arange(1, 126))
 
-    def roll():
+    def roll() -> ContactFilter:
         flt = ContactFilter(part100, **kwargs)
         arcs, _ = flt.tracks.advance(np.full(turns.size, i), turns)
         flt.touch(-40.0)
@@ -81,15 +93,15 @@ def test_grid_filter_roll(benchmark, part100, scales):
                 flt.belief()
         return flt
 
-    flt = benchmark.pedantic(roll, rounds=5, iterations=1, warmup_rounds=1)
+    flt: ContactFilter = benchmark.pedantic(roll, rounds=5, iterations=1, warmup_rounds=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(part100.arc_offset(flt.belief().map_arc, flt.current[i])) < 0.05
     benchmark.extra_info.update({"scales": len(flt.noise_scales), "readings": int(turns.size)})
     if not benchmark.disabled:
-        benchmark.extra_info["per_reading_ms"] = benchmark.stats.stats.min / turns.size * 1e3
+        benchmark.extra_info["per_reading_ms"] = cast("Metadata", benchmark.stats).stats.min / turns.size * 1e3
 
 
 @pytest.mark.parametrize("name", ["egg100", "heldout-a star-16"])
-def test_reach_build(benchmark, part100, name):
+def test_reach_build(benchmark: BenchmarkFixture, part100: Part, name: str) -> None:
     """Building a part's reach for the 100 mm jaw (once per part; shared by every filter after)."""
     from pathlib import Path
 
@@ -100,12 +112,12 @@ def test_reach_build(benchmark, part100, name):
         if name == "egg100"
         else load_part(Path(__file__).resolve().parents[1] / "parts" / "heldout-a" / "star-16.json")
     )
-    r = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)
+    r: Reach = benchmark.pedantic(Reach, args=(part,), rounds=3, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     benchmark.extra_info.update({"perimeter_mm": round(part.perimeter, 1), "grid": int(r.sigma.size)})
     per_second(benchmark, "grid_points_per_second", r.sigma.size)
 
 
-def test_wheel_filter_roll(benchmark):
+def test_wheel_filter_roll(benchmark: BenchmarkFixture) -> None:
     """A 5 mm wheel's filter over a 20 mm roll from inside the kidney's waist: 80 readings 0.25 mm apart
     (one a millimetre used by the likelihood), a belief every 4, as :func:`driver.wheel.localize_with_wheel`."""
     part = load_part(PARTS_DIR / "kidney.csv")
@@ -115,7 +127,7 @@ def test_wheel_filter_roll(benchmark):
     theta = part.tangent_angle(part.param_at_arc(start + np.r_[0.0, lengths]))
     turns = theta[1:] - theta[0]
 
-    def roll():
+    def roll() -> Belief:
         flt.reset()
         for k, (L, om) in enumerate(zip(lengths, turns)):
             flt.update(float(L), float(om))
@@ -123,7 +135,7 @@ def test_wheel_filter_roll(benchmark):
                 b = flt.belief()
         return b
 
-    b = benchmark.pedantic(roll, rounds=5, iterations=1)
+    b: Belief = benchmark.pedantic(roll, rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(float(part.arc_offset(b.map_arc, start + lengths[-1]))) < 0.3
     benchmark.extra_info.update({"starts": int(flt.grid.size), "readings": int(lengths.size)})
     per_second(benchmark, "readings_per_second", lengths.size)

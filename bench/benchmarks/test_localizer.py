@@ -8,7 +8,11 @@ perimeter integration at the paper's h = 1e-5 on the same part, timed in the sam
 Run: ``pytest bench --benchmark-only`` (figures in ``--benchmark-json``).
 """
 
+from __future__ import annotations
+
 import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 import pytest
@@ -16,14 +20,21 @@ import pytest
 from bench.benchmarks.baselines import per_second, random_outline, traced_outline, trapezoid_perimeter, trefoil_part
 from localizer import feasible_segments, part_from_points
 
+if TYPE_CHECKING:
+    from pytest_benchmark.fixture import BenchmarkFixture
+    from pytest_benchmark.stats import Metadata
+
+    from localizer import Part, Segment
+    from localizer.solve._table import ArcTable
+
 N_QUERIES = 20
 
 
-def _star():
+def _star() -> Part:
     return part_from_points(random_outline(np.random.default_rng(0), n=36, amplitude=5.0), name="star-36")
 
 
-def _traced(seed):
+def _traced(seed: int) -> Callable[[], Part]:
     return lambda: part_from_points(traced_outline(np.random.default_rng(seed)), name=f"traced-90-{seed}")
 
 
@@ -31,14 +42,14 @@ PARTS = {"trefoil": trefoil_part, "star-36": _star, **{f"traced-90-{s}": _traced
 
 
 @pytest.fixture(scope="module", params=list(PARTS))
-def part(request):
+def part(request: pytest.FixtureRequest) -> Part:
     p = PARTS[request.param]()
     feasible_segments(p, 10.0, 0.1)  # build and cache the tables once per part (and compile the kernels)
     return p
 
 
 @pytest.fixture(scope="module")
-def queries(part):
+def queries(part: Part) -> list[tuple[float, float, float]]:
     rng = np.random.default_rng(2005)
     P = part.perimeter
     out = []
@@ -49,13 +60,17 @@ def queries(part):
     return out
 
 
-def _run(part, queries):
+def _run(part: Part, queries: list[tuple[float, float, float]]) -> list[list[Segment]]:
     return [feasible_segments(part, L, w) for _, L, w in queries]
 
 
-def test_exact_query_vs_perimeter_integration(benchmark, part, queries):
+def test_exact_query_vs_perimeter_integration(
+    benchmark: BenchmarkFixture, part: Part, queries: list[tuple[float, float, float]]
+) -> None:
     # rounds spread over a second or more: the machine's speed drifts over seconds (docs/contributing.md)
-    results = benchmark.pedantic(_run, args=(part, queries), rounds=200, iterations=1, warmup_rounds=2)
+    results: list[list[Segment]] = benchmark.pedantic(  # type: ignore[no-untyped-call,unused-ignore]
+        _run, args=(part, queries), rounds=200, iterations=1, warmup_rounds=2
+    )
     for (s0, L, w), segs in zip(queries, results):  # completeness: the truth is always found, exactly
         assert np.abs(part.arc_offset([s.start_arc for s in segs], s0)).min() < 1e-6
         for s in segs:
@@ -64,7 +79,7 @@ def test_exact_query_vs_perimeter_integration(benchmark, part, queries):
     if benchmark.disabled:
         return
     integration = min(_timed(trapezoid_perimeter, part) for _ in range(3))
-    per_query = benchmark.stats.stats.min / N_QUERIES
+    per_query = cast("Metadata", benchmark.stats).stats.min / N_QUERIES
     ratio = integration / per_query
     benchmark.extra_info.update(
         {
@@ -81,25 +96,25 @@ def test_exact_query_vs_perimeter_integration(benchmark, part, queries):
     assert ratio >= 1000
 
 
-def _timed(fn, *args):
+def _timed(fn: Callable[..., object], *args: object) -> float:
     t0 = time.perf_counter()
     fn(*args)
     return time.perf_counter() - t0
 
 
-def test_perimeter_integration_h1e5(benchmark):
+def test_perimeter_integration_h1e5(benchmark: BenchmarkFixture) -> None:
     part = trefoil_part()
-    value = benchmark.pedantic(trapezoid_perimeter, args=(part,), rounds=3, iterations=1)
+    value: float = benchmark.pedantic(trapezoid_perimeter, args=(part,), rounds=3, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert value == pytest.approx(part.perimeter, rel=1e-9)
     per_second(benchmark, "steps_per_second", part.n_knots / 1e-5)
 
 
-def test_table_build(benchmark):
+def test_table_build(benchmark: BenchmarkFixture) -> None:
     from localizer.solve._table import arc_table
 
-    def build():
+    def build() -> ArcTable:
         p = trefoil_part()
         return arc_table(p)
 
-    table = benchmark.pedantic(build, rounds=200, iterations=1)
+    table: ArcTable = benchmark.pedantic(build, rounds=200, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert table.theta_error < 1e-9

@@ -4,7 +4,10 @@ Run: ``pytest bench --benchmark-only`` (figures in ``--benchmark-json``); the
 full studies and plots are ``python -m bench.reports.march_study``.
 """
 
+from __future__ import annotations
+
 import time
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 import pytest
@@ -13,11 +16,17 @@ from bench.benchmarks.baselines import trefoil_part
 from bench.reports.march_study import proposition_1
 from localizer import MarchOptions, feasible_segments, march, march_grid
 
+if TYPE_CHECKING:
+    from pytest_benchmark.fixture import BenchmarkFixture
+    from pytest_benchmark.stats import Metadata
+
+    from localizer import MarchGrid, MarchResult, Part
+
 H = 1e-5  # the paper's step
 
 
 @pytest.fixture(scope="module")
-def part():
+def part() -> Part:
     p = trefoil_part()
     feasible_segments(p, 10.0, 0.1)
     march_grid(p, H)
@@ -25,14 +34,14 @@ def part():
 
 
 @pytest.fixture(scope="module")
-def query(part):
+def query(part: Part) -> tuple[float, float, float]:
     s0, L = 120.0, 25.0
     return s0, L, float(part.tangent_angle_at_arc(s0 + L) - part.tangent_angle_at_arc(s0))
 
 
-def test_march_query_at_paper_step(benchmark, part, query):
+def test_march_query_at_paper_step(benchmark: BenchmarkFixture, part: Part, query: tuple[float, float, float]) -> None:
     s0, L, w = query
-    res = benchmark.pedantic(
+    res: MarchResult = benchmark.pedantic(  # type: ignore[no-untyped-call,unused-ignore]
         march, args=(part, L, w), kwargs={"options": MarchOptions(step=H)}, rounds=100, iterations=1
     )
     assert 0 < res.steps <= 6 * res.grid_cells  # Theorem 2
@@ -55,23 +64,25 @@ def test_march_query_at_paper_step(benchmark, part, query):
         }
     )
     if not benchmark.disabled:
-        benchmark.extra_info["march_over_exact"] = benchmark.stats.stats.min / t_exact
+        benchmark.extra_info["march_over_exact"] = cast("Metadata", benchmark.stats).stats.min / t_exact
 
 
-def test_march_grid_at_paper_step(benchmark):
+def test_march_grid_at_paper_step(benchmark: BenchmarkFixture) -> None:
     p = trefoil_part()
 
-    def build():
+    def build() -> MarchGrid:
         p.forget_tables()
         return march_grid(p, H)
 
-    grid = benchmark.pedantic(build, rounds=2, iterations=1)
+    grid: MarchGrid = benchmark.pedantic(build, rounds=2, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert grid.length[-1] == pytest.approx(p.perimeter, rel=1e-9)
     assert grid.turn[-1] == pytest.approx(2 * np.pi, abs=1e-6)
 
 
-def test_proposition_1_ratio(benchmark):
-    rows = benchmark.pedantic(proposition_1, args=(2, 11), kwargs=dict(h=1e-4), rounds=1, iterations=1)
+def test_proposition_1_ratio(benchmark: BenchmarkFixture) -> None:
+    rows: list[dict[str, Any]] = benchmark.pedantic(  # type: ignore[no-untyped-call,unused-ignore]
+        proposition_1, args=(2, 11), kwargs=dict(h=1e-4), rounds=1, iterations=1
+    )
     ok = [r for r in rows if r["measured"] is not None and r["kind"] == "simple"]
     dev = np.array([abs(r["measured"] - r["predicted"]) for r in ok])
     benchmark.extra_info.update(

@@ -5,17 +5,21 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from localizer import CircularArc, CubicBezier, Line, load_outline
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 ROOT = Path(__file__).resolve().parents[2]
 PARTS = (ROOT / "parts" / "bracket.dxf", ROOT / "parts" / "profile.svg")
 COLOURS = {Line: "tab:blue", CircularArc: "tab:orange", CubicBezier: "tab:green"}
 
 
-def draw(paths, out: Path) -> Path:
+def draw(paths: Sequence[Path], out: Path) -> Path:
     """One panel per outline; returns the PNG written into ``out``."""
     import matplotlib
 
@@ -42,11 +46,11 @@ def draw(paths, out: Path) -> Path:
         ax.grid(alpha=0.3)
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
-    handles = [plt.Line2D([], [], color=c, lw=2, label=k.__name__) for k, c in COLOURS.items()]
+    handles = [plt.Line2D([], [], color=c, lw=2, label=k.__name__) for k, c in COLOURS.items()]  # type: ignore[attr-defined,unused-ignore]
     handles += [
-        plt.Line2D([], [], ls="", marker="^", color="k", label="convex corner"),
-        plt.Line2D([], [], ls="", marker="v", color="tab:red", label="concave corner"),
-        plt.Line2D([], [], ls="", marker="o", color="k", label="first point (arrow: travel)"),
+        plt.Line2D([], [], ls="", marker="^", color="k", label="convex corner"),  # type: ignore[attr-defined,unused-ignore]
+        plt.Line2D([], [], ls="", marker="v", color="tab:red", label="concave corner"),  # type: ignore[attr-defined,unused-ignore]
+        plt.Line2D([], [], ls="", marker="o", color="k", label="first point (arrow: travel)"),  # type: ignore[attr-defined,unused-ignore]
     ]
     fig.legend(handles=handles, loc="lower center", ncol=6, fontsize=8)
     fig.tight_layout(rect=(0, 0.08, 1, 1))
@@ -57,7 +61,7 @@ def draw(paths, out: Path) -> Path:
     return png
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.reports.cad_figure", description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "generated" / "cad")
     args = ap.parse_args(argv)

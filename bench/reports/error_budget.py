@@ -15,11 +15,15 @@ import sys
 import tempfile
 from dataclasses import fields
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from bench.montecarlo import run_study
 from bench.study import load_study
 from bench.summary import wilson
 from sim2d import PRESETS
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 GROUPS = {
     "twist noise (v2_noise)": ["v2_noise"],
@@ -35,7 +39,7 @@ GROUPS = {
 PAPER_STUDY = Path(__file__).resolve().parents[1] / "studies" / "paper.toml"
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="docs/generated/robustness/budget")
     ap.add_argument("--trials", type=int, default=150)
@@ -62,7 +66,7 @@ def main(argv=None) -> int:
     else:
         for label, names in GROUPS.items():
             configs[f"only {label}"] = {n: 0.0 for n in every if n not in names}
-    results = {}
+    results: dict[str, dict[str, Any]] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for k, (label, zeroed) in enumerate(configs.items()):
             noise_file = Path(tmp) / f"noise{k}.toml"
@@ -94,7 +98,7 @@ def main(argv=None) -> int:
     return 0
 
 
-def _plot(results, path, trials):
+def _plot(results: dict[str, dict[str, Any]], path: Path, trials: int) -> None:
     import matplotlib
 
     matplotlib.use("Agg")

@@ -13,11 +13,21 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
 from bench.benchmarks.baselines import random_outline, trapezoid_perimeter, trefoil_part
 from localizer import LENGTH_TOL, TURN_TOL, MarchOptions, feasible_segments, march, march_grid, part_from_points
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
+
+    from localizer import Part, Segment
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 TIGHT: dict[str, float] = {"length_tol": 1e-10, "turn_tol": 1e-10}
 
@@ -26,7 +36,7 @@ def _log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def _random_part(rng, convex: bool):
+def _random_part(rng: np.random.Generator, convex: bool) -> Part:
     while True:
         part = part_from_points(random_outline(rng, int(rng.integers(24, 60)), 2.5 if convex else 9.0))
         kmin = part.curvature(np.linspace(0, part.n_knots, 20 * part.n_knots)).min()
@@ -34,18 +44,18 @@ def _random_part(rng, convex: bool):
             return part
 
 
-def _query(part, rng):
+def _query(part: Part, rng: np.random.Generator) -> tuple[float, float, float]:
     P = part.perimeter
     s0, L = rng.uniform(0, P), rng.uniform(0.05, 0.4) * P
     w = float(part.tangent_angle_at_arc(s0 + L) - part.tangent_angle_at_arc(s0))
     return s0, L, w
 
 
-def _nearest(part, segs, arc):
+def _nearest(part: Part, segs: Sequence[Segment], arc: float) -> Segment:
     return min(segs, key=lambda g: abs(part.arc_offset(g.start_arc, arc)))
 
 
-def measured_ratio(part, seg, exact_start):
+def measured_ratio(part: Part, seg: Segment, exact_start: float) -> float | None:
     """Median ratio of consecutive iterate errors in the linear regime, or None."""
     err = np.abs(part.arc_offset(np.array(seg.iterates), exact_start))
     tail = err[(err > 1e-6) & (err < 0.1)]
@@ -55,10 +65,10 @@ def measured_ratio(part, seg, exact_start):
 
 
 # ------------------------------------------------------------------ studies
-def proposition_1(n_parts: int, seed: int, h: float = 1e-4, max_iterations: int = 20_000):
+def proposition_1(n_parts: int, seed: int, h: float = 1e-4, max_iterations: int = 20_000) -> list[dict[str, Any]]:
     """Measured convergence ratio against κ(s*)/κ(t*) on random convex parts."""
     rng = np.random.default_rng(seed)
-    rows = []
+    rows: list[dict[str, Any]] = []
     for k in range(n_parts):
         part = _random_part(rng, convex=True)
         for _ in range(2):
@@ -88,12 +98,18 @@ def proposition_1(n_parts: int, seed: int, h: float = 1e-4, max_iterations: int 
     return rows
 
 
-def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int, deltas=(3e-2, 1e-2, 3e-3, 1e-3, 3e-4)):
+def near_equal_curvature(
+    n_parts: int,
+    seed: int,
+    h: float,
+    max_iterations: int,
+    deltas: Sequence[float] = (3e-2, 1e-2, 3e-3, 1e-3, 3e-4),
+) -> list[dict[str, Any]]:
     """Instances made to have κ(t*)/κ(s*) = 1 + δ: the ratio of Proposition 1 close to 1."""
     from scipy.optimize import brentq
 
     rng = np.random.default_rng(seed)
-    rows = []
+    rows: list[dict[str, Any]] = []
     for k in range(n_parts):
         part = _random_part(rng, convex=True)
         P = part.perimeter
@@ -140,10 +156,10 @@ def near_equal_curvature(n_parts: int, seed: int, h: float, max_iterations: int,
     return rows
 
 
-def theorem_2(n_parts: int, seed: int, h: float = 1e-4):
+def theorem_2(n_parts: int, seed: int, h: float = 1e-4) -> list[dict[str, Any]]:
     """Steps taken against the bound 6τ/h, convex and non-convex."""
     rng = np.random.default_rng(seed)
-    rows = []
+    rows: list[dict[str, Any]] = []
     for _k in range(n_parts):
         for convex in (True, False):
             part = _random_part(rng, convex)
@@ -161,12 +177,14 @@ def theorem_2(n_parts: int, seed: int, h: float = 1e-4):
     return rows
 
 
-def cost_against_step(steps=(1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, seed: int = 3):
+def cost_against_step(
+    steps: Sequence[float] = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, seed: int = 3
+) -> list[dict[str, Any]]:
     """Grid build, march and step count against h on the 90-knot trefoil."""
     part = trefoil_part()
     rng = np.random.default_rng(seed)
     qs = [_query(part, rng) for _ in range(n_queries)]
-    rows = []
+    rows: list[dict[str, Any]] = []
     for h in steps:
         part.forget_tables()
         t0 = time.perf_counter()
@@ -188,10 +206,10 @@ def cost_against_step(steps=(1e-3, 3e-4, 1e-4, 3e-5, 1e-5), n_queries: int = 5, 
     return rows
 
 
-def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int = 3):
+def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int = 3) -> list[dict[str, Any]]:
     """Does the march at the paper's step and tolerances find every exact segment?"""
     rng = np.random.default_rng(seed)
-    rows = []
+    rows: list[dict[str, Any]] = []
     for convex in (True, False):
         for k in range(n_parts):
             part = _random_part(rng, convex)
@@ -199,7 +217,7 @@ def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int
                 s0, L, w = _query(part, rng)
                 exact = feasible_segments(part, L, w)
                 marched = march(part, L, w, MarchOptions(step=h)).segments
-                missed = []
+                missed: list[dict[str, float]] = []
                 for e in exact:
                     slope = abs(float(part.curvature(e.end_param) - part.curvature(e.start_param)))
                     allowed = 2 * TURN_TOL / max(slope, 1e-12) + 2 * LENGTH_TOL + 0.01
@@ -223,7 +241,7 @@ def completeness(n_parts: int, seed: int, h: float = 1e-5, queries_per_part: int
     return rows
 
 
-def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
+def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5) -> dict[str, Any]:
     """Time per query and error of both methods on the trefoil, in one run.
 
     The error is the distance from the true start (the queries are made from
@@ -237,7 +255,7 @@ def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
     grid = march_grid(part, h)  # the march's h-grid, once per part and step
     _ = grid.inflections, grid.negated_turn  # and what it derives from it
     build = time.perf_counter() - t0
-    rows = []
+    rows: list[dict[str, Any]] = []
     for s0, L, w in qs:
         t0 = time.perf_counter()
         ex = feasible_segments(part, L, w)
@@ -269,7 +287,14 @@ def exact_vs_march(h: float = 1e-5, n_queries: int = 10, seed: int = 5):
 
 
 # -------------------------------------------------------------------- plots
-def _plots(out: Path, prop1, thm2, cost, compl, versus):
+def _plots(
+    out: Path,
+    prop1: list[dict[str, Any]],
+    thm2: list[dict[str, Any]],
+    cost: list[dict[str, Any]],
+    compl: list[dict[str, Any]],
+    versus: dict[str, Any],
+) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -292,6 +317,7 @@ def _plots(out: Path, prop1, thm2, cost, compl, versus):
     stalled = np.array([r["kind"] == "stalled" for r in prop1])
     a2.semilogy(allp[~stalled], np.maximum(its[~stalled], 1), "o", ms=4, alpha=0.7, label="converged")
     a2.semilogy(allp[stalled], its[stalled], "x", color="tab:red", ms=7, label="stalled (iteration cap)")
+    r: FloatArray | dict[str, Any]  # the name serves twice: these ratios, then a completeness row below
     r = np.linspace(0.05, 0.9995, 400)
     a2.semilogy(r, np.log(1e-10 / 10.0) / np.log(r), color="0.5", lw=1, label="log(1e-10 / 10 mm) / log r")
     a2.set_xlabel("predicted ratio")
@@ -405,11 +431,17 @@ def _plots(out: Path, prop1, thm2, cost, compl, versus):
     plt.close(fig)
 
 
-def summarize(prop1, thm2, cost, compl, versus):
+def summarize(
+    prop1: list[dict[str, Any]],
+    thm2: list[dict[str, Any]],
+    cost: list[dict[str, Any]],
+    compl: list[dict[str, Any]],
+    versus: dict[str, Any],
+) -> dict[str, Any]:
     ok = [r for r in prop1 if r["measured"] is not None and r["kind"] == "simple"]
     dev = np.array([abs(r["measured"] - r["predicted"]) for r in ok])
     rows = versus["rows"]
-    by = {}
+    by: dict[str, dict[str, Any]] = {}
     for convex in (True, False):
         sel = [r for r in compl if r["convex"] == convex]
         by["convex" if convex else "non_convex"] = {
@@ -456,7 +488,7 @@ def summarize(prop1, thm2, cost, compl, versus):
     }
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="docs/generated/march", help="folder for the PNG plots and summary.json")
     ap.add_argument("--quick", action="store_true", help="few instances and h=1e-4 for completeness")

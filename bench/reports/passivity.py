@@ -22,6 +22,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,6 +30,11 @@ from passivity import PassivityController
 from sim2d.haptic import Axis, Operator, Servo, simulate_servo, simulate_wall
 from sim2d.noise import PRESETS
 from sim2d.wrist import Wrist
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from sim2d.haptic import AxisTrace
 
 VARIANTS = {
     "plain": {},
@@ -44,7 +50,9 @@ def controller(variant: str, dt: float, booking: str = "observed") -> PassivityC
     return PassivityController(dt, booking=booking, **VARIANTS[variant])
 
 
-def wall_study(axis: Axis = Axis(), operator: Operator = Operator()) -> tuple[dict, dict]:
+def wall_study(
+    axis: Axis = Axis(), operator: Operator = Operator()
+) -> tuple[dict[str, dict[str, Any]], dict[str, Any]]:
     """Run the four variants (and the bare wall). Returns (results, traces)."""
     results, traces = {}, {}
     for name in VARIANTS:
@@ -71,7 +79,9 @@ def wall_study(axis: Axis = Axis(), operator: Operator = Operator()) -> tuple[di
     return results, {"traces": traces, "extra": extra}
 
 
-def servo_study(gains=GAINS, noise: str = "paper", duration: float = 1.0, seed: int = 0) -> tuple[list, dict]:
+def servo_study(
+    gains: Sequence[float] = GAINS, noise: str = "paper", duration: float = 1.0, seed: int = 0
+) -> tuple[list[dict[str, Any]], dict[str, AxisTrace]]:
     """The contact servo, bare and guarded, at each gain. Returns (rows, traces at gain 20)."""
     model = PRESETS[noise]
     volts_per_newton = Wrist().volts_per_newton
@@ -103,7 +113,7 @@ def servo_study(gains=GAINS, noise: str = "paper", duration: float = 1.0, seed: 
     return rows, traces
 
 
-def _plots(out: Path, wall: dict, servo_traces: dict) -> None:
+def _plots(out: Path, wall: dict[str, Any], servo_traces: dict[str, AxisTrace]) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -151,7 +161,7 @@ def _plots(out: Path, wall: dict, servo_traces: dict) -> None:
     plt.close(fig)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench.reports.passivity", description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--json",

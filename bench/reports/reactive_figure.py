@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
@@ -22,19 +23,32 @@ from driver.jaw import calibrate_simulated, localize_reactively
 from localizer import load_part
 from sim2d import SimRig, load_noise
 
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
+
+    from driver.jaw import ReactiveRun
+    from localizer import Outline, Part
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
+    #: One belief check: (rotation rolled, rad; present contact of each hypothesis, mm; their posterior;
+    #: the true contact, mm; the belief's mass within its radius of the estimate).
+    Snapshot: TypeAlias = tuple[float, FloatArray, FloatArray, float, float]
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def run(part_file: Path, start: float, seed: int):
+def run(part_file: Path, start: float, seed: int) -> tuple[Part | Outline, ReactiveRun, list[Snapshot], float]:
     part = load_part(part_file)
     study = load_study(ROOT / "bench" / "studies" / "reactive.toml")
     noise = load_noise("paper")
     cal = calibrate_simulated(part, noise, seed=seed + 1)
     rig = SimRig(part, noise=noise, seed=seed)
     flt = reactive_filter(study, part, noise)
-    snaps = []
+    snaps: list[Snapshot] = []
 
-    def observe(event):
+    def observe(event: dict[str, Any]) -> None:
         if event.get("event") == "belief":
             w = flt.posterior()
             snaps.append((event["rotation"], part.wrap_arc(flt.current.copy()), w, event["true_arc"], event["mass"]))
@@ -51,7 +65,7 @@ def run(part_file: Path, start: float, seed: int):
     return part, res, snaps, rig.truth()["contact_arc"]
 
 
-def draw(part, snaps, out: Path, title: str) -> None:
+def draw(part: Part | Outline, snaps: Sequence[Snapshot], out: Path, title: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -109,7 +123,7 @@ def draw(part, snaps, out: Path, title: str) -> None:
     plt.close(fig)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m bench.reports.reactive_figure", description=__doc__.split("\n\n")[0]
     )

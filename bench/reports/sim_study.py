@@ -13,6 +13,7 @@ import math
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
@@ -29,18 +30,29 @@ from driver.rig import RigError
 from localizer import SUCCESS_RADIUS, Part, load_part
 from sim2d import SimRig
 
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
+
 SHIPPED = ("cam.json", "ellipse.json", "trefoil.json", "kidney.csv")
 
 
-def _log(msg):
+def _log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def fidelity(steps_deg=(0.8, 0.4, 0.2, 0.1), starts=(20.0, 90.0, 160.0, 230.0), angle_deg=40.0):
+def fidelity(
+    steps_deg: Sequence[float] = (0.8, 0.4, 0.2, 0.1),
+    starts: Sequence[float] = (20.0, 90.0, 160.0, 230.0),
+    angle_deg: float = 40.0,
+) -> list[dict[str, Any]]:
     """Noise-free rolls on the cam: the paper's L estimate and ours against the true arc length."""
     part = load_part(PARTS_DIR / "cam.json")
     cal = calibrate_simulated(part)
-    rows = []
+    rows: list[dict[str, Any]] = []
     for deg in steps_deg:
         for start in starts:
             rig = SimRig(part, noise="none", seed=1)
@@ -65,10 +77,13 @@ def fidelity(steps_deg=(0.8, 0.4, 0.2, 0.1), starts=(20.0, 90.0, 160.0, 230.0), 
     return rows
 
 
-def calibration_accuracy(noises=("none", "paper"), seeds=(0, 1, 2)):
+def calibration_accuracy(
+    noises: Sequence[str] = ("none", "paper"), seeds: Sequence[int] = (0, 1, 2)
+) -> dict[str, dict[str, float]]:
     part = load_part(PARTS_DIR / "cam.json")
-    out = {}
+    out: dict[str, dict[str, float]] = {}
     for noise in noises:
+        errs: list[float] | FloatArray  # the name serves twice: the readings' errors, then as an array
         errs = []
         for seed in seeds:
             cal = calibrate_simulated(part, noise, seed=seed)
@@ -86,13 +101,13 @@ def calibration_accuracy(noises=("none", "paper"), seeds=(0, 1, 2)):
     return out
 
 
-def engines(starts=(20.0, 120.0, 200.0)):
+def engines(starts: Sequence[float] = (20.0, 120.0, 200.0)) -> list[dict[str, Any]]:
     """The same noise-free two-roll runs on the kinematic and the pymunk rig."""
     part = load_part(PARTS_DIR / "cam.json")
     cal = calibrate_simulated(part)
-    rows = []
+    rows: list[dict[str, Any]] = []
     for start in starts:
-        res = {}
+        res: dict[str, dict[str, Any]] = {}
         for engine in ("kinematic", "pymunk"):
             rig = SimRig(part, noise="none", seed=1, engine=engine)
             t0 = time.perf_counter()
@@ -129,17 +144,19 @@ def engines(starts=(20.0, 120.0, 200.0)):
 LIKELIHOOD_SD = {"none": (0.01, 1e-5), "paper": (0.3, math.radians(0.03))}
 
 
-def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", rolls_deg=(20.0, 15.0)):
+def end_to_end(
+    noise: str, trials: int, seed: int, engine: str = "kinematic", rolls_deg: Sequence[float] = (20.0, 15.0)
+) -> dict[str, dict[str, Any]]:
     """Two rolls from random starts on every shipped part: success (< 0.3 mm), refusals, ambiguity."""
     rng = np.random.default_rng(seed)
     sd_length, sd_turn = LIKELIHOOD_SD[noise]
-    out = {}
+    out: dict[str, dict[str, Any]] = {}
     for name in SHIPPED:
         part = load_part(PARTS_DIR / name)
         if not isinstance(part, Part):
             raise TypeError(f"{name}: the paper's study rolls on the shipped point-file parts")
         cal = calibrate_simulated(part, noise, seed=seed, engine=engine)
-        rows: list[dict] = []
+        rows: list[dict[str, Any]] = []
         for _k in range(trials):
             start = float(rng.uniform(0, part.perimeter))
             rig = SimRig(part, noise=noise, seed=int(rng.integers(1 << 31)), engine=engine)
@@ -207,7 +224,7 @@ def end_to_end(noise: str, trials: int, seed: int, engine: str = "kinematic", ro
     return out
 
 
-def _plot(out: Path, fid, e2e_paper):
+def _plot(out: Path, fid: list[dict[str, Any]], e2e_paper: dict[str, dict[str, Any]]) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -251,7 +268,7 @@ def _plot(out: Path, fid, e2e_paper):
     plt.close(fig)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="docs/generated/sim")
     ap.add_argument("--trials", type=int, default=40, help="random starts per part and noise level")

@@ -12,10 +12,20 @@ import argparse
 import json
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
 from localizer import Reach, WheelJaw, load_part, roll_bound, wheel_reach_for
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
+    import numpy.typing as npt
+
+    from localizer import Outline, Part
+
+    FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 ROOT = Path(__file__).resolve().parents[2]
 PARTS = {
@@ -37,7 +47,7 @@ DIRECTION_SD = math.radians(0.02)
 ROLL = 15.0  # mm, the roll whose bound is drawn
 
 
-def sample(part):
+def sample(part: Part | Outline) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """(arc, points, tangent angle, curvature) every SPACING mm."""
     s = np.arange(0.0, part.perimeter, SPACING)
     return (
@@ -48,7 +58,7 @@ def sample(part):
     )
 
 
-def roll_sds(kappa_ends, radius, texture):
+def roll_sds(kappa_ends: Iterable[FloatArray], radius: float, texture: float) -> tuple[float, FloatArray]:
     """The standard deviations (mm, rad) of one roll's L and Ω for a wheel of ``radius`` mm, one
     reading at each end (docs/wheel.md): the axle encoder and the calibrated radius's error in L;
     the arm encoder, the wrist's residual direction and the surface texture the disc follows (tilts
@@ -59,7 +69,7 @@ def roll_sds(kappa_ends, radius, texture):
     return math.sqrt(var_l), np.sqrt(var_o)
 
 
-def figures(out: Path) -> dict:
+def figures(out: Path) -> dict[str, Any]:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -67,7 +77,7 @@ def figures(out: Path) -> dict:
 
     out.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
-    numbers: dict = {"radii_mm": list(RADII), "reach": {}, "bound_mm": {}}
+    numbers: dict[str, Any] = {"radii_mm": list(RADII), "reach": {}, "bound_mm": {}}
 
     # 1. a wheel of 5 mm rolling along the kidney's concave side
     # each part read once, so that each wheel's reach is built once (wheel_reach_for keeps it)
@@ -82,7 +92,7 @@ def figures(out: Path) -> dict:
     centre = pts + r * np.c_[np.sin(th), -np.cos(th)]
     ax.plot(*centre[ok].T, ".", color="tab:blue", ms=0.6, label=f"axle path, wheel r = {r:g} mm")
     for k in concave[:: max(1, concave.size // 5)]:
-        ax.add_patch(plt.Circle(tuple(centre[k]), r, fill=False, color="tab:blue", lw=1))
+        ax.add_patch(plt.Circle(tuple(centre[k]), r, fill=False, color="tab:blue", lw=1))  # type: ignore[attr-defined,unused-ignore]
         ax.plot(*pts[k], "o", color="k", ms=3)
     ax.plot(*pts[~ok].T, ".", color="tab:red", ms=1.0, label="not reached by it")
     ax.set_aspect("equal")
@@ -137,7 +147,7 @@ def figures(out: Path) -> dict:
     return numbers
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.reports.wheel_figure", description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("docs/generated/wheel"))
     args = ap.parse_args(argv)
