@@ -3,7 +3,12 @@ finger's and the world's; a contract other tools read (names kept stable)."""
 
 from __future__ import annotations
 
-__all__ = ["TRIAL_COLUMNS", "METHODS", "METHOD_COLUMNS", "FINGER_COLUMNS", "WORLD_COLUMNS"]
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from sim2d import WorldChange
+
+__all__ = ["TRIAL_COLUMNS", "METHODS", "METHOD_COLUMNS", "FINGER_COLUMNS", "WORLD_COLUMNS", "world_cells"]
 
 
 #: Columns of trials.csv, in order.
@@ -63,3 +68,15 @@ FINGER_COLUMNS = ("jaw", "redraws", "reachable", "arc_mm")
 #: Columns of a study with a ``[world]`` table: the defects' centres (model arc, mm) and signed heights
 #: (mm), space-separated, the world's scale, and the wrist's spikes in the localizing rig's readings.
 WORLD_COLUMNS = ("world_defect_arc", "world_defect_height_mm", "world_scale", "world_spikes")
+
+
+def world_cells(change: WorldChange | None, spikes: int | str = "") -> dict[str, Any]:
+    """The :data:`WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
+    if change is None:
+        return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
+    return {
+        "world_defect_arc": " ".join(f"{d.arc:.3f}" for d in change.defects),
+        "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
+        "world_scale": change.scale,
+        "world_spikes": spikes,
+    }

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 
     from .trial import TrialSpec
 
-__all__ = ["TrialDraw", "draw_trial", "draw_world", "world_cells"]
+__all__ = ["TrialDraw", "draw_trial", "draw_world"]
 
 
 class TrialDraw(NamedTuple):
@@ -57,15 +57,3 @@ def draw_world(spec: TrialSpec, part_file: str, part: Part | Outline, start: flo
         return None
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial, 2]))
     return s.world.draw(part, start, rng, s.parts.index(part_file))
-
-
-def world_cells(change: WorldChange | None, spikes: int | str = "") -> dict[str, Any]:
-    """The :data:`bench.columns.WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
-    if change is None:
-        return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
-    return {
-        "world_defect_arc": " ".join(f"{d.arc:.3f}" for d in change.defects),
-        "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
-        "world_scale": change.scale,
-        "world_spikes": spikes,
-    }

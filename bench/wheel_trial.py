@@ -19,6 +19,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from driver.wheel import WheelRun
+    from localizer import Outline, Part
+
+    from .study import Study
     from .trial import TrialSpec
 
 __all__ = ["run_wheel_trial", "RADIUS_SD", "MAX_REDRAWS"]
@@ -35,8 +39,8 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
     from localizer import WheelJaw, parse_jaw, wheel_reach_for
     from sim2d import WheelRig
 
-    from .methods import _curve, _err, mismatch_cell, reactive_stop, rotation_curve
-    from .trial_draw import draw_trial, draw_world, world_cells
+    from .columns import world_cells
+    from .trial_draw import draw_trial, draw_world
 
     s = spec.study
     t0 = time.perf_counter()
@@ -68,6 +72,7 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
     )
     cal_seed, rig_seed = int(rng.integers(1 << 31)), int(rng.integers(1 << 31))
     change = None
+    failure: str | None = None
     try:
         if not math.isfinite(start):
             raise RuntimeError(f"no start the {wheel} reaches in {MAX_REDRAWS} draws on {part.name}")
@@ -81,7 +86,10 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
             rig, part, wheel, approach_pose=rig.approach_pose(start), calibration=cal, policy=policy
         )
     except Exception as exc:  # noqa: BLE001 - the trial's failure is its result
-        text = f"{type(exc).__name__}: {exc}"[:200]
+        failure = f"{type(exc).__name__}: {exc}"[:200]
+    if failure is not None:
+        text = failure
+        spikes: int | str = ""
         row.update(
             {
                 "true_arc": math.nan,
@@ -103,38 +111,42 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
                 "reactive_bridges": "",
                 "reactive_bound_mm": "",
                 "reactive_mismatch_arc": "",
-                "time_s": time.perf_counter() - t0,
-                **(world_cells(change) if s.world is not None else {}),
             }
         )
-        return row
-    truth = rig.truth()["contact_arc"]
+    else:
+        spikes = rig.spikes.count
+        row.update(_run_cells(s, part, run, rig.truth()["contact_arc"]))
+    row["time_s"] = time.perf_counter() - t0
+    if s.world is not None:
+        row.update(world_cells(change, spikes))
+    return row
+
+
+def _run_cells(s: Study, part: Part | Outline, run: WheelRun, truth: float) -> dict[str, Any]:
+    """The cells of a wheel's run that ended (sure or not) with the contact at ``truth`` mm."""
+    from .methods import _curve, _err, mismatch_cell, reactive_stop, rotation_curve
+
     err = _err(part, run.estimate_arc, truth)
     rot = math.degrees(run.rotation)
     ok = int(err < s.success_radius)
-    row.update(
-        {
-            "true_arc": truth,
-            "estimate_arc": run.estimate_arc,
-            "error_mm": err,
-            "success": ok,
-            "probability": run.belief.mass,
-            "ambiguous": int(run.belief.ambiguous),
-            "failure": "",
-            "arc_mm": run.arc,
-            "reactive_success": ok,
-            "reactive_error_mm": err,
-            "reactive_estimate_arc": run.estimate_arc,
-            "reactive_rotation_deg": rot,
-            "reactive_curve": _curve(rotation_curve(part, run.history, rot, err, s.reactive.max_rotation_deg)),
-            "reactive_stopped": reactive_stop(run),
-            "reactive_mass": run.belief.mass,
-            "reactive_failure": "",
-            "reactive_bridges": run.jumps,
-            "reactive_bound_mm": "",  # the bound models the straight jaw's readings
-            "reactive_mismatch_arc": mismatch_cell(run.belief),
-            "time_s": time.perf_counter() - t0,
-            **(world_cells(change, rig.spikes.count) if s.world is not None else {}),
-        }
-    )
-    return row
+    return {
+        "true_arc": truth,
+        "estimate_arc": run.estimate_arc,
+        "error_mm": err,
+        "success": ok,
+        "probability": run.belief.mass,
+        "ambiguous": int(run.belief.ambiguous),
+        "failure": "",
+        "arc_mm": run.arc,
+        "reactive_success": ok,
+        "reactive_error_mm": err,
+        "reactive_estimate_arc": run.estimate_arc,
+        "reactive_rotation_deg": rot,
+        "reactive_curve": _curve(rotation_curve(part, run.history, rot, err, s.reactive.max_rotation_deg)),
+        "reactive_stopped": reactive_stop(run),
+        "reactive_mass": run.belief.mass,
+        "reactive_failure": "",
+        "reactive_bridges": run.jumps,
+        "reactive_bound_mm": "",  # the bound models the straight jaw's readings
+        "reactive_mismatch_arc": mismatch_cell(run.belief),
+    }
