@@ -17,40 +17,23 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple, TypeAlias, cast
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 import numpy.typing as npt
 
+from .reactive_method import (
+    reactive_filter,
+    score_reactive,
+)
+from .scoring import ENCODER_SLACK_DEG, MARK_DEG, FloatArray, boundary_error, curve_cell
+
 if TYPE_CHECKING:
-    from driver.jaw import Calibration, ReactivePolicy, ReactiveRun, RollResult
-    from driver.wheel import WheelRun
-    from localizer import Belief, Candidate, ContactFilter, Localization, Outline, Part
+    from driver.jaw import Calibration, RollResult
+    from localizer import Candidate, ContactFilter, Localization, Outline, Part
     from sim2d import NoiseModel, WorldChange
 
     from .study import Study
-
-FloatArray: TypeAlias = npt.NDArray[np.float64]
-
-MARK_DEG = 5.0
-#: Where the jaw is laid on the part: the contact this far (mm) from the jaw's centre, behind it in
-#: the rolling direction, so that most of the jaw lies ahead.
-JAW_START = 40.0
-#: How far short of a mark (degrees) a measured turn still reaches it: more than the encoder's step.
-ENCODER_SLACK_DEG = 0.05
-
-
-def _curve(pairs: Iterable[tuple[float, float]]) -> str:
-    return " ".join(f"{r:g}:{e:.4f}" for r, e in pairs)
-
-
-def parse_curve(text: str) -> list[tuple[float, float]]:
-    """[(rotation deg, error mm), ...] of a ``<method>_curve`` cell."""
-    out = []
-    for item in str(text or "").split():
-        r, e = item.split(":")
-        out.append((float(r), float(e)))
-    return out
 
 
 def fixed_readings(rolls: Sequence[RollResult], part: Part | Outline) -> dict[str, FloatArray]:
@@ -129,12 +112,6 @@ def _sd_scale(study: Study) -> float:
 
     given = study.reactive.sd_scale
     return float(given if given is not None else SCALE_SD)
-
-
-def _err(part: Part | Outline, est: float, truth: float) -> float:
-    if not (math.isfinite(est) and math.isfinite(truth)):
-        return math.inf
-    return abs(float(part.arc_offset(est, truth)))
 
 
 def _marks(turns: FloatArray) -> list[tuple[float, int]]:
@@ -222,7 +199,7 @@ def score_rule(
         }
     return {
         "estimate_arc": best.end_arc,
-        "error_mm": _err(part, best.end_arc, true_arc),
+        "error_mm": boundary_error(part, best.end_arc, true_arc),
         "candidates": len(loc.candidates),
         "probability": best.probability,
         "ambiguous": int(loc.ambiguous),
@@ -261,7 +238,7 @@ def score_paper(
                 sd_length=study.sd_length,
                 sd_turn=math.radians(study.sd_turn_deg),
             ).best
-            e = _err(part, sub.end_arc, seq["truth"][k]) if sub is not None else math.inf
+            e = boundary_error(part, sub.end_arc, seq["truth"][k]) if sub is not None else math.inf
         except Exception:  # noqa: BLE001 - a prefix the rule cannot take counts as a miss
             e = math.inf
         curve.append((mark, e))
@@ -294,11 +271,11 @@ def _score_sequential(
     for j in range(1, len(seq["z"])):
         update(float(seq["z"][j]), float(seq["turn"][j]), float(seq["jaw"][j]))
         if j in marks:
-            curve.append((marks[j], _err(part, estimate()[0], seq["truth"][j])))
+            curve.append((marks[j], boundary_error(part, estimate()[0], seq["truth"][j])))
     est, mass = estimate()
     return {
         "estimate_arc": est,
-        "error_mm": _err(part, est, seq["truth"][-1]),
+        "error_mm": boundary_error(part, est, seq["truth"][-1]),
         "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)),
         "curve": curve,
         "stopped": "fixed",
@@ -332,124 +309,6 @@ def score_grid(study: Study, part: Part | Outline, noise: NoiseModel, seq: dict[
         return b.map_arc, b.mass
 
     return _score_sequential(study, part, seq, flt.update, estimate)
-
-
-def reactive_filter(
-    study: Study, part: Part | Outline, noise: NoiseModel, filter_class: type[ContactFilter] | None = None
-) -> ContactFilter:
-    """The ContactFilter a study's [reactive] options describe (``filter_class``: a subclass to build
-    instead, e.g. :class:`bench.replay.FilterRecorder`).
-
-    Standard deviations not given are the filter's own defaults; ``sd_slope = "auto"`` takes 5x the
-    study's noise model's RMS slope (machined parts vary: measured 0.8e-3 to 1.9e-3 rad RMS at the
-    paper preset, whose model RMS is 0.6e-3, and the basis' coefficients are not its values).
-    """
-    from localizer import ContactFilter
-    from sim2d import machining_slope
-
-    o = study.reactive
-    given = {k: getattr(o, k) for k in ("sd_position", "sd_scale", "sd_slope") if getattr(o, k) is not None}
-    if given.get("sd_slope") == "auto":
-        given["sd_slope"] = max(
-            5.0 * machining_slope(noise.machining_error, noise.machining_wavelength, part.perimeter), 5e-4
-        )
-    for key in ("noise_scales", "slope_envelope"):
-        if getattr(o, key) is not None:
-            given[key] = getattr(o, key)
-    for key in ("temper", "shape_spacing", "defect_window", "lookalike_slope", "corner_ends"):
-        if getattr(o, key) is not None:
-            given[key] = getattr(o, key)
-    cls = ContactFilter if filter_class is None else filter_class
-    return cls(part, radius=study.success_radius, confidence=o.confidence, **given)
-
-
-def reactive_policy(study: Study) -> ReactivePolicy:
-    """The :class:`driver.jaw.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
-    from driver.jaw import CONFIRM, ReactivePolicy
-
-    o = study.reactive
-    return ReactivePolicy(
-        step=math.radians(study.step_deg),
-        confidence=o.confidence,
-        max_rotation=math.radians(o.max_rotation_deg),
-        check_every=o.check_every,
-        min_spread=o.min_spread,
-        confirm=CONFIRM if o.confirm is None else o.confirm,
-    )
-
-
-def reactive_stop(run: ReactiveRun | WheelRun) -> str:
-    """A reactive run's stop as trials.csv says it: confident, mismatch (the readings did not fit the part),
-    ambiguous (the belief ended with two or more strong modes) or budget (not sure otherwise: the
-    rotation budget, or blocked both ways)."""
-    if run.stopped in ("confident", "mismatch"):
-        return run.stopped
-    return "ambiguous" if run.belief.ambiguous else "budget"
-
-
-def rotation_curve(
-    part: Part | Outline,
-    history: Sequence[tuple[float, float, float, float]],
-    rotation_deg: float,
-    final: float,
-    budget_deg: float,
-) -> list[tuple[float, float]]:
-    """(mark deg, error mm) at every 5° of a rolling's rotation up to ``budget_deg``: the belief's error at
-    the last check before the mark (``history``: (rotation rad, map_arc, mass, true_arc) per check), the
-    final error once the rolling stopped."""
-    curve = []
-    mark = MARK_DEG
-    while mark <= budget_deg + 1e-9:
-        if rotation_deg <= mark + 1e-9:
-            e = final  # stopped (sure, or out of budget) before this mark
-        else:
-            before = [h for h in history if math.degrees(h[0]) <= mark + 1e-9]
-            e = _err(part, before[-1][1], before[-1][3]) if before else math.inf
-        curve.append((mark, e))
-        mark += MARK_DEG
-    return curve
-
-
-def score_reactive(
-    study: Study,
-    part: Part | Outline,
-    noise: NoiseModel,
-    cal: Calibration,
-    start: float,
-    rig_seed: int,
-    filter_class: type[ContactFilter] | None = None,
-    change: WorldChange | None = None,
-) -> dict[str, Any]:
-    """The reactive filter from the same start on a rig with the same seed (in world ``change``: the
-    study's ``[world]``, :class:`sim2d.WorldChange`)."""
-    from driver.jaw import localize_reactively
-    from sim2d import SimRig
-
-    o = study.reactive
-    rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine, change=change)
-    res = localize_reactively(
-        rig,
-        part,
-        calibration=cal,
-        filter=reactive_filter(study, part, noise, filter_class),
-        approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
-        policy=reactive_policy(study),
-    )
-    truth = rig.truth()["contact_arc"]
-    final = _err(part, res.estimate_arc, truth)
-    rot = math.degrees(res.rotation)
-    return {
-        "estimate_arc": res.estimate_arc,
-        "error_mm": final,
-        "rotation_deg": rot,
-        "curve": rotation_curve(part, res.history, rot, final, o.max_rotation_deg),
-        "stopped": reactive_stop(res),
-        "mass": res.belief.mass,
-        "bridges": res.bridges,
-        "path": (res.true_arcs, res.segments),
-        "mismatch_arc": mismatch_cell(res.belief),
-        "spikes": rig.spikes.count,
-    }
 
 
 @dataclass(frozen=True)
@@ -499,17 +358,6 @@ SCORERS: dict[str, Scorer] = {
         False,
     ),
 }
-
-
-def mismatch_cell(belief: Belief) -> str:
-    """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), "unknown" where the run
-    found one but could not tell where, empty when none."""
-    arcs = getattr(belief, "mismatch", None)
-    if not arcs:
-        return ""
-    if not all(math.isfinite(a) for a in arcs):
-        return "unknown"
-    return f"{arcs[0]:.2f}-{arcs[1]:.2f}"
 
 
 def score_methods(
@@ -579,7 +427,7 @@ def score_methods(
                 f"{m}_error_mm": r["error_mm"],
                 f"{m}_estimate_arc": r["estimate_arc"],
                 f"{m}_rotation_deg": r["rotation_deg"],
-                f"{m}_curve": _curve(r["curve"]),
+                f"{m}_curve": curve_cell(r["curve"]),
                 f"{m}_stopped": r["stopped"],
                 f"{m}_mass": r["mass"],
                 f"{m}_failure": r["failure"],

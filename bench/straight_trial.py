@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from localizer import Localization, ModeTracks, Part
     from sim2d import SimRig
 
-    from .trial import TrialSpec
+    from .trial_draw import TrialSpec
 
 __all__ = ["run_straight_trial", "start_sampler"]
 
@@ -56,7 +56,8 @@ def run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
     from driver.rig import RigError
     from sim2d import SimRig
 
-    from .methods import JAW_START, broken_rule, score_methods, score_rule
+    from .methods import broken_rule, score_methods, score_rule
+    from .scoring import JAW_START
 
     s = spec.study
     t0 = time.perf_counter()

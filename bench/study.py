@@ -92,9 +92,8 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar, cast
 
-from driver.jaw import MAX_ROTATION, STEP_RANGE_DEG
+from driver.jaw import STEP_RANGE_DEG
 from localizer import (
-    CONFIDENCE,
     MAX_GRID_POINTS,
     ROLL_STEP,
     SUCCESS_RADIUS,
@@ -105,6 +104,7 @@ from localizer import (
 from sim2d import WorldSpec
 
 from .columns import FINGER_COLUMNS, METHOD_COLUMNS, METHODS, TRIAL_COLUMNS, WORLD_COLUMNS
+from .method_options import ParticleOptions, ReactiveOptions
 
 if TYPE_CHECKING:
     from sim2d import NoiseModel
@@ -143,36 +143,6 @@ _KEYS = {
     "jaw",
     "world",
 }
-
-
-@dataclass(frozen=True)
-class ReactiveOptions:
-    """[reactive] of a study file (see :func:`driver.jaw.reactive.localize_reactively`)."""
-
-    confidence: float = CONFIDENCE
-    max_rotation_deg: float = round(math.degrees(MAX_ROTATION), 9)
-    check_every: int = 5
-    confirm: int | None = None  # None: driver.jaw.reactive.CONFIRM (checks in a row at the confidence)
-    sd_position: float | None = None  # None: the filter's default
-    sd_scale: float | None = None
-    sd_slope: float | str | None = None  # "auto": from the study's noise model
-    min_spread: float = 0.05
-    noise_scales: tuple[float, ...] | None = None  # None: localizer.NOISE_SCALES
-    temper: float | None = None  # None: the filter's default
-    shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
-    slope_envelope: tuple[float, ...] | None = None  # None: localizer.SLOPE_ENVELOPE; []: the slope prior alone
-    defect_window: float | None = None  # None: localizer.DEFECT_WINDOW (mm); 0: trust every stretch, test none
-    lookalike_slope: float | None = None  # None: localizer.LOOKALIKE_SLOPE; 0: no look-alike check
-    corner_ends: bool | None = None  # None: the filter's default (True); false: the uniform prior over a corner
-
-
-@dataclass(frozen=True)
-class ParticleOptions:
-    """[particle] of a study file (see :class:`localizer.ParticleFilter`)."""
-
-    particles: int = 2000
-    sd_position: float = 0.04
-    process: float = 0.005
 
 
 class StudyError(RolltouchError, ValueError):

@@ -109,7 +109,7 @@ def _plot_fingers(study: Study, rows: Sequence[dict[str, Any]], levels: list[dic
     where each can start and how far it rolled (right)."""
     import matplotlib.pyplot as plt
 
-    from .methods import MARK_DEG, parse_curve
+    from .scoring import MARK_DEG, parse_curve
 
     m = study.methods[0]
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})

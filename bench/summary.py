@@ -167,7 +167,7 @@ def error_over_bound(m: str, rows: Sequence[dict[str, Any]]) -> FloatArray:
 
 def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """``methods`` {name: success rate} over all trials, with details and success against rotation."""
-    from .methods import MARK_DEG, parse_curve
+    from .scoring import MARK_DEG, parse_curve
 
     rates, details, curves = {}, {}, {}
     n = len(rows)

@@ -3,28 +3,11 @@ trial runs it (:mod:`bench.straight_trial`, :mod:`bench.wheel_trial`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from .study import Study
-
-if TYPE_CHECKING:
-    from localizer import ContactFilter
+from .trial_draw import TrialSpec
 
 __all__ = ["TrialSpec", "run_trial"]
-
-
-@dataclass(frozen=True)
-class TrialSpec:
-    """Everything one trial needs (picklable, sent to worker processes): the study, the level and the
-    trial's number, and the reactive method's filter class (None: :class:`localizer.ContactFilter`;
-    :mod:`bench.replay` records the filter's calls with a subclass of it).
-    """
-
-    study: Study
-    level: int
-    trial: int
-    filter_class: type[ContactFilter] | None = None
 
 
 def run_trial(spec: TrialSpec) -> dict[str, Any]:

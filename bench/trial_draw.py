@@ -4,6 +4,7 @@ draw the same part for the same seeds."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -12,12 +13,26 @@ import numpy as np
 from .part_cache import cached_part
 
 if TYPE_CHECKING:
-    from localizer import Outline, Part
+    from localizer import ContactFilter, Outline, Part
     from sim2d import NoiseModel, WorldChange
 
-    from .trial import TrialSpec
+    from .study import Study
 
-__all__ = ["TrialDraw", "draw_trial", "draw_world"]
+
+__all__ = ["TrialSpec", "TrialDraw", "draw_trial", "draw_world"]
+
+
+@dataclass(frozen=True)
+class TrialSpec:
+    """Everything one trial needs (picklable, sent to worker processes): the study, the level and the
+    trial's number, and the reactive method's filter class (None: :class:`localizer.ContactFilter`;
+    :mod:`bench.replay` records the filter's calls with a subclass of it).
+    """
+
+    study: Study
+    level: int
+    trial: int
+    filter_class: type[ContactFilter] | None = None
 
 
 class TrialDraw(NamedTuple):

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from localizer import Outline, Part
 
     from .study import Study
-    from .trial import TrialSpec
+    from .trial_draw import TrialSpec
 
 __all__ = ["run_wheel_trial", "RADIUS_SD", "MAX_REDRAWS"]
 
@@ -124,9 +124,10 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
 
 def _run_cells(s: Study, part: Part | Outline, run: WheelRun, truth: float) -> dict[str, Any]:
     """The cells of a wheel's run that ended (sure or not) with the contact at ``truth`` mm."""
-    from .methods import _curve, _err, mismatch_cell, reactive_stop, rotation_curve
+    from .reactive_method import mismatch_cell, reactive_stop, rotation_curve
+    from .scoring import boundary_error, curve_cell
 
-    err = _err(part, run.estimate_arc, truth)
+    err = boundary_error(part, run.estimate_arc, truth)
     rot = math.degrees(run.rotation)
     ok = int(err < s.success_radius)
     return {
@@ -142,7 +143,7 @@ def _run_cells(s: Study, part: Part | Outline, run: WheelRun, truth: float) -> d
         "reactive_error_mm": err,
         "reactive_estimate_arc": run.estimate_arc,
         "reactive_rotation_deg": rot,
-        "reactive_curve": _curve(rotation_curve(part, run.history, rot, err, s.reactive.max_rotation_deg)),
+        "reactive_curve": curve_cell(rotation_curve(part, run.history, rot, err, s.reactive.max_rotation_deg)),
         "reactive_stopped": reactive_stop(run),
         "reactive_mass": run.belief.mass,
         "reactive_failure": "",

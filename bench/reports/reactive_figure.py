@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
-from bench.methods import reactive_filter, reactive_policy
+from bench.reactive_method import reactive_filter, reactive_policy
 from bench.study import load_study
 from driver.jaw import calibrate_simulated, localize_reactively
 from localizer import load_part

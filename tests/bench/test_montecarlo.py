@@ -317,7 +317,7 @@ def test_a_noise_sweep_runs_each_level_on_its_noise_file(tmp_path):
 
 
 def test_a_reactive_table_without_standard_deviations_uses_the_filters_own(tmp_path):
-    from bench.methods import reactive_filter
+    from bench.reactive_method import reactive_filter
     from localizer import NOISE_SCALES, ContactFilter, load_part
     from sim2d import load_noise
 

@@ -1,0 +1,150 @@
+"""The reactive method of a study, scored on a trial: the filter and the policy a study's [reactive] table
+describes, the run on a fresh rig from the trial's start, and its cells (error, rotation, the rotation
+curve, how it stopped, where the part seemed to differ from its model)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+from .scoring import JAW_START, MARK_DEG, boundary_error
+
+if TYPE_CHECKING:
+    from driver.jaw import Calibration, ReactivePolicy, ReactiveRun
+    from driver.wheel import WheelRun
+    from localizer import Belief, ContactFilter, Outline, Part
+    from sim2d import NoiseModel, WorldChange
+
+    from .study import Study
+
+__all__ = ["reactive_filter", "reactive_policy", "reactive_stop", "rotation_curve", "score_reactive", "mismatch_cell"]
+
+
+def reactive_filter(
+    study: Study, part: Part | Outline, noise: NoiseModel, filter_class: type[ContactFilter] | None = None
+) -> ContactFilter:
+    """The ContactFilter a study's [reactive] options describe (``filter_class``: a subclass to build
+    instead, e.g. :class:`bench.replay.FilterRecorder`).
+
+    Standard deviations not given are the filter's own defaults; ``sd_slope = "auto"`` takes 5x the
+    study's noise model's RMS slope (machined parts vary: measured 0.8e-3 to 1.9e-3 rad RMS at the
+    paper preset, whose model RMS is 0.6e-3, and the basis' coefficients are not its values).
+    """
+    from localizer import ContactFilter
+    from sim2d import machining_slope
+
+    o = study.reactive
+    given = {k: getattr(o, k) for k in ("sd_position", "sd_scale", "sd_slope") if getattr(o, k) is not None}
+    if given.get("sd_slope") == "auto":
+        given["sd_slope"] = max(
+            5.0 * machining_slope(noise.machining_error, noise.machining_wavelength, part.perimeter), 5e-4
+        )
+    for key in ("noise_scales", "slope_envelope"):
+        if getattr(o, key) is not None:
+            given[key] = getattr(o, key)
+    for key in ("temper", "shape_spacing", "defect_window", "lookalike_slope", "corner_ends"):
+        if getattr(o, key) is not None:
+            given[key] = getattr(o, key)
+    cls = ContactFilter if filter_class is None else filter_class
+    return cls(part, radius=study.success_radius, confidence=o.confidence, **given)
+
+
+def reactive_policy(study: Study) -> ReactivePolicy:
+    """The :class:`driver.jaw.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
+    from driver.jaw import CONFIRM, ReactivePolicy
+
+    o = study.reactive
+    return ReactivePolicy(
+        step=math.radians(study.step_deg),
+        confidence=o.confidence,
+        max_rotation=math.radians(o.max_rotation_deg),
+        check_every=o.check_every,
+        min_spread=o.min_spread,
+        confirm=CONFIRM if o.confirm is None else o.confirm,
+    )
+
+
+def reactive_stop(run: ReactiveRun | WheelRun) -> str:
+    """A reactive run's stop as trials.csv says it: confident, mismatch (the readings did not fit the part),
+    ambiguous (the belief ended with two or more strong modes) or budget (not sure otherwise: the
+    rotation budget, or blocked both ways)."""
+    if run.stopped in ("confident", "mismatch"):
+        return run.stopped
+    return "ambiguous" if run.belief.ambiguous else "budget"
+
+
+def rotation_curve(
+    part: Part | Outline,
+    history: Sequence[tuple[float, float, float, float]],
+    rotation_deg: float,
+    final: float,
+    budget_deg: float,
+) -> list[tuple[float, float]]:
+    """(mark deg, error mm) at every 5° of a rolling's rotation up to ``budget_deg``: the belief's error at
+    the last check before the mark (``history``: (rotation rad, map_arc, mass, true_arc) per check), the
+    final error once the rolling stopped."""
+    curve = []
+    mark = MARK_DEG
+    while mark <= budget_deg + 1e-9:
+        if rotation_deg <= mark + 1e-9:
+            e = final  # stopped (sure, or out of budget) before this mark
+        else:
+            before = [h for h in history if math.degrees(h[0]) <= mark + 1e-9]
+            e = boundary_error(part, before[-1][1], before[-1][3]) if before else math.inf
+        curve.append((mark, e))
+        mark += MARK_DEG
+    return curve
+
+
+def score_reactive(
+    study: Study,
+    part: Part | Outline,
+    noise: NoiseModel,
+    cal: Calibration,
+    start: float,
+    rig_seed: int,
+    filter_class: type[ContactFilter] | None = None,
+    change: WorldChange | None = None,
+) -> dict[str, Any]:
+    """The reactive filter from the same start on a rig with the same seed (in world ``change``: the
+    study's ``[world]``, :class:`sim2d.WorldChange`)."""
+    from driver.jaw import localize_reactively
+    from sim2d import SimRig
+
+    o = study.reactive
+    rig = SimRig(part, noise=noise, seed=rig_seed, engine=study.engine, change=change)
+    res = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=reactive_filter(study, part, noise, filter_class),
+        approach_pose=rig.approach_pose(start, jaw_position=-JAW_START, standoff=1.0),
+        policy=reactive_policy(study),
+    )
+    truth = rig.truth()["contact_arc"]
+    final = boundary_error(part, res.estimate_arc, truth)
+    rot = math.degrees(res.rotation)
+    return {
+        "estimate_arc": res.estimate_arc,
+        "error_mm": final,
+        "rotation_deg": rot,
+        "curve": rotation_curve(part, res.history, rot, final, o.max_rotation_deg),
+        "stopped": reactive_stop(res),
+        "mass": res.belief.mass,
+        "bridges": res.bridges,
+        "path": (res.true_arcs, res.segments),
+        "mismatch_arc": mismatch_cell(res.belief),
+        "spikes": rig.spikes.count,
+    }
+
+
+def mismatch_cell(belief: Belief) -> str:
+    """A belief's ``mismatch`` interval as trials.csv writes it: "A-B" (model arc, mm), "unknown" where the run
+    found one but could not tell where, empty when none."""
+    arcs = getattr(belief, "mismatch", None)
+    if not arcs:
+        return ""
+    if not all(math.isfinite(a) for a in arcs):
+        return "unknown"
+    return f"{arcs[0]:.2f}-{arcs[1]:.2f}"

@@ -1,0 +1,51 @@
+"""What every method's score shares: where the jaw is laid, the error of an estimate on the part's
+boundary, and the rotation curve's marks and their text in trials.csv."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import TYPE_CHECKING, TypeAlias
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    from localizer import Outline, Part
+
+
+__all__ = ["FloatArray", "MARK_DEG", "JAW_START", "ENCODER_SLACK_DEG", "curve_cell", "parse_curve", "boundary_error"]
+
+
+FloatArray: TypeAlias = npt.NDArray[np.float64]
+
+
+MARK_DEG = 5.0
+
+
+#: Where the jaw is laid on the part: the contact this far (mm) from the jaw's centre, behind it in
+#: the rolling direction, so that most of the jaw lies ahead.
+JAW_START = 40.0
+
+
+#: How far short of a mark (degrees) a measured turn still reaches it: more than the encoder's step.
+ENCODER_SLACK_DEG = 0.05
+
+
+def curve_cell(pairs: Iterable[tuple[float, float]]) -> str:
+    return " ".join(f"{r:g}:{e:.4f}" for r, e in pairs)
+
+
+def parse_curve(text: str) -> list[tuple[float, float]]:
+    """[(rotation deg, error mm), ...] of a ``<method>_curve`` cell."""
+    out = []
+    for item in str(text or "").split():
+        r, e = item.split(":")
+        out.append((float(r), float(e)))
+    return out
+
+
+def boundary_error(part: Part | Outline, est: float, truth: float) -> float:
+    if not (math.isfinite(est) and math.isfinite(truth)):
+        return math.inf
+    return abs(float(part.arc_offset(est, truth)))
