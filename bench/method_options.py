@@ -21,7 +21,7 @@ class ReactiveOptions:
     confidence: float = CONFIDENCE
     max_rotation_deg: float = round(math.degrees(MAX_ROTATION), 9)
     check_every: int = 5
-    confirm: int | None = None  # None: driver.jaw.reactive.CONFIRM (checks in a row at the confidence)
+    confirm: int | None = None  # None: driver.jaw.CONFIRM (checks in a row at the confidence)
     sd_position: float | None = None  # None: the filter's default
     sd_scale: float | None = None
     sd_slope: float | str | None = None  # "auto": from the study's noise model

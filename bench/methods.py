@@ -9,7 +9,8 @@
 
 Each method also gets a curve: its error (mm) had it stopped after every 5° of rolled rotation,
 stored as ``"5:0.412 10:0.108 ..."`` in the ``<method>_curve`` column, and the Cramér–Rao bound of
-its final place from the readings it took (``<method>_bound_mm``, :func:`method_bound`).
+its final place from the readings it took (``<method>_bound_mm``, :func:`method_bound`). The methods
+stand in one registry, :data:`SCORERS`; :func:`score_methods` scores a trial's every method by it.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ if TYPE_CHECKING:
     from sim2d import NoiseModel, WorldChange
 
     from .study import Study
+
+__all__ = ["TrialInputs", "Scorer", "SCORERS", "score_methods", "score_rule", "broken_rule"]
 
 
 def fixed_readings(rolls: Sequence[RollResult], part: Part | Outline) -> dict[str, FloatArray]:
@@ -392,8 +395,8 @@ def score_methods(
     fixed_bound: list[float] = []  # the fixed-roll methods share one path, so one bound
     out: dict[str, Any] = {}
     for m in study.methods:
-        scorer = SCORERS[m]
         try:
+            scorer = SCORERS[m]
             if seq is None and scorer.fixed_rolls:
                 raise _MethodError(fixed_failure)
             r = scorer.score(trial, m)

@@ -28,7 +28,8 @@ from .summary import (
     json_safe,
     summarize,
 )
-from .trial import TrialSpec, run_trial
+from .trial import run_trial
+from .trial_draw import TrialSpec
 
 __all__ = ["run_study", "read_trials"]
 

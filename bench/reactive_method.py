@@ -51,7 +51,7 @@ def reactive_filter(
 
 
 def reactive_policy(study: Study) -> ReactivePolicy:
-    """The :class:`driver.jaw.reactive.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
+    """The :class:`driver.jaw.ReactivePolicy` a study's ``[reactive]`` table and rolling step describe."""
     from driver.jaw import CONFIRM, ReactivePolicy
 
     o = study.reactive

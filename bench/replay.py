@@ -30,7 +30,8 @@ import numpy as np
 from localizer import ContactFilter, Part
 
 from .study import load_study
-from .trial import TrialSpec, run_trial
+from .trial import run_trial
+from .trial_draw import TrialSpec
 
 __all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "VariantResult"]
 

@@ -48,7 +48,7 @@ def run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
     """:func:`bench.trial.run_trial` with the paper's straight jaw.
 
     The start is drawn uniformly over the boundary points from which the fixed rolls can run
-    (module notes); a start where the simulated rig still refuses to roll (a bridge, or the jaw
+    (:func:`start_sampler`); a start where the simulated rig still refuses to roll (a bridge, or the jaw
     laid off the point) is redrawn, up to 20 times (``restarts``). With ``methods``, every
     method is scored on that same trial, each on its own.
     """

@@ -35,7 +35,7 @@ Several methods on the same trials (instead of ``method``)::
 
     [reactive]                           # the sequential filter (driver.jaw.reactive)
     confidence = 0.95
-    max_rotation_deg = 240.0             # default driver.jaw.reactive.MAX_ROTATION
+    max_rotation_deg = 240.0             # default driver.jaw.MAX_ROTATION
     sd_position = 0.04                   # mm, one contact-location reading   } each optional: the
     sd_scale = 0.003                     # calibration scale                  } filter's own default,
     sd_slope = 0.003                     # rad, the part's slope error        } with its noise scale
@@ -121,7 +121,7 @@ MAX_TRIALS = 100_000
 STUDY_SD_LENGTH = 0.3
 STUDY_SD_TURN_DEG = 0.03
 
-__all__ = ["Study", "StudyError", "load_study"]
+__all__ = ["Study", "StudyError", "load_study", "STUDY_SD_LENGTH", "STUDY_SD_TURN_DEG"]
 
 
 _KEYS = {

@@ -7,7 +7,7 @@ from typing import Any
 
 from .trial_draw import TrialSpec
 
-__all__ = ["TrialSpec", "run_trial"]
+__all__ = ["run_trial"]
 
 
 def run_trial(spec: TrialSpec) -> dict[str, Any]:

@@ -1,4 +1,5 @@
-"""Rig protocol, procedures, pipeline, serial rig and the command line (depends on localizer)."""
+"""The rig protocol every rig keeps, and its rooms: the straight jaw (``jaw``), the wheel finger
+(``wheel``), the serial rig (``link``), what a run leaves (``records``) and the command line (``cli``)."""
 
 from .records import PartMismatch, check_same_part, part_record
 from .rig import (

@@ -71,6 +71,7 @@ __all__ = [
     "spread_by_direction",
     "clear_ahead",
     "ReactivePolicy",
+    "REACTIVE_POLICY",
 ]
 
 
@@ -89,7 +90,7 @@ MAX_ROTATION = math.radians(240.0)
 
 @dataclass(frozen=True)
 class ReactiveRun:
-    """Result of :func:`localize_reactively`.
+    """Result of :func:`driver.jaw.localize_reactively`.
 
     Attributes
     ----------

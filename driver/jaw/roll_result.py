@@ -36,7 +36,7 @@ class RollResult:
         The contact's travel on the jaw itself, signed in the rolling direction.
     offset : float, mm
         Distance of the tool axis from the pressed jaw edge (the wrist's give
-        at the working force, measured by :func:`edge_offset`); see below.
+        at the working force, measured by :func:`driver.jaw.edge_offset`); see below.
     step : float, rad
         The signed rotation of each step.
     readings : tuple of Reading
@@ -66,7 +66,7 @@ class RollResult:
 
 @dataclass(frozen=True)
 class RollingRun:
-    """Result of :func:`localize_by_rolling`.
+    """Result of :func:`driver.jaw.localize_by_rolling`.
 
     Attributes
     ----------

@@ -198,7 +198,7 @@ def plot_reactive(
     *,
     true_arcs: Sequence[float] | None = None,
 ) -> None:
-    """Draw a reactive localization (:class:`driver.jaw.reactive.ReactiveRun`): the part as it is, the stretch
+    """Draw a reactive localization (:class:`driver.jaw.ReactiveRun`): the part as it is, the stretch
     the contact rolled over (from the readings' truth where known), the estimate with its stated
     probability, and the truth.
 

@@ -113,7 +113,7 @@ def localize_with_wheel(
 
     Parameters
     ----------
-    rig : Rig with an axle encoder (:class:`AxleEncoder`)
+    rig : Rig with an axle encoder (:class:`driver.wheel.AxleEncoder`)
     part : Part or Outline
         The part's model.
     wheel : WheelJaw

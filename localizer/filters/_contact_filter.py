@@ -6,9 +6,11 @@ contact's travel turned into arc, tells the starts apart. The hypotheses are the
 the whole boundary; every nuisance of the error model is weighed out in closed form, so one reading
 costs a few vector operations on the grid. The model and why each rule is as it is: docs/filter.md.
 
-The filter is built in layers, each a class over the one below: :class:`ContactState` (settings, grid,
-running sums), :class:`ContactMarginal` (the evidence and the posterior), :class:`ContactFit` (stretches
-of readings: the fit test) and :class:`ContactFilter` here (readings in, a belief out).
+The filter is built in layers, each a class over the one below:
+:class:`~localizer.filters._contact_state.ContactState` (settings, grid, running sums),
+:class:`~localizer.filters._contact_marginal.ContactMarginal` (the evidence and the posterior),
+:class:`~localizer.filters._contact_fit.ContactFit` (stretches of readings: the fit test) and
+:class:`ContactFilter` here (readings in, a belief out).
 """
 
 from __future__ import annotations
@@ -78,7 +80,7 @@ class ContactFilter(ContactFit):
     defect_window : float, mm
         The rolled arc of a stretch of readings the belief must not rest on alone, and over which
         :meth:`fit_test` judges whether the readings still fit the part (0: trust every reading, test
-        nothing). Module notes, "A part that is not its model".
+        nothing). docs/filter.md, "A part that is not its model".
     sd_jaw : float, mm
         Standard deviation of the B-spline coefficients of the calibration's error along the jaw
         (a smooth function of the contact's place on the jaw, the same all run long; 0: none).
@@ -105,15 +107,15 @@ class ContactFilter(ContactFit):
         A factor on ``sd_slope`` under which a sure mass is also at most the probability that the start's
         nominal present contact is within :data:`LOOKALIKE_RADIUS` of the most probable one's: a look-alike
         place must be ruled out under a part off its model by a form tolerance, not only by machining
-        (default :data:`LOOKALIKE_SLOPE`; 0: no such check). Module notes, "A part that is not its model".
+        (default :data:`localizer.LOOKALIKE_SLOPE`; 0: no such check). docs/filter.md, "A part that is not its model".
     corner_ends : bool
         Also state at most the probability under a prior that lays the jaw on a convex corner only at the
         ends of its jump (on one of the two pieces beside it), not at any angle within it (docs/filter.md,
         "A jaw laid on a corner"). No effect on a part without convex corners.
     noise_scales : sequence of float
         Common factors on ``sd_position``, ``sd_scale``, ``sd_slope`` and ``sd_jaw`` that the filter weighs
-        with equal prior probability (the real noise is rarely what the settings say; module
-        notes); ``(1.0,)`` trusts the settings.
+        with equal prior probability (the real noise is rarely what the settings say; docs/filter.md,
+        "Noise it was not told"); ``(1.0,)`` trusts the settings.
 
     Examples
     --------

@@ -26,6 +26,8 @@ from ._stretches import (
 )
 from ._sums import _quad, _Stack, _sums
 
+__all__ = ["ContactFit"]
+
 
 class ContactFit(ContactMarginal):
     """The fit test over stretches of readings and the mass without each stretch."""
@@ -204,7 +206,7 @@ class ContactFit(ContactMarginal):
     def stretch_mass(self, arc: float, radius: float | None = None) -> tuple[float, tuple[float, float]]:
         """The least probability within ``radius`` of the present contact at ``arc`` (mm) when any one
         stretch of the readings, ``defect_window`` mm of the rolled arc, is left out, and that stretch
-        (cumulative arc, mm, as :meth:`update` took it).
+        (cumulative arc, mm, as :meth:`~localizer.ContactFilter.update` took it).
 
         A burr, a dent or a speck of debris where the jaw rolls makes the readings over it follow a
         shape the model does not have, and a crest's tight bend reads like a fillet of the model: the

@@ -21,6 +21,8 @@ from ._contact_state import ContactState
 from ._filter_kernels import weigh_scales
 from ._sums import _quad, _Sums
 
+__all__ = ["ContactMarginal"]
+
 
 class ContactMarginal(ContactState):
     """The closed-form marginalisation over the live starts and what it says of the present contact."""
@@ -28,14 +30,14 @@ class ContactMarginal(ContactState):
     def _solved(self, factor: float = 1.0) -> dict[str, Any]:
         """The marginalisation over the live hypotheses and their log-likelihoods, with the slope
         prior's standard deviations times ``factor``, once per reading (cached: the reference
-        refresh, :meth:`belief` and :meth:`shift` share it)."""
+        refresh, :meth:`~localizer.ContactFilter.belief` and :meth:`shift` share it)."""
         s = self._cached.get(factor)
         if s is None or s["version"] != self._version:
             s = self._solve(factor)
             s["version"] = self._version
             # the slope prior prunes alone only without an envelope; with one, a start far below the
-            # best under one prior may carry the mass under another: :meth:`belief` prunes what is
-            # hopeless under all of them
+            # best under one prior may carry the mass under another: the belief
+            # (:meth:`~localizer.ContactFilter.belief`) prunes what is hopeless under all of them
             s["ll"] = self._log_likelihood(s, prune=factor == 1.0 and not self.slope_envelope)
             self._cached[factor] = s
         return s

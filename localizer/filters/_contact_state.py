@@ -33,9 +33,11 @@ from ._stretches import (
 )
 from ._sums import _bspline, _Reading
 
+__all__ = ["ContactState"]
+
 
 class ContactState:
-    """The filter's settings, its grid of starts and its running sums (:class:`ContactFilter` documents the
+    """The filter's settings, its grid of starts and its running sums (:class:`~localizer.ContactFilter` documents the
     parameters)."""
 
     def __init__(
@@ -152,7 +154,7 @@ class ContactState:
 
     @property
     def segment(self) -> int:
-        """Index of the present contact segment (0, then one more per :meth:`regrasp`)."""
+        """Index of the present contact segment (0, then one more per :meth:`~localizer.ContactFilter.regrasp`)."""
         return self._segment
 
     @property
@@ -203,7 +205,7 @@ class ContactState:
         self._last_span: tuple[float, float] | None = None
         self._bridges: list[tuple[float, float, float, float]] = []  # (turn before, turn, jaw, jump)
         # every call that changed the state since the reset, so that the filter can be rebuilt with a
-        # stretch quarantined from the start (:meth:`_rebuild`)
+        # stretch quarantined from the start (:meth:`~localizer.ContactFilter._rebuild`)
         self._calls: list[tuple[str, tuple[Any, ...]]] = []
         # the rolled arc (mm, from, to) of each quarantined stretch: a reading taken there later (the jaw
         # rolled back onto a burr's crest, where it may stay for tens of degrees) is quarantined as it comes

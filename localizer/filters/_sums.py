@@ -13,7 +13,8 @@ from .._types import FloatArray, IntArray
 
 
 def _quad(s: dict[str, Any], t2: float) -> FloatArray:
-    """Each hypothesis' quadratic form of a :meth:`ContactFilter._solve` (the readings' misfit in units of
+    """Each hypothesis' quadratic form of a solve of the marginalisation
+    (:meth:`localizer.filters._contact_marginal.ContactMarginal._solve`: the readings' misfit in units of
     the told reading variance, every nuisance and the calibration's scale, of prior variance ``t2``,
     weighed out)."""
     qpp, qpz = s["qpp"], s["qpz"]

@@ -4,7 +4,7 @@ import math
 
 from bench.columns import FINGER_COLUMNS
 from bench.study import load_study
-from bench.trial import TrialSpec
+from bench.trial_draw import TrialSpec
 from bench.wheel_trial import run_wheel_trial
 
 
