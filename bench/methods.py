@@ -27,7 +27,7 @@ from .reactive_method import (
     reactive_filter,
     score_reactive,
 )
-from .scoring import ENCODER_SLACK_DEG, MARK_DEG, FloatArray, boundary_error, curve_cell
+from .scoring import ENCODER_SLACK_DEG, MARK_DEG, FloatArray, MethodResult, RuleResult, boundary_error, curve_cell
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, RollResult
@@ -164,7 +164,7 @@ def _mass(part: Part | Outline, candidates: Iterable[Candidate], best: Candidate
     )
 
 
-def broken_rule(text: str) -> dict[str, Any]:
+def broken_rule(text: str) -> RuleResult:
     """The study's own columns of a localizer rule that failed, or had no rolls to take: ``text`` why."""
     return {
         "estimate_arc": math.nan,
@@ -184,7 +184,7 @@ def score_rule(
     rule: str,
     true_arc: float,
     cache: dict[str, Localization | Exception],
-) -> dict[str, Any]:
+) -> RuleResult:
     """The localizer's ``rule`` on the fixed rolls: the study's own columns, and a method's cells."""
     loc = _localize(study, part, rolls, rule, cache)
     if isinstance(loc, Exception):
@@ -218,7 +218,7 @@ def score_paper(
     seq: dict[str, FloatArray],
     rule: str,
     cache: dict[str, Localization | Exception],
-) -> dict[str, Any]:
+) -> MethodResult:
     """The fixed rolls under a localizer rule, and the same rule on shorter prefixes."""
     from localizer import localize
 
@@ -265,7 +265,7 @@ def _score_sequential(
     seq: dict[str, FloatArray],
     update: Callable[[float, float, float], object],
     estimate: Callable[[], tuple[float, float]],
-) -> dict[str, Any]:
+) -> MethodResult:
     """A filter fed the fixed rolls' readings one by one, its estimate at every 5° and at the end.
 
     ``update(z, turn, jaw)``; ``estimate()`` gives (present contact mm, stated mass)."""
@@ -286,7 +286,7 @@ def _score_sequential(
     }
 
 
-def score_particle(study: Study, part: Part | Outline, seq: dict[str, FloatArray], seed: int) -> dict[str, Any]:
+def score_particle(study: Study, part: Part | Outline, seq: dict[str, FloatArray], seed: int) -> MethodResult:
     """The particle filter over the fixed rolls' readings."""
     from localizer import ParticleFilter
 
@@ -302,7 +302,7 @@ def score_particle(study: Study, part: Part | Outline, seq: dict[str, FloatArray
     return _score_sequential(study, part, seq, lambda z, t, d: pf.update(z, t), pf.estimate)
 
 
-def score_grid(study: Study, part: Part | Outline, noise: NoiseModel, seq: dict[str, FloatArray]) -> dict[str, Any]:
+def score_grid(study: Study, part: Part | Outline, noise: NoiseModel, seq: dict[str, FloatArray]) -> MethodResult:
     """The reactive method's grid filter over the fixed rolls' readings (no reactive rolling)."""
     flt = reactive_filter(study, part, noise)
     flt.touch(float(seq["jaw"][0]))
@@ -338,11 +338,11 @@ class Scorer(NamedTuple):
     """One method of the registry: how it is scored on a trial (its result cells, :func:`score_methods`
     completes them), and whether it needs the fixed rolls (it fails with them where they could not run)."""
 
-    score: Callable[[TrialInputs, str], dict[str, Any]]
+    score: Callable[[TrialInputs, str], MethodResult]
     fixed_rolls: bool
 
 
-def _rule(t: TrialInputs, m: str) -> dict[str, Any]:
+def _rule(t: TrialInputs, m: str) -> MethodResult:
     return score_paper(
         t.study, t.part, cast("Sequence[RollResult]", t.rolls), cast("dict[str, FloatArray]", t.seq), m, t.rules
     )

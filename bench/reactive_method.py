@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from .scoring import JAW_START, MARK_DEG, boundary_error
+from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, ReactivePolicy, ReactiveRun
@@ -106,7 +106,7 @@ def score_reactive(
     rig_seed: int,
     filter_class: type[ContactFilter] | None = None,
     change: WorldChange | None = None,
-) -> dict[str, Any]:
+) -> MethodResult:
     """The reactive filter from the same start on a rig with the same seed (in world ``change``: the
     study's ``[world]``, :class:`sim2d.WorldChange`)."""
     from driver.jaw import localize_reactively

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from typing import TYPE_CHECKING, TypeAlias
+from typing import TYPE_CHECKING, TypeAlias, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -14,10 +14,54 @@ if TYPE_CHECKING:
     from localizer import Outline, Part
 
 
-__all__ = ["FloatArray", "MARK_DEG", "JAW_START", "ENCODER_SLACK_DEG", "curve_cell", "parse_curve", "boundary_error"]
+__all__ = [
+    "RuleResult",
+    "MethodResult",
+    "FloatArray",
+    "MARK_DEG",
+    "JAW_START",
+    "ENCODER_SLACK_DEG",
+    "curve_cell",
+    "parse_curve",
+    "boundary_error",
+]
 
 
 FloatArray: TypeAlias = npt.NDArray[np.float64]
+
+
+class RuleResult(TypedDict):
+    """A localizer rule on the fixed rolls, as the study's own columns take it: the estimate (mm), its
+    error (mm), how many candidates, the best's probability, whether ambiguous, the stated mass within
+    the success radius ("" where the rule failed) and why it failed ("" when it did not)."""
+
+    estimate_arc: float
+    error_mm: float
+    candidates: int
+    probability: float
+    ambiguous: int
+    mass: float | str
+    failure: str
+
+
+class MethodResult(TypedDict, total=False):
+    """One method scored on one trial (:data:`bench.methods.SCORERS`), before it becomes the trial's
+    ``<method>_*`` cells: the estimate and its error (mm), the rotation it used (degrees), its error at
+    every mark of rotation, how it stopped, its stated mass, why it failed; a method that rolls on its own
+    also the bridges it met, its true path (for its bound), where the part seemed to differ from its model
+    and its rig's spiked readings."""
+
+    estimate_arc: float
+    error_mm: float
+    rotation_deg: float
+    curve: list[tuple[float, float]]
+    stopped: str
+    mass: float | str
+    failure: str
+    bridges: int | str
+    path: tuple[tuple[float, ...], tuple[int, ...]]
+    mismatch_arc: str
+    spikes: int
 
 
 MARK_DEG = 5.0
