@@ -27,7 +27,7 @@ from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from localizer import ContactFilter, Part
+from localizer import Boundary, ContactFilter
 
 from .study import load_study
 from .trial import run_trial
@@ -43,17 +43,18 @@ _CALLS = ("update", "touch", "bridged", "regrasp")
 
 class FilterRecorder(ContactFilter):
     """A :class:`localizer.ContactFilter` that keeps the calls made to it (``calls``: name, args,
-    keyword args), the outermost only (``regrasp`` calls ``update`` itself). The latest instance
-    is :attr:`last`."""
+    keyword args), the outermost only (``regrasp`` calls ``update`` itself). Each instance is added
+    to ``made`` when built: :func:`record_trial` gives a subclass its own list, so that nothing is
+    shared between runs."""
 
-    last: ClassVar[FilterRecorder | None] = None
+    made: ClassVar[list[FilterRecorder]] = []
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         self.calls: list[tuple[str, tuple[Any, ...], dict[str, Any]]] = []
         self._depth = 0
         self.settings = dict(kwargs)
         super().__init__(*args, **kwargs)
-        FilterRecorder.last = self
+        self.made.append(self)
 
     def reset(self) -> None:
         self.calls = []
@@ -86,7 +87,7 @@ class Recorded:
     """One trial's reactive filter: the part, the settings it was built with, the calls, the trial's
     row of trials.csv and its start (mm)."""
 
-    part: Part
+    part: Boundary
     settings: dict[str, Any]
     calls: tuple[tuple[str, tuple[Any, ...], dict[str, Any]], ...]
     row: dict[str, Any]
@@ -116,9 +117,14 @@ def record_trial(study_path: str | os.PathLike[str], level: int, trial: int) -> 
         raise ValueError(f"study {study_path}: no reactive method to replay (methods = {list(study.methods)})")
     if not 0 <= level < study.levels:
         raise ValueError(f"level={level!r}: the study has levels 0 to {study.levels - 1}")
-    FilterRecorder.last = None
-    row = run_trial(TrialSpec(study, level, trial, filter_class=FilterRecorder))
-    rec = FilterRecorder.last
+    made: list[FilterRecorder] = []
+
+    class Recorder(FilterRecorder):
+        pass
+
+    Recorder.made = made  # this run's filters only
+    row = run_trial(TrialSpec(study, level, trial, filter_class=Recorder))
+    rec = made[-1] if made else None
     if rec is None or row.get("reactive_failure"):
         raise RuntimeError(
             f"trial {trial} of level {level} did not run its reactive method: "
