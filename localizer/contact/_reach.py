@@ -285,10 +285,9 @@ def calibration_arc(part: Boundary, jaw: StraightJaw = DEFAULT_JAW) -> float:
         return float(sigma[int(np.argmax(kappa))])
     # On a drawing the most curved point is a small fillet between faces that turn little, and a jaw
     # laid along its tangent lies nearly flush on the faces beside it: pressed there with the contact
-    # near the jaw's end, it touches the face too, and the calibration comes out non-monotone (6 of
-    # 7 trials on a generated plate). So: a point of a curved piece (a line or a corner has no one
-    # tangent to lay the jaw along) where the part turns away from the jaw most on its nearer side
-    # within CALIBRATION_WINDOW mm, corners' jumps included.
+    # near the jaw's end, it touches the face too, and the calibration comes out non-monotone. So: a
+    # point of a curved piece (a line or a corner has no one tangent to lay the jaw along) where the part
+    # turns away from the jaw most on its nearer side within CALIBRATION_WINDOW mm, corners' jumps included.
     w = CALIBRATION_WINDOW
     theta = part.tangent_angle_at_arc
     ahead = theta(sigma + w, side="after") - theta(sigma)

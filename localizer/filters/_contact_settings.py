@@ -58,9 +58,8 @@ FACE_SLOPES = 5.0
 SLOPE_RHO_MAX = 1000.0
 #: The factor on ``sd_slope`` under which a look-alike place must be ruled out too (docs/filter.md, "A part
 #: that is not its model"): a part a few hundredths of a millimetre off its drawing, where that error
-#: changes over a few millimetres, has slopes several mrad off (the model resampled: 22 µm, 11 mrad),
-#: which at ρ = 30 mm moves the contact 0.3 mm along a roll: more than what told a star's arm from its
-#: look-alike 386 mm away, at a stated 0.951.
+#: changes over a few millimetres, has slopes several mrad off, which at ρ = 30 mm moves the contact
+#: 0.3 mm along a roll: more than what can tell a feature from its look-alike elsewhere on the part.
 LOOKALIKE_SLOPE = 8.0
 #: How near, mm, a start's nominal present contact must be to the most probable one to count as the same
 #: place in the look-alike check: farther is another feature of the part; nearer, the envelope's
