@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from localizer import Outline, Segment, feasible_segments, load_outline
+from localizer.geometry import wrap_angle
 
 __all__ = ["TurningReference", "CornerRoll", "corner_rolls", "check_rolls", "feasible", "holds", "NEAR"]
 
@@ -40,10 +41,6 @@ __all__ = ["TurningReference", "CornerRoll", "corner_rolls", "check_rolls", "fea
 NEAR = 1e-7
 #: Slack on the rotation, rad, and on a start's place, mm.
 TURN_TOL, ARC_TOL = 1e-6, 1e-6
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 class TurningReference:
@@ -68,11 +65,11 @@ class TurningReference:
         theta = first[0]
         for i, p in enumerate(self.pieces):
             if i:
-                self.jump[i] = _wrap(first[i] - last[i - 1])
+                self.jump[i] = wrap_angle(first[i] - last[i - 1])
                 theta += self.jump[i]
             self.theta0[i] = theta
             theta += self._within(i, p.length)
-        self.jump[0] = _wrap(first[0] - last[-1])
+        self.jump[0] = wrap_angle(first[0] - last[-1])
         self.total = theta + self.jump[0] - self.theta0[0]
 
     def _within(self, i: int, u: float) -> float:

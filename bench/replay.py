@@ -70,16 +70,16 @@ class FilterRecorder(ContactFilter):
             self._depth -= 1
 
     def update(self, *args: Any, **kwargs: Any) -> None:
-        return cast(None, self._record("update", args, kwargs))
+        self._record("update", args, kwargs)
 
     def touch(self, *args: Any, **kwargs: Any) -> None:
-        return cast(None, self._record("touch", args, kwargs))
+        self._record("touch", args, kwargs)
 
     def bridged(self, *args: Any, **kwargs: Any) -> float:
         return cast(float, self._record("bridged", args, kwargs))
 
     def regrasp(self, *args: Any, **kwargs: Any) -> None:
-        return cast(None, self._record("regrasp", args, kwargs))
+        self._record("regrasp", args, kwargs)
 
 
 @dataclass(frozen=True)

@@ -88,7 +88,6 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - the trial's failure is its result
         failure = f"{type(exc).__name__}: {exc}"[:200]
     if failure is not None:
-        text = failure
         spikes: int | str = ""
         row.update(
             {
@@ -98,7 +97,7 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
                 "success": 0,
                 "probability": 0.0,
                 "ambiguous": 0,
-                "failure": text,
+                "failure": failure,
                 "arc_mm": math.nan,
                 "reactive_success": 0,
                 "reactive_error_mm": math.inf,
@@ -107,7 +106,7 @@ def run_wheel_trial(spec: TrialSpec) -> dict[str, Any]:
                 "reactive_curve": "",
                 "reactive_stopped": "error",
                 "reactive_mass": "",
-                "reactive_failure": text,
+                "reactive_failure": failure,
                 "reactive_bridges": "",
                 "reactive_bound_mm": "",
                 "reactive_mismatch_arc": "",
