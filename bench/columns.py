@@ -1,14 +1,34 @@
 """The columns of a study's trials.csv: each trial's, each method's (prefixed with its name), the
-finger's and the world's; a contract other tools read (names kept stable)."""
+finger's and the world's; a contract other tools read (names kept stable). A trial's row is built from
+typed parts (:class:`TrialHead`, :class:`RollCells`, :class:`ScoreCells`, :class:`MethodCells`,
+:class:`FingerCells`, :class:`WorldCells`), each the cells of one floor of the trial, by :func:`trial_row`."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol, TypedDict
 
 if TYPE_CHECKING:
     from sim2d import WorldChange
 
-__all__ = ["TRIAL_COLUMNS", "METHODS", "METHOD_COLUMNS", "FINGER_COLUMNS", "WORLD_COLUMNS", "world_cells"]
+    from .study import Study
+
+__all__ = [
+    "TRIAL_COLUMNS",
+    "METHODS",
+    "METHOD_COLUMNS",
+    "FINGER_COLUMNS",
+    "WORLD_COLUMNS",
+    "TrialHead",
+    "RollCells",
+    "ScoreCells",
+    "MethodCells",
+    "FingerCells",
+    "WorldCells",
+    "Rolled",
+    "Scored",
+    "world_cells",
+    "trial_row",
+]
 
 
 #: Columns of trials.csv, in order.
@@ -70,7 +90,114 @@ FINGER_COLUMNS = ("jaw", "redraws", "reachable", "arc_mm")
 WORLD_COLUMNS = ("world_defect_arc", "world_defect_height_mm", "world_scale", "world_spikes")
 
 
-def world_cells(change: WorldChange | None, spikes: int | str = "") -> dict[str, Any]:
+class TrialHead(TypedDict):
+    """The trial's first cells, drawn before anything else: its level, number, the swept parameter and its
+    value, and the part file's name."""
+
+    level: int
+    trial: int
+    parameter: str
+    value: str | float | None
+    part: str
+
+
+class RollCells(TypedDict):
+    """What the finger's rolling tells of a trial: where it started (model arc, mm), how often the start
+    was redrawn because the rig refused it, and the fixed rolls' lengths (mm) and turns (rad) as
+    space-separated text (empty for a wheel, or where they could not run)."""
+
+    start_arc: float
+    restarts: int
+    lengths: str
+    turns: str
+
+
+class ScoreCells(TypedDict):
+    """The trial's own verdict: the true contact at the end, the estimate and its error (mm), success,
+    the rule's candidates (empty for a wheel), the best's probability, whether ambiguous, and why the
+    trial failed ("" when it did not). With ``methods``, the estimate is the first method's."""
+
+    true_arc: float
+    estimate_arc: float
+    error_mm: float
+    success: int
+    candidates: int | str
+    probability: float
+    ambiguous: int
+    failure: str
+
+
+class MethodCells(TypedDict):
+    """One method's :data:`METHOD_COLUMNS` cells, before they are prefixed with its name."""
+
+    success: int
+    error_mm: float
+    estimate_arc: float
+    rotation_deg: float
+    curve: str
+    stopped: str
+    mass: float | str
+    failure: str
+    bridges: int | str
+    bound_mm: float | str
+    mismatch_arc: str
+
+
+class FingerCells(TypedDict):
+    """The :data:`FINGER_COLUMNS` cells."""
+
+    jaw: str
+    redraws: int
+    reachable: float
+    arc_mm: float | str
+
+
+class WorldCells(TypedDict):
+    """The :data:`WORLD_COLUMNS` cells (each empty before a world was drawn)."""
+
+    world_defect_arc: str
+    world_defect_height_mm: str
+    world_scale: float | str
+    world_spikes: int | str
+
+
+class Rolled(Protocol):
+    """A finger's rolling, as the row takes it: its cells, the finger's cells (None where the study does not
+    name its finger) and the world it rolled in (None: the model as machined, or none was drawn)."""
+
+    @property
+    def cells(self) -> RollCells: ...
+
+    @property
+    def finger(self) -> FingerCells | None: ...
+
+    @property
+    def change(self) -> WorldChange | None: ...
+
+
+class Scored(NamedTuple):
+    """A trial's scores: its own cells, every method's by name, and the wrist's spiked readings in the
+    localizing rig ("" where no rig rolled)."""
+
+    cells: ScoreCells
+    methods: dict[str, MethodCells]
+    spikes: int | str
+
+
+def trial_row(study: Study, head: TrialHead, rolled: Rolled, scored: Scored, seconds: float) -> dict[str, Any]:
+    """The trials.csv row of a trial of ``study`` that took ``seconds``: its typed parts as one flat
+    mapping, each method's cells prefixed with its name."""
+    row: dict[str, Any] = {**head, **rolled.cells, **scored.cells, "time_s": seconds}
+    for name, cells in scored.methods.items():
+        row.update({f"{name}_{key}": value for key, value in cells.items()})
+    if rolled.finger is not None:
+        row.update(rolled.finger)
+    if study.world is not None:
+        row.update(world_cells(rolled.change, scored.spikes))
+    return row
+
+
+def world_cells(change: WorldChange | None, spikes: int | str = "") -> WorldCells:
     """The :data:`WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
     if change is None:
         return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}

@@ -10,7 +10,8 @@
 Each method also gets a curve: its error (mm) had it stopped after every 5° of rolled rotation,
 stored as ``"5:0.412 10:0.108 ..."`` in the ``<method>_curve`` column, and the Cramér–Rao bound of
 its final place from the readings it took (``<method>_bound_mm``, :func:`method_bound`). The methods
-stand in one registry, :data:`SCORERS`; :func:`score_methods` scores a trial's every method by it.
+stand in one registry, :data:`SCORERS`; :func:`score_methods` scores a trial's every method by it, and
+:func:`score_trial` a trial's rolling (either finger's) as a whole.
 """
 
 from __future__ import annotations
@@ -18,16 +19,16 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple, cast
+from typing import TYPE_CHECKING, NamedTuple, cast
 
 import numpy as np
 import numpy.typing as npt
 
-from .reactive_method import (
-    reactive_filter,
-    score_reactive,
-)
+from .columns import MethodCells, ScoreCells, Scored
+from .reactive_method import failed_method, reactive_filter, score_reactive, score_wheel
 from .scoring import ENCODER_SLACK_DEG, MARK_DEG, FloatArray, MethodResult, RuleResult, boundary_error, curve_cell
+from .straight_trial import StraightRoll
+from .wheel_trial import WheelRoll
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, RollResult
@@ -35,8 +36,9 @@ if TYPE_CHECKING:
     from sim2d import NoiseModel, WorldChange
 
     from .study import Study
+    from .trial import TrialContext
 
-__all__ = ["TrialInputs", "Scorer", "SCORERS", "score_methods", "score_rule", "broken_rule"]
+__all__ = ["TrialInputs", "Scorer", "SCORERS", "score_trial", "score_methods", "score_rule", "broken_rule"]
 
 
 def fixed_readings(rolls: Sequence[RollResult], part: Part | Outline) -> dict[str, FloatArray]:
@@ -363,37 +365,19 @@ SCORERS: dict[str, Scorer] = {
 }
 
 
-def score_methods(
-    study: Study,
-    part: Part | Outline,
-    noise: NoiseModel,
-    cal: Calibration,
-    rolls: Sequence[RollResult] | None,
-    start: float,
-    rig_seed: int,
-    true_arc: float,
-    rules: dict[str, Localization | Exception] | None = None,
-    filter_class: type[ContactFilter] | None = None,
-    change: WorldChange | None = None,
-    fixed_failure: str = "",
-) -> dict[str, Any]:
-    """The ``<method>_<column>`` cells of one trial for every method of ``study``, each on its own.
+def score_methods(trial: TrialInputs, fixed_failure: str = "") -> tuple[dict[str, MethodCells], int | None]:
+    """The cells of every method of the trial's study, each scored on its own, by name; and the reactive
+    method's rig's spiked readings (None without it).
 
-    ``rolls`` are the fixed rolls' :class:`driver.jaw.RollResult` (None where they could not run
-    in the trial's world: ``fixed_failure`` says why, and the fixed-roll methods fail with it); ``rules``
-    caches the localizer's results per rule within the trial; ``filter_class`` is the reactive method's
-    filter (default :class:`localizer.ContactFilter`); ``change`` the trial's world
-    (:class:`sim2d.WorldChange`, None: the model as machined). With the reactive method, the cell
-    ``_spikes`` holds its rig's spiked readings.
+    Where the fixed rolls could not run in the trial's world (``trial.rolls`` None), ``fixed_failure``
+    says why, and the fixed-roll methods fail with it.
     """
-    seq = fixed_readings(rolls, part) if rolls is not None else None
-    trial = TrialInputs(
-        study, part, noise, cal, rolls, seq, start, rig_seed, {} if rules is None else rules, filter_class, change
-    )
+    study, part, seq, noise = trial.study, trial.part, trial.seq, trial.noise
     sds = reading_noise(seq, part, noise) if seq is not None else (math.nan, math.nan)
     sd_scale = _sd_scale(study)
     fixed_bound: list[float] = []  # the fixed-roll methods share one path, so one bound
-    out: dict[str, Any] = {}
+    out: dict[str, MethodCells] = {}
+    spikes: int | None = None
     for m in study.methods:
         try:
             scorer = SCORERS[m]
@@ -401,7 +385,7 @@ def score_methods(
                 raise _MethodError(fixed_failure)
             r = scorer.score(trial, m)
             if "spikes" in r:
-                out["_spikes"] = r["spikes"]
+                spikes = r["spikes"]
             r["failure"] = ""
         except Exception as exc:  # noqa: BLE001 - this method failed on this trial; the others still count
             text = str(exc) if isinstance(exc, _MethodError) else f"{type(exc).__name__}: {exc}"
@@ -424,19 +408,81 @@ def score_methods(
                 assert seq is not None  # the fixed-roll methods failed above without their rolls
                 fixed_bound.append(method_bound(part, seq["truth"], None, sds, sd_scale, noise))
             bound = fixed_bound[0]
-        out.update(
-            {
-                f"{m}_success": int(r["error_mm"] < study.success_radius),
-                f"{m}_error_mm": r["error_mm"],
-                f"{m}_estimate_arc": r["estimate_arc"],
-                f"{m}_rotation_deg": r["rotation_deg"],
-                f"{m}_curve": curve_cell(r["curve"]),
-                f"{m}_stopped": r["stopped"],
-                f"{m}_mass": r["mass"],
-                f"{m}_failure": r["failure"],
-                f"{m}_bridges": r.get("bridges", ""),
-                f"{m}_bound_mm": bound,
-                f"{m}_mismatch_arc": r.get("mismatch_arc", ""),
-            }
-        )
-    return out
+        out[m] = {
+            "success": int(r["error_mm"] < study.success_radius),
+            "error_mm": r["error_mm"],
+            "estimate_arc": r["estimate_arc"],
+            "rotation_deg": r["rotation_deg"],
+            "curve": curve_cell(r["curve"]),
+            "stopped": r["stopped"],
+            "mass": r["mass"],
+            "failure": r["failure"],
+            "bridges": r.get("bridges", ""),
+            "bound_mm": bound,
+            "mismatch_arc": r.get("mismatch_arc", ""),
+        }
+    return out, spikes
+
+
+def score_trial(ctx: TrialContext, rolled: StraightRoll | WheelRoll) -> Scored:
+    """A trial's scores: a wheel's run as the ``reactive`` method (:func:`bench.reactive_method.score_wheel`);
+    the straight jaw's fixed rolls under the study's rule (the trial's own cells) and every method of the
+    study on that same trial, the trial's estimate then the first method's."""
+    if isinstance(rolled, WheelRoll):
+        return score_wheel(ctx.study, ctx.part, rolled.run, rolled.true_arc, rolled.failure, rolled.spikes)
+    s = ctx.study
+    if rolled.failure:
+        return _broken_trial(s, rolled.failure)
+    assert rolled.cal is not None  # a trial that did not break was calibrated
+    rule = s.method if s.method in ("paper", "likelihood") else "paper"
+    rules: dict[str, Localization | Exception] = {}
+    own = (
+        score_rule(s, ctx.part, rolled.rolls, rule, rolled.true_arc, rules)
+        if rolled.rolls is not None
+        else broken_rule(rolled.fixed_failure)
+    )
+    cells: ScoreCells = {
+        "true_arc": rolled.true_arc,
+        "estimate_arc": own["estimate_arc"],
+        "error_mm": own["error_mm"],
+        "success": int(own["error_mm"] < s.success_radius),
+        "candidates": own["candidates"],
+        "probability": own["probability"],
+        "ambiguous": own["ambiguous"],
+        "failure": "" if s.methods else own["failure"],
+    }
+    if not s.methods:
+        return Scored(cells, {}, rolled.spikes)
+    seq = fixed_readings(rolled.rolls, ctx.part) if rolled.rolls is not None else None
+    trial = TrialInputs(
+        s,
+        ctx.part,
+        ctx.noise,
+        rolled.cal,
+        rolled.rolls,
+        seq,
+        rolled.start,
+        rolled.rig_seed,
+        rules,
+        ctx.spec.filter_class,
+        rolled.change,
+    )
+    methods, spikes = score_methods(trial, rolled.fixed_failure)
+    first = methods[s.methods[0]]
+    cells.update({"success": first["success"], "error_mm": first["error_mm"], "estimate_arc": first["estimate_arc"]})
+    return Scored(cells, methods, rolled.spikes if spikes is None else spikes)
+
+
+def _broken_trial(s: Study, text: str) -> Scored:
+    """The scores of a trial that broke before any method could run: every method's failure ``text``."""
+    cells: ScoreCells = {
+        "true_arc": math.nan,
+        "estimate_arc": math.nan,
+        "error_mm": math.inf,
+        "success": 0,
+        "candidates": 0,
+        "probability": 0.0,
+        "ambiguous": 0,
+        "failure": text,
+    }
+    return Scored(cells, {m: failed_method(text) for m in s.methods}, "")

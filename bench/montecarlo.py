@@ -28,8 +28,7 @@ from .summary import (
     json_safe,
     summarize,
 )
-from .trial import run_trial
-from .trial_draw import TrialSpec
+from .trial import TrialSpec, run_trial
 
 __all__ = ["run_study", "read_trials"]
 

@@ -1,6 +1,7 @@
 """The reactive method of a study, scored on a trial: the filter and the policy a study's [reactive] table
 describes, the run on a fresh rig from the trial's start, and its cells (error, rotation, the rotation
-curve, how it stopped, where the part seemed to differ from its model)."""
+curve, how it stopped, where the part seemed to differ from its model); a wheel's run is scored as the
+reactive method too (:func:`score_wheel`)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,8 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error
+from .columns import MethodCells, ScoreCells, Scored
+from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, curve_cell
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, ReactivePolicy, ReactiveRun
@@ -18,7 +20,16 @@ if TYPE_CHECKING:
 
     from .study import Study
 
-__all__ = ["reactive_filter", "reactive_policy", "reactive_stop", "rotation_curve", "score_reactive", "mismatch_cell"]
+__all__ = [
+    "reactive_filter",
+    "reactive_policy",
+    "reactive_stop",
+    "rotation_curve",
+    "score_reactive",
+    "score_wheel",
+    "failed_method",
+    "mismatch_cell",
+]
 
 
 def reactive_filter(
@@ -148,3 +159,66 @@ def mismatch_cell(belief: Belief) -> str:
     if not all(math.isfinite(a) for a in arcs):
         return "unknown"
     return f"{arcs[0]:.2f}-{arcs[1]:.2f}"
+
+
+def failed_method(text: str) -> MethodCells:
+    """The cells of a method that could not run on a trial: ``text`` why."""
+    return {
+        "success": 0,
+        "error_mm": math.inf,
+        "estimate_arc": math.nan,
+        "rotation_deg": math.nan,
+        "curve": "",
+        "stopped": "error",
+        "mass": "",
+        "failure": text,
+        "bridges": "",
+        "bound_mm": "",
+        "mismatch_arc": "",
+    }
+
+
+def score_wheel(
+    study: Study, part: Part | Outline, run: WheelRun | None, truth: float, failure: str, spikes: int | str
+) -> Scored:
+    """A wheel trial's scores: its ``run`` (sure or not) that ended with the contact at ``truth`` mm, as the
+    trial's own cells and the ``reactive`` method's; ``failure`` (run None) says why it did not run."""
+    if run is None:
+        failed: ScoreCells = {
+            "true_arc": math.nan,
+            "estimate_arc": math.nan,
+            "error_mm": math.inf,
+            "success": 0,
+            "candidates": "",
+            "probability": 0.0,
+            "ambiguous": 0,
+            "failure": failure,
+        }
+        return Scored(failed, {"reactive": failed_method(failure)}, spikes)
+    err = boundary_error(part, run.estimate_arc, truth)
+    rot = math.degrees(run.rotation)
+    ok = int(err < study.success_radius)
+    cells: ScoreCells = {
+        "true_arc": truth,
+        "estimate_arc": run.estimate_arc,
+        "error_mm": err,
+        "success": ok,
+        "candidates": "",
+        "probability": run.belief.mass,
+        "ambiguous": int(run.belief.ambiguous),
+        "failure": "",
+    }
+    reactive: MethodCells = {
+        "success": ok,
+        "error_mm": err,
+        "estimate_arc": run.estimate_arc,
+        "rotation_deg": rot,
+        "curve": curve_cell(rotation_curve(part, run.history, rot, err, study.reactive.max_rotation_deg)),
+        "stopped": reactive_stop(run),
+        "mass": run.belief.mass,
+        "failure": "",
+        "bridges": run.jumps,
+        "bound_mm": "",  # the bound models the straight jaw's readings
+        "mismatch_arc": mismatch_cell(run.belief),
+    }
+    return Scored(cells, {"reactive": reactive}, spikes)

@@ -30,8 +30,7 @@ import numpy as np
 from localizer import Boundary, ContactFilter
 
 from .study import load_study
-from .trial import run_trial
-from .trial_draw import TrialSpec
+from .trial import TrialSpec, run_trial
 
 __all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "VariantResult"]
 

@@ -1,31 +1,29 @@
-"""A trial of a study with the paper's straight jaw, start to score: draw the trial (part, noise, world),
-calibrate the simulated wrist, draw a start the fixed rolls can run from, roll, and score every method on
-that same trial (:mod:`bench.methods`)."""
+"""The rolling of a trial with the paper's straight jaw: calibrate the simulated wrist, draw a start the
+fixed rolls can run from, roll them (in the trial's world), for :mod:`bench.methods` to score every
+method on that same trial."""
 
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from localizer import Outline
 
-from .columns import world_cells
-from .study import Study
-from .trial_draw import draw_trial, draw_world
+from .columns import FingerCells, RollCells
+from .scoring import JAW_START
 
 if TYPE_CHECKING:
-    from driver.jaw import RollResult
-    from localizer import Localization, ModeTracks, Part
-    from sim2d import SimRig
+    from driver.jaw import Calibration, RollResult
+    from localizer import ModeTracks, Part
+    from sim2d import SimRig, WorldChange
 
-    from .trial_draw import TrialSpec
+    from .trial import TrialContext
 
-__all__ = ["run_straight_trial", "start_sampler"]
+__all__ = ["StraightRoll", "roll_straight", "start_sampler"]
 
 
 def start_sampler(
@@ -44,28 +42,42 @@ def start_sampler(
     return ok, tracks
 
 
-def run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
-    """:func:`bench.trial.run_trial` with the paper's straight jaw.
+class StraightRoll(NamedTuple):
+    """The straight jaw's rolling in a trial: its cells and the finger's; where it started (mm), the
+    wrist's calibration, the fixed rolls (None where they could not run in the trial's world:
+    ``fixed_failure`` says why), the rig's seed the reactive method rolls from again, the true contact at
+    the end (mm), the world and the rig's spiked readings; ``failure``: why the trial broke before any
+    method could run ("" when it did not; then the rest is empty)."""
+
+    cells: RollCells
+    finger: FingerCells | None
+    start: float
+    cal: Calibration | None
+    rolls: tuple[RollResult, ...] | None
+    rig_seed: int
+    true_arc: float
+    change: WorldChange | None
+    fixed_failure: str
+    spikes: int | str
+    failure: str
+
+
+def roll_straight(ctx: TrialContext) -> StraightRoll:
+    """The fixed rolls of a trial with the paper's straight jaw (:func:`bench.trial.run_trial`).
 
     The start is drawn uniformly over the boundary points from which the fixed rolls can run
     (:func:`start_sampler`); a start where the simulated rig still refuses to roll (a bridge, or the jaw
-    laid off the point) is redrawn, up to 20 times (``restarts``). With ``methods``, every
-    method is scored on that same trial, each on its own.
+    laid off the point) is redrawn, up to 20 times (``restarts``). The methods are scored on that same
+    trial, each on its own (:func:`bench.methods.score_trial`).
     """
     from driver.jaw import calibrate_simulated, laid_off, roll_sequence
     from driver.rig import RigError
     from sim2d import SimRig
 
-    from .methods import broken_rule, score_methods, score_rule
-    from .scoring import JAW_START
-
-    s = spec.study
-    t0 = time.perf_counter()
-    rng, part_file, part, noise, row = draw_trial(spec)
+    s, rng, part, noise = ctx.study, ctx.rng, ctx.part, ctx.noise
     rolls = [math.radians(r) for r in s.rolls_deg]
     jaw_start = -JAW_START if rolls[0] > 0 else JAW_START
-    rule = s.method if s.method in ("paper", "likelihood") else "paper"
-    failure: str | None = None
+    finger = _finger_cells(ctx, rolls, jaw_start) if s.fingers else None
     try:
         cal = calibrate_simulated(part, noise, seed=int(rng.integers(1 << 31)), engine=s.engine)
         candidates, tracks = start_sampler(part, rolls, jaw_start)
@@ -99,7 +111,7 @@ def run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
             raise RigError("no start out of 20 let the rolls run on the simulated rig")
         # the start was drawn on the model as machined, the same in every world; the world's own part and
         # wrist (a [world] table) then roll the fixed rolls from there
-        change = draw_world(spec, part_file, part, start)
+        change = ctx.world.draw(part, start, ctx.world_rng, ctx.part_index) if ctx.world is not None else None
         fixed_failure = ""
         if change is not None and change.differs:
             rig = SimRig(part, noise=noise, seed=rig_seed, engine=s.engine, change=change)
@@ -108,108 +120,30 @@ def run_straight_trial(spec: TrialSpec) -> dict[str, Any]:
             except RigError as exc:
                 run, fixed_failure = None, f"the fixed rolls on the world's part: {type(exc).__name__}: {exc}"[:200]
     except Exception as exc:  # the trial broke before any method could run: every method's failure
+        broken: RollCells = {"start_arc": math.nan, "restarts": 0, "lengths": "", "turns": ""}
         failure = f"{type(exc).__name__}: {exc}"[:200]
-    if failure is not None:
-        row.update(_broken_trial(s, failure))
-        change, spikes = None, ""
-    else:
-        true_arc = rig.truth()["contact_arc"]
-        row.update(
-            {
-                "start_arc": start,
-                "true_arc": true_arc,
-                "restarts": restarts,
-                "failure": "",
-                "lengths": " ".join(f"{r.length:.6f}" for r in run) if run is not None else "",
-                "turns": " ".join(f"{r.turn:.8f}" for r in run) if run is not None else "",
-            }
-        )
-        rules: dict[str, Localization | Exception] = {}
-        own = score_rule(s, part, run, rule, true_arc, rules) if run is not None else broken_rule(fixed_failure)
-        row.update(
-            {
-                "estimate_arc": own["estimate_arc"],
-                "error_mm": own["error_mm"],
-                "success": int(own["error_mm"] < s.success_radius),
-                "candidates": own["candidates"],
-                "probability": own["probability"],
-                "ambiguous": own["ambiguous"],
-                "failure": "" if s.methods else own["failure"],
-            }
-        )
-        if s.methods:
-            row.update(
-                score_methods(
-                    s,
-                    part,
-                    noise,
-                    cal,
-                    run,
-                    start,
-                    rig_seed,
-                    true_arc,
-                    rules,
-                    filter_class=spec.filter_class,
-                    change=change,
-                    fixed_failure=fixed_failure,
-                )
-            )
-            first_method = s.methods[0]
-            for key in ("success", "error_mm", "estimate_arc"):
-                row[key] = row[f"{first_method}_{key}"]
-        spikes = row.pop("_spikes", rig.spikes.count)
-    if s.world is not None:
-        row.update(world_cells(change, spikes))
-    row["time_s"] = time.perf_counter() - t0
-    if s.fingers:
-        row.update(_finger_cells(spec, part, rolls, jaw_start))
-    return row
-
-
-def _broken_trial(s: Study, text: str) -> dict[str, Any]:
-    """The cells of a trial that broke before any method could run: every method's failure ``text``."""
-    row: dict[str, Any] = {
-        "start_arc": math.nan,
-        "true_arc": math.nan,
-        "estimate_arc": math.nan,
-        "error_mm": math.inf,
-        "success": 0,
-        "candidates": 0,
-        "probability": 0.0,
-        "ambiguous": 0,
-        "lengths": "",
-        "turns": "",
-        "restarts": 0,
-        "failure": text,
+        return StraightRoll(broken, finger, math.nan, None, None, 0, math.nan, None, "", "", failure)
+    cells: RollCells = {
+        "start_arc": start,
+        "restarts": restarts,
+        "lengths": " ".join(f"{r.length:.6f}" for r in run) if run is not None else "",
+        "turns": " ".join(f"{r.turn:.8f}" for r in run) if run is not None else "",
     }
-    for m in s.methods:
-        row.update(
-            {
-                f"{m}_success": 0,
-                f"{m}_error_mm": math.inf,
-                f"{m}_estimate_arc": math.nan,
-                f"{m}_rotation_deg": math.nan,
-                f"{m}_curve": "",
-                f"{m}_stopped": "error",
-                f"{m}_mass": "",
-                f"{m}_failure": text,
-                f"{m}_bridges": "",
-            }
-        )
-    return row
+    true_arc = rig.truth()["contact_arc"]
+    return StraightRoll(cells, finger, start, cal, run, rig_seed, true_arc, change, fixed_failure, rig.spikes.count, "")
 
 
-def _finger_cells(spec: TrialSpec, part: Part | Outline, rolls: Sequence[float], jaw_start: float) -> dict[str, Any]:
+def _finger_cells(ctx: TrialContext, rolls: Sequence[float], jaw_start: float) -> FingerCells:
     """The :data:`bench.columns.FINGER_COLUMNS` of a straight jaw's trial in a study that names its finger: how
     often a uniform start over the whole boundary (from a stream of its own, so that the trial itself is the
     same as in any other study) would have had to be redrawn for the fixed rolls to run, and how much of the
     boundary they run from."""
-    s = spec.study
+    s, spec = ctx.study, ctx.spec
     rng = np.random.default_rng(np.random.SeedSequence([s.seed, spec.level, spec.trial, 1]))
-    candidates, tracks = start_sampler(part, rolls, jaw_start)
+    candidates, tracks = start_sampler(ctx.part, rolls, jaw_start)
     ok = np.zeros(tracks.sigma.size, dtype=bool)
     ok[candidates] = True
     redraws = 0
-    while redraws < 1000 and not ok[int(rng.uniform(0, part.perimeter) / tracks.h) % ok.size]:
+    while redraws < 1000 and not ok[int(rng.uniform(0, ctx.part.perimeter) / tracks.h) % ok.size]:
         redraws += 1
-    return {"jaw": s.level_jaw(spec.level), "redraws": redraws, "reachable": float(ok.mean()), "arc_mm": ""}
+    return {"jaw": ctx.jaw, "redraws": redraws, "reachable": float(ok.mean()), "arc_mm": ""}

@@ -17,8 +17,7 @@ import pytest
 from bench.benchmarks.baselines import per_second
 from bench.montecarlo import run_study
 from bench.study import load_study
-from bench.trial import run_trial
-from bench.trial_draw import TrialSpec
+from bench.trial import TrialSpec, run_trial
 
 if TYPE_CHECKING:
     from pytest_benchmark.fixture import BenchmarkFixture

@@ -264,8 +264,7 @@ particles = 500
 
 def test_one_methods_error_is_that_methods_failure_only(tmp_path, monkeypatch):
     import localizer
-    from bench.trial import run_trial
-    from bench.trial_draw import TrialSpec
+    from bench.trial import TrialSpec, run_trial
 
     study = small_methods_study(tmp_path)
     real = localizer.localize

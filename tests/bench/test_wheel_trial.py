@@ -4,15 +4,14 @@ import math
 
 from bench.columns import FINGER_COLUMNS
 from bench.study import load_study
-from bench.trial_draw import TrialSpec
-from bench.wheel_trial import run_wheel_trial
+from bench.trial import TrialSpec, run_trial
 
 
 def test_a_wheel_jammed_at_a_pockets_mouth_retraces_and_localizes():
     # wheel-heldout, x0.5, trial 86 (star-08): the 5 mm wheel jammed 1.8 mm after its start, and the
     # filter, normalising over starts that all fitted badly, stopped sure (0.99999) 366 mm off
     study = load_study("bench/studies/wheel-heldout.toml")
-    row = run_wheel_trial(TrialSpec(study, 0, 86))
+    row = run_trial(TrialSpec(study, 0, 86))
     assert row["failure"] == ""
     assert row["reactive_success"] == 1 and row["reactive_stopped"] == "confident"
     assert set(FINGER_COLUMNS) <= set(row) and row["jaw"] == "wheel:5" and math.isfinite(row["arc_mm"])
