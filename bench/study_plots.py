@@ -15,6 +15,7 @@ from localizer import load_part
 from .study import Study
 from .summary import (
     _number,
+    calibration,
     error_over_bound,
     reliability,
     summarize,
@@ -240,7 +241,7 @@ def _plot_reliability(study: Study, rows: Sequence[dict[str, Any]], out: Path) -
             ax.plot([lo, 1], [lo, 1], color="0.6", lw=1, ls="--", label="a promise kept")
             for level in range(study.levels):
                 sel = [r for r in rows if int(r["level"]) == level]
-                pts = [p for p in reliability(study, m, sel) if p[0] >= lo]
+                pts = [p for p in reliability(m, sel) if p[0] >= lo]
                 if not pts:
                     continue
                 x, y, n = (np.array(v) for v in zip(*pts))
@@ -254,7 +255,9 @@ def _plot_reliability(study: Study, rows: Sequence[dict[str, Any]], out: Path) -
             ax.set_ylim(lo if lo else 0.0, 1.0 + (1 - lo) * 0.01)
             ax.set_xlabel("stated probability within the radius at the stop")
             ax.set_ylabel(f"fraction actually within {study.success_radius} mm")
-            ax.set_title(f"{m}" + (" (from 0.9 up)" if lo else ""), fontsize=10)
+            cal = calibration(m, rows)
+            told = "" if cal is None else f"; calibration error {cal['error']:.3f} over {cal['trials']}"
+            ax.set_title(f"{m}" + (" (from 0.9 up)" if lo else told), fontsize=10)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="upper left" if not lo else "lower right")
     fig.suptitle(f"{study.name}: reliability (numbers: trials per bin; bars: 95% intervals)", fontsize=10)

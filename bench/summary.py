@@ -25,6 +25,8 @@ __all__ = [
     "summarize_methods",
     "RELIABILITY_BINS",
     "reliability",
+    "FULL_BIN",
+    "calibration",
     "print_summary",
 ]
 
@@ -152,6 +154,7 @@ def method_detail(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> dict[
         "error_over_bound_rms": float(np.sqrt(np.mean(ratio**2))) if ratio.size else None,
         "error_over_bound_median": float(np.median(ratio)) if ratio.size else None,
         "bounded_successes": int(ratio.size),
+        "calibration": calibration(m, rows),
     }
 
 
@@ -190,11 +193,16 @@ def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str,
     return {"methods": rates, "method_details": details, "success_by_rotation_deg": curves}
 
 
-#: Bins of stated confidence in the reliability diagram (fine near 1, where the stops are).
-RELIABILITY_BINS = (0.0, 0.5, 0.8, 0.9, 0.95, 0.97, 0.99, 0.999, 1.0 + 1e-12)
+#: Bins of stated confidence in the reliability diagram and the calibration error (fine near 1, where the
+#: stops are).
+RELIABILITY_BINS = (0.0, 0.1, 0.2, 0.35, 0.5, 0.65, 0.8, 0.9, 0.95, 0.97, 0.99, 0.999, 1.0 + 1e-12)
+
+#: A bin of the reliability diagram this full is held to its promise on its own (the calibration's
+#: ``worst_gap``): with fewer trials its actual rate is too uncertain to tell a gap of 0.05 from chance.
+FULL_BIN = 30
 
 
-def reliability(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> list[tuple[float, float, int]]:
+def reliability(m: str, rows: Sequence[dict[str, Any]]) -> list[tuple[float, float, int]]:
     """(mean stated mass, fraction within the success radius, trials) per bin of stated mass."""
     mass = np.array([_number(r.get(f"{m}_mass", "")) for r in rows])
     hit = np.array([int(r[f"{m}_success"]) for r in rows])
@@ -204,6 +212,32 @@ def reliability(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> list[tu
         if sel.any():
             out.append((float(mass[sel].mean()), float(hit[sel].mean()), int(sel.sum())))
     return out
+
+
+def calibration(m: str, rows: Sequence[dict[str, Any]]) -> dict[str, Any] | None:
+    """How well method ``m``'s stated probability within the success radius matches how often it is so.
+
+    ``error``: the count-weighted mean of |mean stated − fraction within| over :data:`RELIABILITY_BINS`
+    (the expected calibration error); ``worst_gap``: the largest such gap in a bin of at least
+    :data:`FULL_BIN` trials (None: no bin that full); ``bins``: each bin's mean stated probability, the
+    fraction within, its trials and that fraction's Wilson 95% interval. None where the method states no
+    probability on any of ``rows``.
+    """
+    bins = reliability(m, rows)
+    if not bins:
+        return None
+    n = sum(b[2] for b in bins)
+    gaps = [abs(stated - actual) for stated, actual, _ in bins]
+    full = [g for g, b in zip(gaps, bins) if b[2] >= FULL_BIN]
+    return {
+        "error": float(sum(g * b[2] for g, b in zip(gaps, bins)) / n),
+        "worst_gap": max(full) if full else None,
+        "trials": n,
+        "bins": [
+            {"stated": stated, "actual": actual, "trials": k, "ci95": list(wilson(int(round(actual * k)), k))}
+            for stated, actual, k in bins
+        ],
+    }
 
 
 def print_summary(summary: dict[str, Any]) -> None:
@@ -238,3 +272,7 @@ def _print_method(m: str, d: dict[str, Any], indent: str) -> None:
         f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}"
         + (f"; model mismatch {d['mismatch']}" if d.get("mismatch") else "")
     )
+    cal = d.get("calibration")
+    if cal is not None:
+        worst = "no bin of 30" if cal["worst_gap"] is None else f"worst full bin {cal['worst_gap']:.3f}"
+        print(f"{indent}{'':10s} calibration error {cal['error']:.3f} over {cal['trials']} stated ({worst})")

@@ -1,0 +1,99 @@
+"""How well a method's stated probability means what it says, over the studies it was run in.
+
+``python -m bench.calibration DIR [DIR ...] [--method reactive] [--json FILE]`` reads each study folder's
+trials.csv and prints, per study and level and then pooled over the studies level by level, the
+method's calibration (:func:`bench.summary.calibration`: the trial-weighted gap between the stated
+probability within the success radius and how often it was so, and the worst bin of at least
+:data:`bench.summary.FULL_BIN` trials), with how often it stopped sure and sure and wrong.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from .montecarlo import read_trials
+from .summary import calibration, json_safe
+
+__all__ = ["calibration_table", "main"]
+
+
+def calibration_table(folders: Sequence[str | Path], method: str = "reactive") -> list[dict[str, Any]]:
+    """One record per (study folder, level) and one per level pooled over the folders (``study`` "pooled"),
+    then one over everything (``level`` "all"): trials, sure, sure and wrong, and the calibration.
+
+    Raises
+    ------
+    FileNotFoundError
+        A folder without a trials.csv.
+    KeyError
+        A study that did not run ``method``.
+    """
+    by_level: dict[str, list[dict[str, Any]]] = {}
+    out = []
+    everything: list[dict[str, Any]] = []
+    for folder in folders:
+        table = Path(folder) / "trials.csv"
+        if not table.exists():
+            raise FileNotFoundError(f"{folder}: no trials.csv (is it a study's --out folder?)")
+        rows = read_trials(table)
+        if rows and f"{method}_mass" not in rows[0]:
+            raise KeyError(f"{folder}: the study did not run the method {method!r}")
+        levels: dict[str, list[dict[str, Any]]] = {}
+        for r in rows:
+            levels.setdefault(str(r.get("value", "")), []).append(r)
+        for level, sel in levels.items():
+            out.append(_record(Path(folder).name, level, method, sel))
+            by_level.setdefault(level, []).extend(sel)
+        everything.extend(rows)
+    if len(folders) > 1:
+        out += [_record("pooled", level, method, sel) for level, sel in by_level.items()]
+    out.append(_record("pooled" if len(folders) > 1 else Path(folders[0]).name, "all", method, everything))
+    return out
+
+
+def _record(study: str, level: str, method: str, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    sure = [r for r in rows if r.get(f"{method}_stopped") == "confident"]
+    return {
+        "study": study,
+        "level": level,
+        "trials": len(rows),
+        "sure": len(sure),
+        "sure_wrong": sum(1 - int(r[f"{method}_success"]) for r in sure),
+        "calibration": calibration(method, rows),
+    }
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench.calibration", description=__doc__.split("\n\n")[0])
+    parser.add_argument("folders", nargs="+", metavar="DIR", help="a study's --out folder (with trials.csv)")
+    parser.add_argument("--method", default="reactive", help="the method whose stated probability (default reactive)")
+    parser.add_argument("--json", metavar="FILE", help="also write the records as JSON")
+    args = parser.parse_args(argv)
+    try:
+        records = calibration_table(args.folders, args.method)
+    except (FileNotFoundError, KeyError) as exc:
+        print(f"error: {exc.args[0]}", file=sys.stderr)
+        return 2
+    print(
+        f"{'study':28s} {'level':>8s} {'trials':>6s} {'sure':>5s} {'wrong':>5s} {'cal. error':>10s} {'worst bin':>9s}"
+    )
+    for r in records:
+        cal = r["calibration"]
+        err = "-" if cal is None else f"{cal['error']:.3f}"
+        worst = "-" if cal is None or cal["worst_gap"] is None else f"{cal['worst_gap']:.3f}"
+        print(
+            f"{r['study'][:28]:28s} {(r['level'] or '-')[:12]:>12s} {r['trials']:6d} {r['sure']:5d} "
+            f"{r['sure_wrong']:5d} {err:>10s} {worst:>9s}"
+        )
+    if args.json:
+        Path(args.json).write_text(json.dumps(json_safe(records), indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,78 @@
+"""The calibration of a method's stated probability: the binned gap between what it states and how
+often it is right, against sums written out by hand."""
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from bench.summary import FULL_BIN, RELIABILITY_BINS, calibration
+
+
+def rows(*groups):
+    """Rows of the reactive method: for each (stated mass, trials, right), that many trials."""
+    out = []
+    for mass, n, right in groups:
+        out += [{"reactive_mass": repr(mass), "reactive_success": str(int(i < right))} for i in range(n)]
+    return out
+
+
+def test_a_promise_kept_in_every_bin_has_no_calibration_error():
+    cal = calibration("reactive", rows((0.25, 100, 25), (0.96, 100, 96)))
+    assert cal["error"] == pytest.approx(0.0, abs=1e-12)
+    assert cal["worst_gap"] == pytest.approx(0.0, abs=1e-12)
+    assert [b["trials"] for b in cal["bins"]] == [100, 100]
+
+
+def test_an_under_confident_method_is_off_by_its_gap_weighted_by_trials():
+    # 50 trials said 0.6 and were all right (gap 0.4); 150 said 0.96 and 144 were right (gap 0)
+    cal = calibration("reactive", rows((0.6, 50, 50), (0.96, 150, 144)))
+    assert cal["error"] == pytest.approx(0.4 * 50 / 200)
+    assert cal["worst_gap"] == pytest.approx(0.4)
+    assert cal["bins"][0]["ci95"][0] < 1.0 == cal["bins"][0]["actual"]
+
+
+def test_a_bin_of_few_trials_counts_in_the_error_but_is_not_held_to_its_promise_alone():
+    cal = calibration("reactive", rows((0.6, FULL_BIN - 1, FULL_BIN - 1), (0.96, 100, 96)))
+    assert cal["worst_gap"] == pytest.approx(0.0, abs=1e-12)
+    assert cal["error"] == pytest.approx(0.4 * (FULL_BIN - 1) / (FULL_BIN - 1 + 100))
+
+
+def test_a_method_that_states_nothing_has_no_calibration():
+    assert calibration("reactive", [{"reactive_mass": "", "reactive_success": "1"}] * 5) is None
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.0, 1.0), st.booleans()), min_size=1, max_size=60))
+def test_the_error_is_the_trial_weighted_gap_of_the_bins(trials):
+    data = [{"reactive_mass": repr(m), "reactive_success": str(int(ok))} for m, ok in trials]
+    cal = calibration("reactive", data)
+    expected = 0.0
+    for lo, hi in zip(RELIABILITY_BINS[:-1], RELIABILITY_BINS[1:]):
+        sel = [(m, ok) for m, ok in trials if lo <= m < hi]
+        if sel:
+            expected += abs(sum(m for m, _ in sel) / len(sel) - sum(ok for _, ok in sel) / len(sel)) * len(sel)
+    assert cal["error"] == pytest.approx(expected / len(trials), abs=1e-12)
+    assert cal["trials"] == len(trials) == sum(b["trials"] for b in cal["bins"])
+
+
+def test_the_calibration_table_pools_studies_level_by_level(tmp_path, capsys):
+    import csv
+
+    from bench.calibration import calibration_table, main
+    from bench.columns import TRIAL_COLUMNS
+
+    for name, groups in (("a", [(0.6, 40, 40)]), ("b", [(0.6, 40, 20)])):
+        (tmp_path / name).mkdir()
+        with open(tmp_path / name / "trials.csv", "w", newline="") as f:
+            fields = [*TRIAL_COLUMNS, "reactive_mass", "reactive_success", "reactive_stopped"]
+            w = csv.DictWriter(f, fieldnames=fields, restval="")
+            w.writeheader()
+            for i, r in enumerate(rows(*groups)):
+                w.writerow({"level": 0, "trial": i, "value": "x1", "success": r["reactive_success"], **r})
+    recs = calibration_table([tmp_path / "a", tmp_path / "b"])
+    by = {(r["study"], r["level"]): r for r in recs}
+    assert by[("a", "x1")]["calibration"]["error"] == pytest.approx(0.4)
+    assert by[("b", "x1")]["calibration"]["error"] == pytest.approx(0.1)
+    assert by[("pooled", "x1")]["calibration"]["error"] == pytest.approx(0.15)  # 60 of 80 right at 0.6
+    assert by[("pooled", "all")]["trials"] == 80
+    assert main([str(tmp_path / "nothing")]) == 2 and "no trials.csv" in capsys.readouterr().err
