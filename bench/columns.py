@@ -10,8 +10,6 @@ from typing import TYPE_CHECKING, Any, NamedTuple, Protocol, TypedDict
 if TYPE_CHECKING:
     from sim2d import WorldChange
 
-    from .study import Study
-
 __all__ = [
     "TRIAL_COLUMNS",
     "METHODS",
@@ -184,15 +182,15 @@ class Scored(NamedTuple):
     spikes: int | str
 
 
-def trial_row(study: Study, head: TrialHead, rolled: Rolled, scored: Scored, seconds: float) -> dict[str, Any]:
-    """The trials.csv row of a trial of ``study`` that took ``seconds``: its typed parts as one flat
-    mapping, each method's cells prefixed with its name."""
+def trial_row(head: TrialHead, rolled: Rolled, scored: Scored, seconds: float, *, world: bool) -> dict[str, Any]:
+    """The trials.csv row of a trial that took ``seconds``: its typed parts as one flat mapping, each
+    method's cells prefixed with its name; ``world``: the study has a ``[world]`` table (its columns)."""
     row: dict[str, Any] = {**head, **rolled.cells, **scored.cells, "time_s": seconds}
     for name, cells in scored.methods.items():
         row.update({f"{name}_{key}": value for key, value in cells.items()})
     if rolled.finger is not None:
         row.update(rolled.finger)
-    if study.world is not None:
+    if world:
         row.update(world_cells(rolled.change, scored.spikes))
     return row
 

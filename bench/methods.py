@@ -36,7 +36,7 @@ if TYPE_CHECKING:
     from sim2d import NoiseModel, WorldChange
 
     from .study import Study
-    from .trial import TrialContext
+    from .trial_context import TrialContext
 
 __all__ = ["TrialInputs", "Scorer", "SCORERS", "score_trial", "score_methods", "score_rule", "broken_rule"]
 

@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from localizer import ModeTracks, Part
     from sim2d import SimRig, WorldChange
 
-    from .trial import TrialContext
+    from .trial_context import TrialContext
 
 __all__ = ["StraightRoll", "roll_straight", "start_sampler"]
 

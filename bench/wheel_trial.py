@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from driver.wheel import WheelRun
     from sim2d import WorldChange
 
-    from .trial import TrialContext
+    from .trial_context import TrialContext
 
 __all__ = ["WheelRoll", "roll_wheel", "RADIUS_SD", "MAX_REDRAWS"]
 

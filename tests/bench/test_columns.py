@@ -58,7 +58,7 @@ def test_a_row_of_a_study_has_exactly_its_columns(name):
     score = dict.fromkeys(keys(ScoreCells), 0)
     finger = dict.fromkeys(FINGER_COLUMNS, 0) if study.fingers else None
     scored = Scored(score, {m: _method(k) for k, m in enumerate(study.methods)}, 2)
-    row = trial_row(study, head, _Rolled(finger), scored, 0.5)
+    row = trial_row(head, _Rolled(finger), scored, 0.5, world=study.world is not None)
     assert set(row) == set(study.columns)
     assert (study.world is not None) == (set(WORLD_COLUMNS) <= set(row))
     assert row["time_s"] == 0.5 and row["trial"] == 3
