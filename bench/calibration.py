@@ -4,20 +4,25 @@
 trials.csv and prints, per study and level and then pooled over the studies level by level, the
 method's calibration (:func:`bench.summary.calibration`: the trial-weighted gap between the stated
 probability within the success radius and how often it was so, and the worst bin of at least
-:data:`bench.summary.FULL_BIN` trials), with how often it stopped sure and sure and wrong.
+:data:`bench.summary.FULL_BIN` trials), with how often it stopped sure and sure and wrong; and its
+calibration along the rolling: the stated probability at every 5° mark of every trial against whether
+the estimate was within the radius there (``<method>_mass_curve`` and ``<method>_curve``; studies run
+before those columns have none).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from .montecarlo import read_trials
-from .summary import calibration, json_safe
+from .scoring import parse_curve
+from .summary import binned, calibration, calibration_of, json_safe
 
 __all__ = ["calibration_table", "main"]
 
@@ -33,9 +38,9 @@ def calibration_table(folders: Sequence[str | Path], method: str = "reactive") -
     KeyError
         A study that did not run ``method``.
     """
-    by_level: dict[str, list[dict[str, Any]]] = {}
+    by_level: dict[str, list[Trial]] = {}
     out = []
-    everything: list[dict[str, Any]] = []
+    everything: list[Trial] = []
     for folder in folders:
         table = Path(folder) / "trials.csv"
         if not table.exists():
@@ -43,21 +48,38 @@ def calibration_table(folders: Sequence[str | Path], method: str = "reactive") -
         rows = read_trials(table)
         if rows and f"{method}_mass" not in rows[0]:
             raise KeyError(f"{folder}: the study did not run the method {method!r}")
-        levels: dict[str, list[dict[str, Any]]] = {}
+        record = Path(folder) / "study.json"
+        radius = float(json.loads(record.read_text())["success_radius"]) if record.exists() else math.nan
+        levels: dict[str, list[Trial]] = {}
         for r in rows:
-            levels.setdefault(str(r.get("value", "")), []).append(r)
+            levels.setdefault(str(r.get("value", "")), []).append(Trial(r, radius))
         for level, sel in levels.items():
             out.append(_record(Path(folder).name, level, method, sel))
             by_level.setdefault(level, []).extend(sel)
-        everything.extend(rows)
+            everything.extend(sel)
     if len(folders) > 1:
         out += [_record("pooled", level, method, sel) for level, sel in by_level.items()]
     out.append(_record("pooled" if len(folders) > 1 else Path(folders[0]).name, "all", method, everything))
     return out
 
 
-def _record(study: str, level: str, method: str, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+class Trial(NamedTuple):
+    """A row of a study's trials.csv and its study's success radius, mm (NaN: its study.json is missing)."""
+
+    row: dict[str, Any]
+    radius: float
+
+
+def _record(study: str, level: str, method: str, trials: Sequence[Trial]) -> dict[str, Any]:
+    rows = [t.row for t in trials]
     sure = [r for r in rows if r.get(f"{method}_stopped") == "confident"]
+    stated, right = [], []
+    for r, radius in trials:
+        errors = dict(parse_curve(r.get(f"{method}_curve", "")))
+        for mark, p in parse_curve(r.get(f"{method}_mass_curve", "")):
+            if mark in errors and math.isfinite(radius):
+                stated.append(p)
+                right.append(float(errors[mark] < radius))
     return {
         "study": study,
         "level": level,
@@ -65,6 +87,7 @@ def _record(study: str, level: str, method: str, rows: Sequence[dict[str, Any]])
         "sure": len(sure),
         "sure_wrong": sum(1 - int(r[f"{method}_success"]) for r in sure),
         "calibration": calibration(method, rows),
+        "along": calibration_of(binned(stated, right)),
     }
 
 
@@ -86,9 +109,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         cal = r["calibration"]
         err = "-" if cal is None else f"{cal['error']:.3f}"
         worst = "-" if cal is None or cal["worst_gap"] is None else f"{cal['worst_gap']:.3f}"
+        along = "-" if r["along"] is None else f"{r['along']['error']:.3f}"
+        marks = "-" if r["along"] is None else str(r["along"]["trials"])
         print(
             f"{r['study'][:28]:28s} {(r['level'] or '-')[:12]:>12s} {r['trials']:6d} {r['sure']:5d} "
-            f"{r['sure_wrong']:5d} {err:>10s} {worst:>9s}"
+            f"{r['sure_wrong']:5d} {err:>10s} {worst:>9s} {along:>6s} {marks:>6s}"
         )
     if args.json:
         Path(args.json).write_text(json.dumps(json_safe(records), indent=2) + "\n")

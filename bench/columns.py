@@ -61,7 +61,9 @@ METHODS = ("paper", "likelihood", "particle", "grid", "reactive")
 #: states none); ``failure``: the method's error text; ``bridges``: bridges the reactive rolling met;
 #: ``bound_mm``: the Cramér–Rao bound of the final place from the readings the method took
 #: (:func:`bench.methods.method_bound`; empty for a wheel, or without an encoder step);
-#: ``mismatch_arc``: where on the model the readings stopped fitting, "A-B" mm (empty when they fit).
+#: ``mismatch_arc``: where on the model the readings stopped fitting, "A-B" mm (empty when they fit);
+#: ``mass_curve``: the stated probability within the success radius at every mark of ``curve``
+#: ("5:0.231 10:0.9512 ...", empty if the method states none), for its calibration along the rolling.
 METHOD_COLUMNS = (
     "success",
     "error_mm",
@@ -74,6 +76,7 @@ METHOD_COLUMNS = (
     "bridges",
     "bound_mm",
     "mismatch_arc",
+    "mass_curve",
 )
 
 
@@ -139,6 +142,7 @@ class MethodCells(TypedDict):
     bridges: int | str
     bound_mm: float | str
     mismatch_arc: str
+    mass_curve: str
 
 
 class FingerCells(TypedDict):

@@ -26,7 +26,16 @@ import numpy.typing as npt
 
 from .columns import MethodCells, ScoreCells, Scored
 from .reactive_method import failed_method, reactive_filter, score_reactive, score_wheel
-from .scoring import ENCODER_SLACK_DEG, MARK_DEG, FloatArray, MethodResult, RuleResult, boundary_error, curve_cell
+from .scoring import (
+    ENCODER_SLACK_DEG,
+    MARK_DEG,
+    FloatArray,
+    MethodResult,
+    RuleResult,
+    boundary_error,
+    curve_cell,
+    mass_cell,
+)
 from .straight_trial import StraightRoll
 from .wheel_trial import WheelRoll
 
@@ -229,29 +238,33 @@ def score_paper(
         raise _MethodError(own["failure"])
     share = study.rolls_deg[0] / sum(study.rolls_deg) if len(study.rolls_deg) > 1 else 1.0
     sign = 1.0 if rolls[0].step > 0 else -1.0
-    curve = []
+    curve, masses = [], []
     for mark, k in _marks(seq["turn"]):
         k1 = max(1, int(round(k * share)))
         segs = [(0, k1)] + ([(k1, k)] if k > k1 else [])
         pieces = [(sign * (seq["z"][b] - seq["z"][a]), seq["turn"][b] - seq["turn"][a]) for a, b in segs]
         try:
-            sub = localize(
+            loc = localize(
                 part,
                 pieces,
                 rule=rule,
                 direction="ccw" if sign > 0 else "cw",
                 sd_length=study.sd_length,
                 sd_turn=math.radians(study.sd_turn_deg),
-            ).best
+            )
+            sub = loc.best
             e = boundary_error(part, sub.end_arc, seq["truth"][k]) if sub is not None else math.inf
+            p = _mass(part, loc.candidates, sub, study.success_radius) if sub is not None else 0.0
         except Exception:  # noqa: BLE001 - a prefix the rule cannot take counts as a miss
-            e = math.inf
+            e, p = math.inf, math.nan
         curve.append((mark, e))
+        masses.append((mark, p))
     return {
         "estimate_arc": own["estimate_arc"],
         "error_mm": own["error_mm"],
         "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)),
         "curve": curve,
+        "mass_curve": masses,
         "stopped": "fixed",
         "mass": own["mass"],
     }
@@ -272,17 +285,20 @@ def _score_sequential(
 
     ``update(z, turn, jaw)``; ``estimate()`` gives (present contact mm, stated mass)."""
     marks = dict((k, m) for m, k in _marks(seq["turn"]))
-    curve = []
+    curve, masses = [], []
     for j in range(1, len(seq["z"])):
         update(float(seq["z"][j]), float(seq["turn"][j]), float(seq["jaw"][j]))
         if j in marks:
-            curve.append((marks[j], boundary_error(part, estimate()[0], seq["truth"][j])))
+            at, stated = estimate()
+            curve.append((marks[j], boundary_error(part, at, seq["truth"][j])))
+            masses.append((marks[j], stated))
     est, mass = estimate()
     return {
         "estimate_arc": est,
         "error_mm": boundary_error(part, est, seq["truth"][-1]),
         "rotation_deg": float(sum(abs(r) for r in study.rolls_deg)),
         "curve": curve,
+        "mass_curve": masses,
         "stopped": "fixed",
         "mass": mass,
     }
@@ -420,6 +436,7 @@ def score_methods(trial: TrialInputs, fixed_failure: str = "") -> tuple[dict[str
             "bridges": r.get("bridges", ""),
             "bound_mm": bound,
             "mismatch_arc": r.get("mismatch_arc", ""),
+            "mass_curve": mass_cell(r.get("mass_curve", [])),
         }
     return out, spikes
 

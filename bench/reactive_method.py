@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from .columns import MethodCells, ScoreCells, Scored
-from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, curve_cell
+from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, curve_cell, mass_cell
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, ReactivePolicy, ReactiveRun
@@ -91,19 +91,22 @@ def rotation_curve(
     rotation_deg: float,
     final: float,
     budget_deg: float,
-) -> list[tuple[float, float]]:
-    """(mark deg, error mm) at every 5° of a rolling's rotation up to ``budget_deg``: the belief's error at
-    the last check before the mark (``history``: (rotation rad, map_arc, mass, true_arc) per check), the
-    final error once the rolling stopped."""
+    final_mass: float = math.nan,
+) -> list[tuple[float, float, float]]:
+    """(mark deg, error mm, stated mass) at every 5° of a rolling's rotation up to ``budget_deg``: the
+    belief's at the last check before the mark (``history``: (rotation rad, map_arc, mass, true_arc) per
+    check; before the first, an infinite error and no mass), the final error and ``final_mass`` once the
+    rolling stopped."""
     curve = []
     mark = MARK_DEG
     while mark <= budget_deg + 1e-9:
         if rotation_deg <= mark + 1e-9:
-            e = final  # stopped (sure, or out of budget) before this mark
+            e, p = final, final_mass  # stopped (sure, or out of budget) before this mark
         else:
             before = [h for h in history if math.degrees(h[0]) <= mark + 1e-9]
             e = boundary_error(part, before[-1][1], before[-1][3]) if before else math.inf
-        curve.append((mark, e))
+            p = before[-1][2] if before else math.nan
+        curve.append((mark, e, p))
         mark += MARK_DEG
     return curve
 
@@ -136,11 +139,13 @@ def score_reactive(
     truth = rig.truth()["contact_arc"]
     final = boundary_error(part, res.estimate_arc, truth)
     rot = math.degrees(res.rotation)
+    curve = rotation_curve(part, res.history, rot, final, o.max_rotation_deg, res.belief.mass)
     return {
         "estimate_arc": res.estimate_arc,
         "error_mm": final,
         "rotation_deg": rot,
-        "curve": rotation_curve(part, res.history, rot, final, o.max_rotation_deg),
+        "curve": [(k, e) for k, e, _ in curve],
+        "mass_curve": [(k, p) for k, _, p in curve],
         "stopped": reactive_stop(res),
         "mass": res.belief.mass,
         "bridges": res.bridges,
@@ -175,6 +180,7 @@ def failed_method(text: str) -> MethodCells:
         "bridges": "",
         "bound_mm": "",
         "mismatch_arc": "",
+        "mass_curve": "",
     }
 
 
@@ -197,6 +203,7 @@ def score_wheel(
         return Scored(failed, {"reactive": failed_method(failure)}, spikes)
     err = boundary_error(part, run.estimate_arc, truth)
     rot = math.degrees(run.rotation)
+    curve = rotation_curve(part, run.history, rot, err, study.reactive.max_rotation_deg, run.belief.mass)
     ok = int(err < study.success_radius)
     cells: ScoreCells = {
         "true_arc": truth,
@@ -213,12 +220,13 @@ def score_wheel(
         "error_mm": err,
         "estimate_arc": run.estimate_arc,
         "rotation_deg": rot,
-        "curve": curve_cell(rotation_curve(part, run.history, rot, err, study.reactive.max_rotation_deg)),
+        "curve": curve_cell((k, e) for k, e, _ in curve),
         "stopped": reactive_stop(run),
         "mass": run.belief.mass,
         "failure": "",
         "bridges": run.jumps,
         "bound_mm": "",  # the bound models the straight jaw's readings
         "mismatch_arc": mismatch_cell(run.belief),
+        "mass_curve": mass_cell((k, p) for k, _, p in curve),
     }
     return Scored(cells, {"reactive": reactive}, spikes)

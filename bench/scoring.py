@@ -22,6 +22,7 @@ __all__ = [
     "JAW_START",
     "ENCODER_SLACK_DEG",
     "curve_cell",
+    "mass_cell",
     "parse_curve",
     "boundary_error",
 ]
@@ -55,6 +56,7 @@ class MethodResult(TypedDict, total=False):
     error_mm: float
     rotation_deg: float
     curve: list[tuple[float, float]]
+    mass_curve: list[tuple[float, float]]
     stopped: str
     mass: float | str
     failure: str
@@ -77,11 +79,18 @@ ENCODER_SLACK_DEG = 0.05
 
 
 def curve_cell(pairs: Iterable[tuple[float, float]]) -> str:
+    """A ``<method>_curve`` cell: "5:0.4120 10:0.1080 ..." (mark deg, error mm)."""
     return " ".join(f"{r:g}:{e:.4f}" for r, e in pairs)
 
 
+def mass_cell(pairs: Iterable[tuple[float, float]]) -> str:
+    """A ``<method>_mass_curve`` cell: "5:0.231 10:0.9512 ..." (mark deg, stated probability within the
+    success radius; six significant digits, enough to tell 0.9999 from 0.99999; "nan" where none)."""
+    return " ".join(f"{r:g}:{p:.6g}" for r, p in pairs)
+
+
 def parse_curve(text: str) -> list[tuple[float, float]]:
-    """[(rotation deg, error mm), ...] of a ``<method>_curve`` cell."""
+    """[(rotation deg, value), ...] of a ``<method>_curve`` (error mm) or ``<method>_mass_curve`` cell."""
     out = []
     for item in str(text or "").split():
         r, e = item.split(":")

@@ -26,7 +26,9 @@ __all__ = [
     "RELIABILITY_BINS",
     "reliability",
     "FULL_BIN",
+    "binned",
     "calibration",
+    "calibration_of",
     "print_summary",
 ]
 
@@ -203,27 +205,38 @@ FULL_BIN = 30
 
 
 def reliability(m: str, rows: Sequence[dict[str, Any]]) -> list[tuple[float, float, int]]:
-    """(mean stated mass, fraction within the success radius, trials) per bin of stated mass."""
+    """(mean stated mass, fraction within the success radius, trials) per bin of stated mass at the end."""
     mass = np.array([_number(r.get(f"{m}_mass", "")) for r in rows])
     hit = np.array([int(r[f"{m}_success"]) for r in rows])
+    return binned(mass, hit)
+
+
+def binned(stated: npt.ArrayLike, right: npt.ArrayLike) -> list[tuple[float, float, int]]:
+    """(mean stated, fraction right, count) per bin of :data:`RELIABILITY_BINS` that holds any of the
+    finite ``stated`` probabilities (``right``: 1 or 0 each)."""
+    p, hit = np.asarray(stated, dtype=float), np.asarray(right, dtype=float)
     out = []
     for lo, hi in zip(RELIABILITY_BINS[:-1], RELIABILITY_BINS[1:]):
-        sel = np.isfinite(mass) & (mass >= lo) & (mass < hi)
+        sel = np.isfinite(p) & (p >= lo) & (p < hi)
         if sel.any():
-            out.append((float(mass[sel].mean()), float(hit[sel].mean()), int(sel.sum())))
+            out.append((float(p[sel].mean()), float(hit[sel].mean()), int(sel.sum())))
     return out
 
 
 def calibration(m: str, rows: Sequence[dict[str, Any]]) -> dict[str, Any] | None:
-    """How well method ``m``'s stated probability within the success radius matches how often it is so.
+    """How well method ``m``'s stated probability within the success radius at the end of each trial
+    matches how often it is so (:func:`calibration_of`); None where it states none on any of ``rows``."""
+    return calibration_of(reliability(m, rows))
 
-    ``error``: the count-weighted mean of |mean stated − fraction within| over :data:`RELIABILITY_BINS`
-    (the expected calibration error); ``worst_gap``: the largest such gap in a bin of at least
-    :data:`FULL_BIN` trials (None: no bin that full); ``bins``: each bin's mean stated probability, the
-    fraction within, its trials and that fraction's Wilson 95% interval. None where the method states no
-    probability on any of ``rows``.
+
+def calibration_of(bins: Sequence[tuple[float, float, int]]) -> dict[str, Any] | None:
+    """The calibration of :func:`binned`'s ``bins``.
+
+    ``error``: the count-weighted mean of |mean stated − fraction right| (the expected calibration
+    error); ``worst_gap``: the largest such gap in a bin of at least :data:`FULL_BIN` (None: no bin that
+    full); ``trials``: the count; ``bins``: each bin's mean stated probability, fraction right, count and
+    that fraction's Wilson 95% interval. None without any bin.
     """
-    bins = reliability(m, rows)
     if not bins:
         return None
     n = sum(b[2] for b in bins)

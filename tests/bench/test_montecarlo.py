@@ -14,6 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from bench.montecarlo import read_trials, run_study
+from bench.scoring import parse_curve
 from bench.study import StudyError, load_study
 from bench.summary import wilson
 
@@ -240,6 +241,12 @@ def test_grid_method_scores_the_filter_on_the_fixed_readings(tmp_path):
     for r in rows:
         assert float(r["grid_rotation_deg"]) == pytest.approx(35.0)
         assert len(r["grid_curve"].split()) == 7  # every 5° of the 35°
+        for m in ("paper", "particle", "grid"):
+            # each mark of the error curve has the stated probability at that mark, the last one the final
+            errors, masses = parse_curve(r[f"{m}_curve"]), parse_curve(r[f"{m}_mass_curve"])
+            assert [k for k, _ in masses] == [k for k, _ in errors]
+            assert all(0.0 <= p <= 1.0 + 1e-9 for _, p in masses)
+            assert masses[-1][1] == pytest.approx(float(r[f"{m}_mass"]), abs=1e-5)
         # the filter was fed the same readings as the paper's rule: it lands where the truth is
         # or fails like a method, never as a broken trial
         assert r["failure"] == "" and math.isfinite(float(r["grid_error_mm"]))

@@ -76,3 +76,27 @@ def test_the_calibration_table_pools_studies_level_by_level(tmp_path, capsys):
     assert by[("pooled", "x1")]["calibration"]["error"] == pytest.approx(0.15)  # 60 of 80 right at 0.6
     assert by[("pooled", "all")]["trials"] == 80
     assert main([str(tmp_path / "nothing")]) == 2 and "no trials.csv" in capsys.readouterr().err
+
+
+def test_the_calibration_along_the_rolling_takes_every_mark_of_every_trial(tmp_path):
+    import csv
+
+    from bench.calibration import calibration_table
+    from bench.columns import TRIAL_COLUMNS
+
+    fields = [*TRIAL_COLUMNS, "reactive_mass", "reactive_success", "reactive_curve", "reactive_mass_curve"]
+    with open(tmp_path / "trials.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, restval="")
+        w.writeheader()
+        for i in range(10):
+            # stated 0.9 at both marks; within the 0.3 mm radius at 5°, not at 10° (0.3 is not within)
+            curve, masses = "5:0.1000 10:0.3000", "5:0.9 10:0.9"
+            w.writerow({"level": 0, "trial": i, "success": 0, "reactive_mass": "0.9", "reactive_success": 0,
+                        "reactive_curve": curve, "reactive_mass_curve": masses})  # fmt: skip
+    (tmp_path / "study.json").write_text('{"success_radius": 0.3}')
+    rec = calibration_table([tmp_path])[0]
+    assert rec["along"]["trials"] == 20
+    assert rec["along"]["error"] == pytest.approx(0.4)
+    assert rec["calibration"]["error"] == pytest.approx(0.9)
+    (tmp_path / "study.json").unlink()  # without the radius, nothing along the rolling can be judged
+    assert calibration_table([tmp_path])[0]["along"] is None
