@@ -6,8 +6,8 @@ method's calibration (:func:`bench.summary.calibration`: the trial-weighted gap 
 probability within the success radius and how often it was so, and the worst bin of at least
 :data:`bench.summary.FULL_BIN` trials), with how often it stopped sure and sure and wrong; and its
 calibration along the rolling: the stated probability at every 5° mark of every trial against whether
-the estimate was within the radius there (``<method>_mass_curve`` and ``<method>_curve``; studies run
-before those columns have none).
+the estimate was within the radius there, up to the first mark at or past where the rolling stopped
+(``<method>_mass_curve`` and ``<method>_curve``; studies run before those columns have none).
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from .montecarlo import read_trials
-from .scoring import parse_curve
-from .summary import binned, calibration, calibration_of, json_safe
+from .scoring import MARK_DEG, parse_curve
+from .summary import binned, calibration, calibration_of, cell_number, json_safe
 
 __all__ = ["calibration_table", "main"]
 
@@ -76,7 +76,10 @@ def _record(study: str, level: str, method: str, trials: Sequence[Trial]) -> dic
     stated, right = [], []
     for r, radius in trials:
         errors = dict(parse_curve(r.get(f"{method}_curve", "")))
+        rotation = cell_number(r.get(f"{method}_rotation_deg", ""))
         for mark, p in parse_curve(r.get(f"{method}_mass_curve", "")):
+            if mark >= rotation + MARK_DEG:
+                break  # the rolling had stopped: the curve repeats its last statement
             if mark in errors and math.isfinite(radius):
                 stated.append(p)
                 right.append(float(errors[mark] < radius))

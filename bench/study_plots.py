@@ -14,8 +14,8 @@ from localizer import load_part
 
 from .study import Study
 from .summary import (
-    _number,
     calibration,
+    cell_number,
     error_over_bound,
     reliability,
     summarize,
@@ -158,8 +158,8 @@ def _plot_bound(study: Study, rows: Sequence[dict[str, Any]], out: Path) -> None
     fig, ax = plt.subplots(figsize=(6.5, 5.0))
     lo, hi = math.inf, 0.0
     for k, m in enumerate(study.methods):
-        bound = np.array([_number(r.get(f"{m}_bound_mm", "")) for r in rows])
-        err = np.array([_number(r[f"{m}_error_mm"]) for r in rows])
+        bound = np.array([cell_number(r.get(f"{m}_bound_mm", "")) for r in rows])
+        err = np.array([cell_number(r[f"{m}_error_mm"]) for r in rows])
         ok = np.array([int(r[f"{m}_success"]) for r in rows], dtype=bool)
         keep = np.isfinite(bound) & (bound > 0) & np.isfinite(err)
         if not keep.any():
@@ -228,7 +228,7 @@ def _plot_reliability(study: Study, rows: Sequence[dict[str, Any]], out: Path) -
     of 95% is about the few that miss. Bars: each bin's 95% Wilson interval."""
     import matplotlib.pyplot as plt
 
-    stating = [m for m in study.methods if any(np.isfinite(_number(r.get(f"{m}_mass", ""))) for r in rows)]
+    stating = [m for m in study.methods if any(np.isfinite(cell_number(r.get(f"{m}_mass", ""))) for r in rows)]
     if not stating:
         return
     fig, axes = plt.subplots(len(stating), 2, figsize=(10, 4.2 * len(stating)), squeeze=False)

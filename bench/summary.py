@@ -19,6 +19,7 @@ FloatArray: TypeAlias = npt.NDArray[np.float64]
 __all__ = [
     "wilson",
     "json_safe",
+    "cell_number",
     "summarize",
     "method_detail",
     "error_over_bound",
@@ -66,7 +67,7 @@ def json_safe(value: object) -> object:
     return value
 
 
-def _number(text: Any) -> float:
+def cell_number(text: Any) -> float:
     """A trials.csv cell as a float (empty: nan)."""
     try:
         return float(text)
@@ -102,7 +103,7 @@ def summarize(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
         if study.methods:
             levels[-1]["methods"] = {m: method_detail(study, m, sel) for m in study.methods}
         if study.fingers and n:
-            arcs = np.array([_number(r.get("arc_mm", "")) for r in sel], dtype=float)
+            arcs = np.array([cell_number(r.get("arc_mm", "")) for r in sel], dtype=float)
             levels[-1].update(
                 {
                     "jaw": study.level_jaw(level),
@@ -128,8 +129,8 @@ def method_detail(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> dict[
     """One method's record over ``rows``: success, how it stopped, confident and wrong, per part."""
     n = len(rows)
     ok = sum(int(r[f"{m}_success"]) for r in rows)
-    rot = np.array([_number(r[f"{m}_rotation_deg"]) for r in rows], dtype=float)
-    err = np.array([_number(r[f"{m}_error_mm"]) for r in rows], dtype=float)
+    rot = np.array([cell_number(r[f"{m}_rotation_deg"]) for r in rows], dtype=float)
+    err = np.array([cell_number(r[f"{m}_error_mm"]) for r in rows], dtype=float)
     stopped = [r.get(f"{m}_stopped", "") for r in rows]
     confident = [r for r, st in zip(rows, stopped) if st == "confident"]
     per_part: dict[str, dict[str, int]] = {}
@@ -164,9 +165,9 @@ def error_over_bound(m: str, rows: Sequence[dict[str, Any]]) -> FloatArray:
     """Error / Cramér–Rao bound of method ``m`` over its successful trials that have a finite bound."""
     out = []
     for r in rows:
-        bound = _number(r.get(f"{m}_bound_mm", ""))
+        bound = cell_number(r.get(f"{m}_bound_mm", ""))
         if int(r[f"{m}_success"]) and math.isfinite(bound) and bound > 0:
-            out.append(_number(r[f"{m}_error_mm"]) / bound)
+            out.append(cell_number(r[f"{m}_error_mm"]) / bound)
     return np.array(out, dtype=float)
 
 
@@ -206,7 +207,7 @@ FULL_BIN = 30
 
 def reliability(m: str, rows: Sequence[dict[str, Any]]) -> list[tuple[float, float, int]]:
     """(mean stated mass, fraction within the success radius, trials) per bin of stated mass at the end."""
-    mass = np.array([_number(r.get(f"{m}_mass", "")) for r in rows])
+    mass = np.array([cell_number(r.get(f"{m}_mass", "")) for r in rows])
     hit = np.array([int(r[f"{m}_success"]) for r in rows])
     return binned(mass, hit)
 

@@ -84,15 +84,17 @@ def test_the_calibration_along_the_rolling_takes_every_mark_of_every_trial(tmp_p
     from bench.calibration import calibration_table
     from bench.columns import TRIAL_COLUMNS
 
-    fields = [*TRIAL_COLUMNS, "reactive_mass", "reactive_success", "reactive_curve", "reactive_mass_curve"]
+    fields = [*TRIAL_COLUMNS, "reactive_mass", "reactive_success", "reactive_rotation_deg"]
+    fields += ["reactive_curve", "reactive_mass_curve"]
     with open(tmp_path / "trials.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, restval="")
         w.writeheader()
         for i in range(10):
             # stated 0.9 at both marks; within the 0.3 mm radius at 5°, not at 10° (0.3 is not within)
-            curve, masses = "5:0.1000 10:0.3000", "5:0.9 10:0.9"
-            w.writerow({"level": 0, "trial": i, "success": 0, "reactive_mass": "0.9", "reactive_success": 0,
-                        "reactive_curve": curve, "reactive_mass_curve": masses})  # fmt: skip
+            # the rolling stopped at 8°: the 15° mark repeats the 10° one and is not a statement of its own
+            curve, masses = "5:0.1000 10:0.3000 15:0.3000", "5:0.9 10:0.9 15:0.9"
+            cells = {"reactive_rotation_deg": 8.0, "reactive_curve": curve, "reactive_mass_curve": masses}
+            w.writerow({"level": 0, "trial": i, "success": 0, "reactive_mass": "0.9", "reactive_success": 0, **cells})
     (tmp_path / "study.json").write_text('{"success_radius": 0.3}')
     rec = calibration_table([tmp_path])[0]
     assert rec["along"]["trials"] == 20
