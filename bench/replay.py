@@ -7,7 +7,7 @@ to filters built with other settings. Only the filter differs; the rolling is no
 variant that would have stopped earlier, or rolled elsewhere, is judged on the same readings)::
 
     python -m bench.replay bench/studies/heldout-a.toml --level 3 --trial 26 \\
-        --set sd_slope=0 --set sd_jaw=0.045 --set temper=1
+        --set sd_slope=0 --set sd_jaw=0.045 --set "temper=1 defect_window=0" [--at 35]
 
 Each variant's line gives the stated probability within the success radius, the error of the
 most probable present contact, and how much more likely (natural log, the evidence untempered)
@@ -21,9 +21,10 @@ import argparse
 import math
 import os
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, cast
+from typing import Any, ClassVar, TypeAlias, cast
 
 import numpy as np
 
@@ -32,12 +33,15 @@ from localizer import Boundary, ContactFilter
 from .study import load_study
 from .trial import TrialSpec, run_trial
 
-__all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "VariantResult"]
+__all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "calls_until", "VariantResult"]
 
 #: A start within this of the true one counts as the true start (mm).
 NEAR = 2.0
 
 _CALLS = ("update", "touch", "bridged", "regrasp")
+
+#: One call made to a filter: its name, arguments and keyword arguments.
+Call: TypeAlias = tuple[str, tuple[Any, ...], dict[str, Any]]
 
 
 class FilterRecorder(ContactFilter):
@@ -49,7 +53,7 @@ class FilterRecorder(ContactFilter):
     made: ClassVar[list[FilterRecorder]] = []
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        self.calls: list[tuple[str, tuple[Any, ...], dict[str, Any]]] = []
+        self.calls: list[Call] = []
         self._depth = 0
         self.settings = dict(kwargs)
         super().__init__(*args, **kwargs)
@@ -88,7 +92,7 @@ class Recorded:
 
     part: Boundary
     settings: dict[str, Any]
-    calls: tuple[tuple[str, tuple[Any, ...], dict[str, Any]], ...]
+    calls: tuple[Call, ...]
     row: dict[str, Any]
     start_arc: float
 
@@ -134,14 +138,28 @@ def record_trial(study_path: str | os.PathLike[str], level: int, trial: int) -> 
     )
 
 
-def replay(rec: Recorded, **changes: Any) -> VariantResult:
-    """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied."""
+def calls_until(calls: Sequence[Call], at_deg: float | None) -> list[Call]:
+    """The calls made before the rolling first turned ``at_deg`` degrees (every call: None)."""
+    if at_deg is None:
+        return list(calls)
+    out = []
+    for call in calls:
+        name, args, _ = call
+        if name == "update" and abs(float(args[1])) >= math.radians(at_deg):
+            break
+        out.append(call)
+    return out
+
+
+def replay(rec: Recorded, at_deg: float | None = None, **changes: Any) -> VariantResult:
+    """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied; with ``at_deg``, only those
+    made before the rolling first turned that many degrees (the belief the filter had there)."""
     settings = {**rec.settings, **changes}
     flt = ContactFilter(rec.part, **settings)
     # the margin from a filter that prunes nothing (the belief from one as run: what a stretch left out,
     # or a fit test, says depends on which starts are still weighed)
     full = ContactFilter(rec.part, **{**settings, "prune": math.inf})
-    for name, args, kwargs in rec.calls:
+    for name, args, kwargs in calls_until(rec.calls, at_deg):
         getattr(flt, name)(*args, **kwargs)
         getattr(full, name)(*args, **kwargs)
     belief = flt.belief()
@@ -180,25 +198,30 @@ def main(argv: list[str] | None = None) -> int:
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="a ContactFilter setting for one variant (repeat for more variants)",
+        help="ContactFilter settings for one variant, space-separated (repeat for more variants)",
     )
+    ap.add_argument("--at", type=float, metavar="DEG", help="the beliefs after this many degrees of rolling")
     args = ap.parse_args(argv)
     variants: list[dict[str, Any]] = [{}]
-    for item in args.set:
-        name, sep, value = item.partition("=")
-        if not sep:
-            ap.error(f"--set {item!r}: use NAME=VALUE, e.g. sd_slope=0")
-        variants.append({name: _value(value)})
+    for group in args.set:
+        variant = {}
+        for item in group.split():
+            name, sep, value = item.partition("=")
+            if not sep:
+                ap.error(f"--set {item!r}: use NAME=VALUE, e.g. sd_slope=0")
+            variant[name] = _value(value)
+        variants.append(variant)
     rec = record_trial(args.study, args.level, args.trial)
     r = rec.row
     print(
         f"{r['part']} {r['value']} trial {args.trial}: reactive {r['reactive_stopped']} at mass "
         f"{r['reactive_mass']}, error {float(r['reactive_error_mm']):.3f} mm after "
         f"{float(r['reactive_rotation_deg']):.1f} degrees, {len(rec.calls)} filter calls"
+        + ("" if args.at is None else f"; the beliefs after {args.at:g} degrees")
     )
     for changes in variants:
         try:
-            v = replay(rec, **changes)
+            v = replay(rec, args.at, **changes)
         except (TypeError, ValueError) as exc:
             print(f"  {changes!s:40s} cannot be built: {exc}", file=sys.stderr)
             continue

@@ -52,3 +52,26 @@ def test_the_command_line(recorded, capsys):
     assert "nonsense" in err
     with pytest.raises(ValueError, match="level=5"):
         record_trial(f, 5, 0)
+
+
+def test_the_belief_part_way_is_that_of_the_calls_made_before_that_turn(recorded):
+    import math
+
+    from bench.replay import calls_until
+
+    _, rec = recorded
+    early = calls_until(rec.calls, 10.0)
+    assert 0 < len(early) < len(rec.calls)
+    assert all(abs(c[1][1]) < math.radians(10.0) for c in early if c[0] == "update")
+    assert calls_until(rec.calls, None) == list(rec.calls) == calls_until(rec.calls, 1e6)
+    # the robustness checks only lower what the model alone states
+    alone = replay(rec, 10.0, defect_window=0.0, slope_envelope=(), lookalike_slope=0.0)
+    assert alone.mass >= replay(rec, 10.0).mass
+    assert alone.settings == {"defect_window": 0.0, "slope_envelope": (), "lookalike_slope": 0.0}
+
+
+def test_a_variant_of_several_settings_on_the_command_line(recorded, capsys):
+    f, _ = recorded
+    assert main([str(f), "--level", "0", "--trial", "0", "--at", "20", "--set", "temper=1 defect_window=0"]) == 0
+    out, _ = capsys.readouterr()
+    assert "after 20 degrees" in out and "{'temper': 1, 'defect_window': 0}" in out
