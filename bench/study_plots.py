@@ -192,30 +192,45 @@ def _plot_bound(study: Study, rows: Sequence[dict[str, Any]], out: Path) -> None
 
 
 def _plot_methods(study: Study, summary: dict[str, Any], out: Path) -> None:
-    """methods.png: success rate against rotation rolled for each method."""
+    """methods.png: each method's success rate against the rotation rolled (left) and how many were sure,
+    and sure and wrong, by then (right; studies with each method's stated probability along the rolling),
+    the fixed rolls' total (the paper's two-roll method) marked on both."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4.4))
+    sure = summary.get("sure_by_rotation_deg", {})
+    stating = [m for m in study.methods if sure.get(m)]
+    fig, axes = plt.subplots(1, 2 if stating else 1, figsize=(13 if stating else 7, 4.4), squeeze=False)
+    ax = axes[0][0]
+    fixed = sum(abs(a) for a in study.rolls_deg)
+    colors = {m: f"C{k}" for k, m in enumerate(study.methods)}
     for m in study.methods:
         curve = summary["success_by_rotation_deg"][m]
         x = [float(k) for k in curve]
         d = summary["method_details"][m]
-        label = f"{m}: {summary['methods'][m]:.1%} at the end, mean rotation {d['mean_rotation_deg']:.0f}°"
-        ax.plot(x, list(curve.values()), "o-", ms=3, label=label)
+        rot = "" if d["mean_rotation_deg"] is None else f", mean rotation {d['mean_rotation_deg']:.0f}°"
+        rate = summary["methods"][m]
+        label = f"{m}: {rate:.1%} at the end{rot}" if rate is not None else m
+        ax.plot(x, list(curve.values()), "o-", ms=3, color=colors[m], label=label)
     ax.axhline(0.45, color="tab:red", lw=1, ls="--", label="the paper's rig: about 45%")
-    ax.axvline(
-        sum(abs(a) for a in study.rolls_deg),
-        color="0.5",
-        lw=1,
-        ls=":",
-        label=f"the fixed rolls: {sum(abs(a) for a in study.rolls_deg):g}°",
-    )
-    ax.set_ylim(0, 1.02)
-    ax.set_xlabel("rotation rolled (degrees)")
     ax.set_ylabel(f"success rate (error < {study.success_radius} mm)")
     ax.set_title(f"{study.name}: {len(study.methods)} methods on the same trials", fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="lower right")
+    if stating:
+        bx = axes[0][1]
+        for m in stating:
+            by = sure[m]
+            x = [float(k) for k in by]
+            end = list(by.values())[-1]
+            label = f"{m}: {end['sure']:.0%} sure, {end['sure_wrong']:.0%} sure and wrong at the end"
+            bx.plot(x, [v["sure"] for v in by.values()], "o-", ms=3, color=colors[m], label=label)
+            bx.plot(x, [v["sure_wrong"] for v in by.values()], "x--", ms=3, lw=1, color=colors[m])
+        bx.set_ylabel(f"fraction sure (stated ≥ {study.reactive.confidence:g}); dashed: sure and wrong")
+        bx.set_title("sure against rotation", fontsize=10)
+    for a in axes[0]:
+        a.axvline(fixed, color="0.5", lw=1, ls=":", label=f"the fixed rolls: {fixed:g}°")
+        a.set_ylim(0, 1.02)
+        a.set_xlabel("rotation rolled (degrees)")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7, loc="lower right" if a is ax else "upper left")
     fig.tight_layout()
     fig.savefig(out / "methods.png", dpi=110)
     plt.close(fig)

@@ -24,6 +24,7 @@ __all__ = [
     "method_detail",
     "error_over_bound",
     "summarize_methods",
+    "sure_by_rotation",
     "RELIABILITY_BINS",
     "reliability",
     "FULL_BIN",
@@ -176,6 +177,7 @@ def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str,
     from .scoring import MARK_DEG, parse_curve
 
     rates, details, curves = {}, {}, {}
+    sure: dict[str, dict[str, dict[str, float]] | None] = {}
     n = len(rows)
     for m in study.methods:
         details[m] = method_detail(study, m, rows)
@@ -193,7 +195,42 @@ def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str,
                 per_mark.setdefault(k, []).append(e < study.success_radius)
                 k += MARK_DEG
         curves[m] = {f"{k:g}": float(np.mean(v)) for k, v in sorted(per_mark.items())}
-    return {"methods": rates, "method_details": details, "success_by_rotation_deg": curves}
+        sure[m] = sure_by_rotation(study, m, rows)
+    return {
+        "methods": rates,
+        "method_details": details,
+        "success_by_rotation_deg": curves,
+        "sure_by_rotation_deg": sure,
+    }
+
+
+def sure_by_rotation(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> dict[str, dict[str, float]] | None:
+    """Method ``m``'s fraction of trials sure (stated probability at least the study's confidence) and
+    sure and wrong (error not within the success radius) at every mark of rotation, {"5": {"sure": ...,
+    "sure_wrong": ...}, ...}; a trial keeps its last statement past its last mark. None where the trials
+    have no ``<m>_mass_curve`` (studies run before it) or the method states nothing."""
+    from .scoring import MARK_DEG, parse_curve
+
+    if not rows or not any(r.get(f"{m}_mass_curve") for r in rows):
+        return None
+    confidence = study.reactive.confidence
+    top_mark = max(study.reactive.max_rotation_deg, sum(abs(a) for a in study.rolls_deg))
+    marks = np.arange(MARK_DEG, top_mark + 1e-9, MARK_DEG)
+    sure, wrong = np.zeros(marks.size), np.zeros(marks.size)
+    for r in rows:
+        masses = {round(k, 6): p for k, p in parse_curve(r.get(f"{m}_mass_curve", ""))}
+        errors = {round(k, 6): e for k, e in parse_curve(r.get(f"{m}_curve", ""))}
+        if not masses:
+            continue
+        last = max(masses)
+        for j, k in enumerate(np.round(marks, 6)):
+            at = k if k in masses else (last if k > last else None)
+            if at is None or not masses[at] >= confidence:
+                continue
+            sure[j] += 1
+            wrong[j] += not errors.get(at, math.inf) < study.success_radius
+    n = len(rows)
+    return {f"{k:g}": {"sure": float(a / n), "sure_wrong": float(b / n)} for k, a, b in zip(marks, sure, wrong)}
 
 
 #: Bins of stated confidence in the reliability diagram and the calibration error (fine near 1, where the

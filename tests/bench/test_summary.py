@@ -102,3 +102,22 @@ def test_the_calibration_along_the_rolling_takes_every_mark_of_every_trial(tmp_p
     assert rec["calibration"]["error"] == pytest.approx(0.9)
     (tmp_path / "study.json").unlink()  # without the radius, nothing along the rolling can be judged
     assert calibration_table([tmp_path])[0]["along"] is None
+
+
+def test_sure_against_rotation_counts_each_trial_from_the_mark_it_is_sure_at():
+    from bench.study import load_study
+    from bench.summary import sure_by_rotation
+
+    study = load_study("bench/studies/reactive.toml")  # confidence 0.95, 0.3 mm
+    rows = [
+        # sure from 10° on, and right there
+        {"reactive_mass_curve": "5:0.5 10:0.96", "reactive_curve": "5:1.0000 10:0.0100"},
+        # sure from 5° on, and wrong
+        {"reactive_mass_curve": "5:0.97 10:0.97", "reactive_curve": "5:0.5000 10:0.5000"},
+        # states nothing
+        {"reactive_mass_curve": "", "reactive_curve": ""},
+    ]
+    by = sure_by_rotation(study, "reactive", rows)
+    assert by["5"] == {"sure": pytest.approx(1 / 3), "sure_wrong": pytest.approx(1 / 3)}
+    assert by["10"] == by["240"] == {"sure": pytest.approx(2 / 3), "sure_wrong": pytest.approx(1 / 3)}
+    assert sure_by_rotation(study, "reactive", rows[2:]) is None
