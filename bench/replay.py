@@ -151,29 +151,36 @@ def calls_until(calls: Sequence[Call], at_deg: float | None) -> list[Call]:
     return out
 
 
-def replay(rec: Recorded, at_deg: float | None = None, **changes: Any) -> VariantResult:
+def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, **changes: Any) -> VariantResult:
     """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied; with ``at_deg``, only those
-    made before the rolling first turned that many degrees (the belief the filter had there)."""
+    made before the rolling first turned that many degrees (the belief the filter had there). Without
+    ``margin`` the true start's margin and the noise scale are not weighed (NaN; a second filter that
+    prunes nothing, most of the cost); the error is then from the filter's own nominal contacts."""
     settings = {**rec.settings, **changes}
     flt = ContactFilter(rec.part, **settings)
     # the margin from a filter that prunes nothing (the belief from one as run: what a stretch left out,
     # or a fit test, says depends on which starts are still weighed)
-    full = ContactFilter(rec.part, **{**settings, "prune": math.inf})
+    full = ContactFilter(rec.part, **{**settings, "prune": math.inf}) if margin else flt
     for name, args, kwargs in calls_until(rec.calls, at_deg):
         getattr(flt, name)(*args, **kwargs)
-        getattr(full, name)(*args, **kwargs)
+        if margin:
+            getattr(full, name)(*args, **kwargs)
     belief = flt.belief()
     part = rec.part
     off = np.abs(np.asarray(part.arc_offset(flt.grid, rec.start_arc)))
+    i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
+    error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(full.current[i])))))
+    if not margin:
+        return VariantResult(
+            settings=dict(changes), mass=belief.mass, error_mm=error, margin=math.nan, noise_scale=math.nan
+        )
     ll = full.log_likelihood() / full.temper
     near, far = ll[off < NEAR], ll[off >= NEAR]
     best_near = float(near.max()) if near.size else -math.inf
     best_far = float(far.max()) if far.size else -math.inf
-    margin = best_near - best_far if np.isfinite(best_far) else math.inf
-    i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
-    error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(full.current[i])))))
+    true_margin = best_near - best_far if np.isfinite(best_far) else math.inf
     return VariantResult(
-        settings=dict(changes), mass=belief.mass, error_mm=error, margin=margin, noise_scale=full.noise_scale()
+        settings=dict(changes), mass=belief.mass, error_mm=error, margin=true_margin, noise_scale=full.noise_scale()
     )
 
 

@@ -75,3 +75,12 @@ def test_a_variant_of_several_settings_on_the_command_line(recorded, capsys):
     assert main([str(f), "--level", "0", "--trial", "0", "--at", "20", "--set", "temper=1 defect_window=0"]) == 0
     out, _ = capsys.readouterr()
     assert "after 20 degrees" in out and "{'temper': 1, 'defect_window': 0}" in out
+
+
+def test_without_the_margin_the_belief_is_the_same(recorded):
+    import math
+
+    _, rec = recorded
+    quick, whole = replay(rec, 20.0, margin=False), replay(rec, 20.0)
+    assert quick.mass == whole.mass and quick.error_mm == pytest.approx(whole.error_mm)
+    assert math.isnan(quick.margin) and math.isnan(quick.noise_scale)
