@@ -104,13 +104,15 @@ class VariantResult:
     mass : stated probability within the success radius; error_mm : the most probable present
     contact against the true start's present contact on the model (mm); margin : log-likelihood of
     the best start within :data:`NEAR` mm of the true one minus the best elsewhere (untempered;
-    inf if no other is left); noise_scale : the λ the readings say."""
+    inf if no other is left); noise_scale : the λ the readings say; mismatch : the readings stopped
+    fitting the part (a belief that is then never sure)."""
 
     settings: dict[str, Any]
     mass: float
     error_mm: float
     margin: float
     noise_scale: float
+    mismatch: bool = False
 
 
 def record_trial(study_path: str | os.PathLike[str], level: int, trial: int) -> Recorded:
@@ -170,6 +172,7 @@ def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, *
     off = np.abs(np.asarray(part.arc_offset(flt.grid, rec.start_arc)))
     i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
     error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(full.current[i])))))
+    mismatched = belief.mismatch is not None or not belief.consistent
     if not margin:
         return VariantResult(
             settings=dict(changes), mass=belief.mass, error_mm=error, margin=math.nan, noise_scale=math.nan
@@ -179,9 +182,7 @@ def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, *
     best_near = float(near.max()) if near.size else -math.inf
     best_far = float(far.max()) if far.size else -math.inf
     true_margin = best_near - best_far if np.isfinite(best_far) else math.inf
-    return VariantResult(
-        settings=dict(changes), mass=belief.mass, error_mm=error, margin=true_margin, noise_scale=full.noise_scale()
-    )
+    return VariantResult(dict(changes), belief.mass, error, true_margin, full.noise_scale(), mismatched)
 
 
 def _value(text: str) -> int | float | tuple[float, ...] | str:
@@ -235,6 +236,7 @@ def main(argv: list[str] | None = None) -> int:
         print(
             f"  {str(changes) if changes else 'as run':40s} mass {v.mass:.3f}  error {v.error_mm:8.3f} mm  "
             f"true-start margin {v.margin:+8.2f} nats  noise scale {v.noise_scale:.2f}"
+            + ("  MISMATCH" if v.mismatch else "")
         )
     return 0
 
