@@ -28,7 +28,7 @@ from typing import Any, ClassVar, TypeAlias, cast
 
 import numpy as np
 
-from localizer import Boundary, ContactFilter
+from localizer import Belief, Boundary, ContactFilter
 
 from .study import load_study
 from .trial import TrialSpec, run_trial
@@ -38,7 +38,7 @@ __all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "calls_until"
 #: A start within this of the true one counts as the true start (mm).
 NEAR = 2.0
 
-_CALLS = ("update", "touch", "bridged", "regrasp")
+_CALLS = ("update", "touch", "bridged", "regrasp", "belief")
 
 #: One call made to a filter: its name, arguments and keyword arguments.
 Call: TypeAlias = tuple[str, tuple[Any, ...], dict[str, Any]]
@@ -46,7 +46,8 @@ Call: TypeAlias = tuple[str, tuple[Any, ...], dict[str, Any]]
 
 class FilterRecorder(ContactFilter):
     """A :class:`localizer.ContactFilter` that keeps the calls made to it (``calls``: name, args,
-    keyword args), the outermost only (``regrasp`` calls ``update`` itself). Each instance is added
+    keyword args), the outermost only (``regrasp`` calls ``update`` itself). ``belief`` is kept too: asking
+    it runs the fit test on its schedule, so a replay must ask when the run asked. Each instance is added
     to ``made`` when built: :func:`record_trial` gives a subclass its own list, so that nothing is
     shared between runs."""
 
@@ -83,6 +84,9 @@ class FilterRecorder(ContactFilter):
 
     def regrasp(self, *args: Any, **kwargs: Any) -> None:
         self._record("regrasp", args, kwargs)
+
+    def belief(self, *args: Any, **kwargs: Any) -> Belief:
+        return cast(Belief, self._record("belief", args, kwargs))
 
 
 @dataclass(frozen=True)
@@ -141,14 +145,20 @@ def record_trial(study_path: str | os.PathLike[str], level: int, trial: int) -> 
 
 
 def calls_until(calls: Sequence[Call], at_deg: float | None) -> list[Call]:
-    """The calls made before the rolling first turned ``at_deg`` degrees (every call: None)."""
+    """The calls made before the rolling had turned ``at_deg`` degrees in all (the rotation rolled, both
+    ways, as a run's rotation curve counts it: the sum of the turns between readings; every call: None)."""
     if at_deg is None:
         return list(calls)
-    out = []
+    out: list[Call] = []
+    rolled, last = 0.0, None
     for call in calls:
         name, args, _ = call
-        if name == "update" and abs(float(args[1])) >= math.radians(at_deg):
-            break
+        if name in ("update", "regrasp"):
+            turn = float(args[1])
+            rolled += abs(turn - last) if last is not None else abs(turn)
+            last = turn
+            if name == "update" and rolled >= math.radians(at_deg):
+                break
         out.append(call)
     return out
 

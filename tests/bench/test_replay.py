@@ -29,7 +29,7 @@ max_rotation_deg = 60.0
 def test_the_recorded_calls_give_back_the_run_belief(recorded):
     _, rec = recorded
     names = {c[0] for c in rec.calls}
-    assert {"touch", "update"} <= names and len(rec.calls) > 20
+    assert {"touch", "update", "belief"} <= names and len(rec.calls) > 20
     as_run = replay(rec)
     assert as_run.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
     assert as_run.error_mm == pytest.approx(float(rec.row["reactive_error_mm"]), abs=0.06)
