@@ -38,7 +38,7 @@ __all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "calls_until"
 #: A start within this of the true one counts as the true start (mm).
 NEAR = 2.0
 
-_CALLS = ("update", "touch", "bridged", "regrasp", "belief")
+_CALLS = ("update", "touch", "bridged", "regrasp", "belief", "reset")
 
 #: One call made to a filter: its name, arguments and keyword arguments.
 Call: TypeAlias = tuple[str, tuple[Any, ...], dict[str, Any]]
@@ -61,8 +61,12 @@ class FilterRecorder(ContactFilter):
         self.made.append(self)
 
     def reset(self) -> None:
-        self.calls = []
-        super().reset()
+        # kept as a call: a run that left the model behind starts its filter again part-way, and a replay
+        # must too
+        if hasattr(self, "calls"):
+            self._record("reset", (), {})
+        else:
+            super().reset()
 
     def _record(self, name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> Any:
         if self._depth == 0:
@@ -106,7 +110,9 @@ class VariantResult:
     """What a variant of the filter says after the recorded calls.
 
     mass : stated probability within the success radius; error_mm : the most probable present
-    contact against the true start's present contact on the model (mm); margin : log-likelihood of
+    contact against the true start's present contact on the model (mm; NaN where the run started its
+    filter again from another contact, where the trial's start is no longer the filter's); margin :
+    log-likelihood of
     the best start within :data:`NEAR` mm of the true one minus the best elsewhere (untempered;
     inf if no other is left); noise_scale : the λ the readings say; mismatch : the readings stopped
     fitting the part (a belief that is then never sure)."""
@@ -153,6 +159,8 @@ def calls_until(calls: Sequence[Call], at_deg: float | None) -> list[Call]:
     rolled, last = 0.0, None
     for call in calls:
         name, args, _ = call
+        if name == "reset":
+            last = None  # the run's turns start again from the contact it then touches
         if name in ("update", "regrasp"):
             turn = float(args[1])
             rolled += abs(turn - last) if last is not None else abs(turn)
@@ -161,6 +169,16 @@ def calls_until(calls: Sequence[Call], at_deg: float | None) -> list[Call]:
                 break
         out.append(call)
     return out
+
+
+def _restarted(calls: Sequence[Call]) -> bool:
+    """Whether the filter was reset after it had taken a reading."""
+    read = False
+    for name, _, _ in calls:
+        read = read or name == "update"
+        if read and name == "reset":
+            return True
+    return False
 
 
 def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, **changes: Any) -> VariantResult:
@@ -173,7 +191,8 @@ def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, *
     # the margin from a filter that prunes nothing (the belief from one as run: what a stretch left out,
     # or a fit test, says depends on which starts are still weighed)
     full = ContactFilter(rec.part, **{**settings, "prune": math.inf}) if margin else flt
-    for name, args, kwargs in calls_until(rec.calls, at_deg):
+    calls = calls_until(rec.calls, at_deg)
+    for name, args, kwargs in calls:
         getattr(flt, name)(*args, **kwargs)
         if margin:
             getattr(full, name)(*args, **kwargs)
@@ -182,6 +201,8 @@ def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, *
     off = np.abs(np.asarray(part.arc_offset(flt.grid, rec.start_arc)))
     i = int(np.flatnonzero(off < NEAR)[np.argmin(off[off < NEAR])])
     error = abs(float(part.arc_offset(belief.map_arc, float(part.wrap_arc(full.current[i])))))
+    if _restarted(calls):
+        error = math.nan  # the filter started again from another contact: the trial's start is not its start
     mismatched = belief.mismatch is not None or not belief.consistent
     if not margin:
         return VariantResult(
