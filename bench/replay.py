@@ -216,7 +216,9 @@ def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, *
     return VariantResult(dict(changes), belief.mass, error, true_margin, full.noise_scale(), mismatched)
 
 
-def _value(text: str) -> int | float | tuple[float, ...] | str:
+def _value(text: str) -> bool | int | float | tuple[float, ...] | str:
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
     for kind in (int, float):
         try:
             return kind(text)

@@ -73,8 +73,10 @@ def test_the_belief_part_way_is_that_of_the_calls_made_before_that_turn(recorded
 def test_a_variant_of_several_settings_on_the_command_line(recorded, capsys):
     f, _ = recorded
     assert main([str(f), "--level", "0", "--trial", "0", "--at", "20", "--set", "temper=1 defect_window=0"]) == 0
+    assert main([str(f), "--level", "0", "--trial", "0", "--set", "corner_ends=false"]) == 0
     out, _ = capsys.readouterr()
     assert "after 20 degrees" in out and "{'temper': 1, 'defect_window': 0}" in out
+    assert "{'corner_ends': False}" in out
 
 
 def test_without_the_margin_the_belief_is_the_same(recorded):
