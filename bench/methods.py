@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .columns import MethodCells, ScoreCells, Scored
-from .reactive_method import failed_method, reactive_filter, score_reactive, score_wheel
+from .reactive_method import reactive_filter, score_reactive, score_wheel
 from .scoring import (
     ENCODER_SLACK_DEG,
     MARK_DEG,
@@ -33,6 +33,7 @@ from .scoring import (
     MethodResult,
     RuleResult,
     boundary_error,
+    broken_trial,
     curve_cell,
     mass_cell,
 )
@@ -449,7 +450,7 @@ def score_trial(ctx: TrialContext, rolled: StraightRoll | WheelRoll) -> Scored:
         return score_wheel(ctx.study, ctx.part, rolled.run, rolled.true_arc, rolled.failure, rolled.spikes)
     s = ctx.study
     if rolled.failure:
-        return _broken_trial(s, rolled.failure)
+        return broken_trial(s.methods, rolled.failure)
     assert rolled.cal is not None  # a trial that did not break was calibrated
     rule = s.method if s.method in ("paper", "likelihood") else "paper"
     rules: dict[str, Localization | Exception] = {}
@@ -488,18 +489,3 @@ def score_trial(ctx: TrialContext, rolled: StraightRoll | WheelRoll) -> Scored:
     first = methods[s.methods[0]]
     cells.update({"success": first["success"], "error_mm": first["error_mm"], "estimate_arc": first["estimate_arc"]})
     return Scored(cells, methods, rolled.spikes if spikes is None else spikes)
-
-
-def _broken_trial(s: Study, text: str) -> Scored:
-    """The scores of a trial that broke before any method could run: every method's failure ``text``."""
-    cells: ScoreCells = {
-        "true_arc": math.nan,
-        "estimate_arc": math.nan,
-        "error_mm": math.inf,
-        "success": 0,
-        "candidates": 0,
-        "probability": 0.0,
-        "ambiguous": 0,
-        "failure": text,
-    }
-    return Scored(cells, {m: failed_method(text) for m in s.methods}, "")

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from .columns import MethodCells, ScoreCells, Scored
-from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, curve_cell, mass_cell
+from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, curve_cell, failed_method, mass_cell
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, ReactivePolicy, ReactiveRun
@@ -27,7 +27,6 @@ __all__ = [
     "rotation_curve",
     "score_reactive",
     "score_wheel",
-    "failed_method",
     "mismatch_cell",
 ]
 
@@ -164,24 +163,6 @@ def mismatch_cell(belief: Belief) -> str:
     if not all(math.isfinite(a) for a in arcs):
         return "unknown"
     return f"{arcs[0]:.2f}-{arcs[1]:.2f}"
-
-
-def failed_method(text: str) -> MethodCells:
-    """The cells of a method that could not run on a trial: ``text`` why."""
-    return {
-        "success": 0,
-        "error_mm": math.inf,
-        "estimate_arc": math.nan,
-        "rotation_deg": math.nan,
-        "curve": "",
-        "stopped": "error",
-        "mass": "",
-        "failure": text,
-        "bridges": "",
-        "bound_mm": "",
-        "mismatch_arc": "",
-        "mass_curve": "",
-    }
 
 
 def score_wheel(

@@ -1,20 +1,25 @@
 """What every method's score shares: where the jaw is laid, the error of an estimate on the part's
-boundary, and the rotation curve's marks and their text in trials.csv."""
+boundary, the rotation curve's marks and their text in trials.csv, and the cells of a method, or of a
+whole trial, that could not run."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, TypeAlias, TypedDict
 
 import numpy as np
 import numpy.typing as npt
+
+from .columns import MethodCells, ScoreCells, Scored
 
 if TYPE_CHECKING:
     from localizer import Outline, Part
 
 
 __all__ = [
+    "failed_method",
+    "broken_trial",
     "RuleResult",
     "MethodResult",
     "FloatArray",
@@ -102,3 +107,36 @@ def boundary_error(part: Part | Outline, est: float, truth: float) -> float:
     if not (math.isfinite(est) and math.isfinite(truth)):
         return math.inf
     return abs(float(part.arc_offset(est, truth)))
+
+
+def failed_method(text: str) -> MethodCells:
+    """The cells of a method that could not run on a trial: ``text`` why."""
+    return {
+        "success": 0,
+        "error_mm": math.inf,
+        "estimate_arc": math.nan,
+        "rotation_deg": math.nan,
+        "curve": "",
+        "stopped": "error",
+        "mass": "",
+        "failure": text,
+        "bridges": "",
+        "bound_mm": "",
+        "mismatch_arc": "",
+        "mass_curve": "",
+    }
+
+
+def broken_trial(methods: Sequence[str], text: str) -> Scored:
+    """The scores of a trial that broke before any method could run: every method's failure ``text``."""
+    cells: ScoreCells = {
+        "true_arc": math.nan,
+        "estimate_arc": math.nan,
+        "error_mm": math.inf,
+        "success": 0,
+        "candidates": 0,
+        "probability": 0.0,
+        "ambiguous": 0,
+        "failure": text,
+    }
+    return Scored(cells, {m: failed_method(text) for m in methods}, "")
