@@ -240,8 +240,10 @@ class Study:
         """The study with ``trials`` per level and the ``engine`` replaced where given (the command line's flags)."""
         s = self
         if trials is not None:
-            if int(trials) < 1:
+            if isinstance(trials, bool) or int(trials) < 1:
                 raise StudyError(f"--trials {trials} must be at least 1")
+            if int(trials) > MAX_TRIALS:
+                raise StudyError(f"--trials {trials} is more than {MAX_TRIALS} per level: split the study")
             s = replace(s, trials=int(trials))
         if engine is not None:
             if engine not in ("kinematic", "pymunk"):

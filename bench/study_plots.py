@@ -127,7 +127,8 @@ def _plot_fingers(study: Study, rows: Sequence[dict[str, Any]], levels: list[dic
             hit / max(len(sel), 1),
             "o-",
             ms=2.5,
-            label=f"{lv['value']}: {d['success']}/{d['trials']}, median {d['median_rotation_deg']:.0f}°",
+            label=f"{lv['value']}: {d['success']}/{d['trials']}"
+            + ("" if d["median_rotation_deg"] is None else f", median {d['median_rotation_deg']:.0f}°"),
         )
     ax.set_ylim(0, 1.02)
     ax.set_xlabel("rotation used (degrees; a wheel: the hand's turning)")

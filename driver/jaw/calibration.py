@@ -109,6 +109,8 @@ class Calibration:
         """Read a calibration written by :meth:`save`."""
         try:
             data = json.loads(Path(path).read_text())
+            if not isinstance(data, dict):
+                raise ValueError(f"it holds a JSON {type(data).__name__}, not a calibration's object")
             jaw = str(data.get("jaw", "straight:100"))  # files from before fingers were named: the paper's jaw
             if not jaw.startswith("straight"):
                 raise ValueError(f"it is a calibration of a {jaw} finger, not of a straight jaw")

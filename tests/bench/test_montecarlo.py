@@ -498,3 +498,31 @@ def test_resume_refuses_a_part_file_edited_since(tmp_path):
     part.write_text(json.dumps(doc))
     with pytest.raises(StudyError, match=r"cam\.json as it was before .* the part file has changed since"):
         run_study(load_study(f), tmp_path / "out", resume=True, workers=1, progress=False)
+
+
+def test_the_command_lines_trials_are_bounded_as_the_study_files_are():
+    from bench.study import MAX_TRIALS
+
+    study = load_study(ROOT / "bench" / "studies" / "paper.toml")
+    assert study.with_overrides(trials=7).trials == 7
+    for bad, match in ((0, "at least 1"), (True, "at least 1"), (MAX_TRIALS + 1, "split the study")):
+        with pytest.raises(StudyError, match=match):
+            study.with_overrides(trials=bad)
+
+
+def test_a_method_that_failed_every_trial_is_still_plotted_and_summed(tmp_path, monkeypatch):
+    import localizer
+
+    study = small_methods_study(tmp_path)
+    real = localizer.localize
+
+    def paper_breaks(part, rolls, rule="likelihood", **kw):
+        if rule == "paper":
+            raise localizer.QueryError("the paper rule refused")
+        return real(part, rolls, rule=rule, **kw)
+
+    monkeypatch.setattr(localizer, "localize", paper_breaks)
+    summary = run_study(study, tmp_path / "out", workers=1, progress=False)
+    d = summary["method_details"]["paper"]
+    assert d["success"] == 0 and d["failures"] == d["trials"] and d["mean_rotation_deg"] is None
+    assert (tmp_path / "out" / "methods.png").stat().st_size > 5000

@@ -169,6 +169,10 @@ def test_calibration_checks_and_file_roundtrip(tmp_path, cam_cal):
     f.write_text("{")
     with pytest.raises(RigError, match="calibration file"):
         Calibration.load(f)
+    for other in ("[1, 2, 3]", '"positions"', "42", "null"):
+        f.write_text(other)  # JSON, but not a calibration's object: one clear line, not an AttributeError
+        with pytest.raises(RigError, match="not a calibration's object"):
+            Calibration.load(f)
 
 
 def test_rolls_must_turn_one_way(cam, cam_cal):
