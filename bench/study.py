@@ -291,7 +291,7 @@ def load_study(path: str | os.PathLike[str]) -> Study:
     if (
         not isinstance(rolls, list)
         or not rolls
-        or not all(isinstance(r, (int, float)) and r != 0 for r in rolls)
+        or not all(isinstance(r, (int, float)) and not isinstance(r, bool) and r != 0 for r in rolls)
         or len({r > 0 for r in rolls}) != 1
     ):
         raise StudyError(
@@ -314,7 +314,7 @@ def load_study(path: str | os.PathLike[str]) -> Study:
         raise StudyError(f"study {path}: engine {engine!r}; use 'kinematic' or 'pymunk'")
     for key, default, lo in (("trials", 100, 1), ("seed", 0, 0)):
         v = data.get(key, default)
-        if not isinstance(v, int) or v < lo:
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise StudyError(f"study {path}: {key}={v!r} must be an integer >= {lo}")
     for key, fallback in (("step_deg", STEP_DEG), ("success_radius", SUCCESS_RADIUS)):
         v = data.get(key, fallback)
@@ -455,11 +455,13 @@ def _options(path: Path, table: object, cls: type[_Options], name: str) -> _Opti
                 raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a list of positive factors")
             values[key] = tuple(float(v) for v in value)
             continue
-        if key in ("defect_window", "lookalike_slope") and isinstance(value, (int, float)) and value == 0:
+        if key in ("defect_window", "lookalike_slope") and type(value) in (int, float) and value == 0:
             values[key] = 0.0
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 or not math.isfinite(value):
             raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a positive number")
+        if key in ("particles", "check_every", "confirm") and value != int(value):
+            raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a whole number")
         values[key] = int(value) if key in ("particles", "check_every", "confirm") else float(value)
     if values.get("temper", 0.5) > 1:
         raise StudyError(f"study {path}: [{name}] temper={values['temper']!r} must be at most 1")

@@ -109,6 +109,16 @@ def test_dask_local_cluster_gives_the_same_table(reference):
         ('parts = ["{cam}"]\nrolls_deg = [20.0, -15.0]', "one sign"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\nmethod = "guess"', "method 'guess'"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\ntrials = 0', "trials=0 must be an integer >= 1"),
+        ('parts = ["{cam}"]\nrolls_deg = [20.0]\ntrials = true', "trials=True must be an integer >= 1"),
+        ('parts = ["{cam}"]\nrolls_deg = [true]', "nonzero angles of one sign"),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\ndefect_window = false',
+            "defect_window=False must be a positive number",
+        ),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\ncheck_every = 2.5',
+            "check_every=2.5 must be a whole number",
+        ),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\ncolour = 3', r"unknown key\(s\) \['colour'\]"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v9"\nvalues = [1.0]', "not a noise-model field"),
         ('parts = ["{cam}"]\nrolls_deg = [20.0]\n[sweep]\nparameter = "v2_noise"\nvalues = [-1.0]', "must be >= 0"),
