@@ -279,11 +279,11 @@ particles = 500
     return load_study(f)
 
 
-def test_one_methods_error_is_that_methods_failure_only(tmp_path, monkeypatch):
+@pytest.fixture
+def paper_rule_refuses(monkeypatch):
+    """The localizer's paper rule refuses every query (the other rules as they are)."""
     import localizer
-    from bench.trial import TrialSpec, run_trial
 
-    study = small_methods_study(tmp_path)
     real = localizer.localize
 
     def paper_breaks(part, rolls, rule="likelihood", **kw):
@@ -292,6 +292,12 @@ def test_one_methods_error_is_that_methods_failure_only(tmp_path, monkeypatch):
         return real(part, rolls, rule=rule, **kw)
 
     monkeypatch.setattr(localizer, "localize", paper_breaks)
+
+
+def test_one_methods_error_is_that_methods_failure_only(tmp_path, paper_rule_refuses):
+    from bench.trial import TrialSpec, run_trial
+
+    study = small_methods_study(tmp_path)
     row = run_trial(TrialSpec(study, 0, 0))
     assert row["failure"] == ""  # the trial itself did not break
     assert row["paper_stopped"] == "error" and row["paper_success"] == 0
@@ -520,18 +526,8 @@ def test_the_command_lines_trials_are_bounded_as_the_study_files_are():
             study.with_overrides(trials=bad)
 
 
-def test_a_method_that_failed_every_trial_is_still_plotted_and_summed(tmp_path, monkeypatch):
-    import localizer
-
+def test_a_method_that_failed_every_trial_is_still_plotted_and_summed(tmp_path, paper_rule_refuses):
     study = small_methods_study(tmp_path)
-    real = localizer.localize
-
-    def paper_breaks(part, rolls, rule="likelihood", **kw):
-        if rule == "paper":
-            raise localizer.QueryError("the paper rule refused")
-        return real(part, rolls, rule=rule, **kw)
-
-    monkeypatch.setattr(localizer, "localize", paper_breaks)
     summary = run_study(study, tmp_path / "out", workers=1, progress=False)
     d = summary["method_details"]["paper"]
     assert d["success"] == 0 and d["failures"] == d["trials"] and d["mean_rotation_deg"] is None
