@@ -105,9 +105,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (FileNotFoundError, KeyError) as exc:
         print(f"error: {exc.args[0]}", file=sys.stderr)
         return 2
-    print(
-        f"{'study':28s} {'level':>8s} {'trials':>6s} {'sure':>5s} {'wrong':>5s} {'cal. error':>10s} {'worst bin':>9s}"
-    )
+    head = ("study", "level", "trials", "sure", "wrong", "cal. error", "worst bin", "along", "marks")
+    print("{:28s} {:>12s} {:>6s} {:>5s} {:>5s} {:>10s} {:>9s} {:>6s} {:>6s}".format(*head))
     for r in records:
         cal = r["calibration"]
         err = "-" if cal is None else f"{cal['error']:.3f}"

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from .columns import MethodCells, ScoreCells, Scored
-from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, curve_cell, failed_method, mass_cell
+from .scoring import JAW_START, MARK_DEG, MethodResult, boundary_error, broken_trial, curve_cell, mass_cell
 
 if TYPE_CHECKING:
     from driver.jaw import Calibration, ReactivePolicy, ReactiveRun
@@ -171,17 +171,7 @@ def score_wheel(
     """A wheel trial's scores: its ``run`` (sure or not) that ended with the contact at ``truth`` mm, as the
     trial's own cells and the ``reactive`` method's; ``failure`` (run None) says why it did not run."""
     if run is None:
-        failed: ScoreCells = {
-            "true_arc": math.nan,
-            "estimate_arc": math.nan,
-            "error_mm": math.inf,
-            "success": 0,
-            "candidates": "",
-            "probability": 0.0,
-            "ambiguous": 0,
-            "failure": failure,
-        }
-        return Scored(failed, {"reactive": failed_method(failure)}, spikes)
+        return broken_trial(("reactive",), failure, candidates="")
     err = boundary_error(part, run.estimate_arc, truth)
     rot = math.degrees(run.rotation)
     curve = rotation_curve(part, run.history, rot, err, study.reactive.max_rotation_deg, run.belief.mass)

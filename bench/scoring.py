@@ -127,14 +127,15 @@ def failed_method(text: str) -> MethodCells:
     }
 
 
-def broken_trial(methods: Sequence[str], text: str) -> Scored:
-    """The scores of a trial that broke before any method could run: every method's failure ``text``."""
+def broken_trial(methods: Sequence[str], text: str, candidates: int | str = 0) -> Scored:
+    """The scores of a trial that broke before any method could run: every method's failure ``text``
+    (``candidates``: the rule's count, a wheel's empty cell)."""
     cells: ScoreCells = {
         "true_arc": math.nan,
         "estimate_arc": math.nan,
         "error_mm": math.inf,
         "success": 0,
-        "candidates": 0,
+        "candidates": candidates,
         "probability": 0.0,
         "ambiguous": 0,
         "failure": text,

@@ -25,6 +25,8 @@ __all__ = [
     "error_over_bound",
     "summarize_methods",
     "sure_by_rotation",
+    "rotation_marks",
+    "at_marks",
     "RELIABILITY_BINS",
     "reliability",
     "FULL_BIN",
@@ -174,27 +176,15 @@ def error_over_bound(m: str, rows: Sequence[dict[str, Any]]) -> FloatArray:
 
 def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """``methods`` {name: success rate} over all trials, with details and success against rotation."""
-    from .scoring import MARK_DEG, parse_curve
-
     rates, details, curves = {}, {}, {}
     sure: dict[str, dict[str, dict[str, float]] | None] = {}
     n = len(rows)
+    marks = rotation_marks(study)
     for m in study.methods:
         details[m] = method_detail(study, m, rows)
         rates[m] = details[m]["success"] / n if n else None
-        per_mark: dict[float, list[bool]] = {}
-        for r in rows:
-            pairs = parse_curve(r[f"{m}_curve"])
-            last = pairs[-1][1] if pairs else math.inf
-            marks = {round(k, 6): e for k, e in pairs}
-            # a method that rolled no further than its last mark keeps its last answer
-            top = max(marks) if marks else 0.0
-            k = MARK_DEG
-            while k <= max(study.reactive.max_rotation_deg, sum(abs(a) for a in study.rolls_deg)) + 1e-9:
-                e = marks.get(round(k, 6), last if k > top else math.inf)
-                per_mark.setdefault(k, []).append(e < study.success_radius)
-                k += MARK_DEG
-        curves[m] = {f"{k:g}": float(np.mean(v)) for k, v in sorted(per_mark.items())}
+        hits = np.array([np.array(at_marks(r[f"{m}_curve"], marks, math.inf)) < study.success_radius for r in rows])
+        curves[m] = {f"{k:g}": float(np.mean(hits[:, j])) for j, k in enumerate(marks)} if n else {}
         sure[m] = sure_by_rotation(study, m, rows)
     return {
         "methods": rates,
@@ -204,33 +194,43 @@ def summarize_methods(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str,
     }
 
 
+def rotation_marks(study: Study) -> FloatArray:
+    """Every 5° mark (``MARK_DEG``) of rotation up to the larger of the reactive budget and the fixed rolls."""
+    from .scoring import MARK_DEG
+
+    top = max(study.reactive.max_rotation_deg, sum(abs(a) for a in study.rolls_deg))
+    return np.arange(MARK_DEG, top + 1e-9, MARK_DEG)
+
+
+def at_marks(text: str, marks: npt.ArrayLike, missing: float) -> list[float]:
+    """A ``<method>_curve`` or ``<method>_mass_curve`` cell's value at each of ``marks`` (deg): past its last
+    mark its last value (a rolling that stopped keeps its last answer), ``missing`` where it has none."""
+    from .scoring import parse_curve
+
+    pairs = parse_curve(text)
+    values = {round(k, 6): v for k, v in pairs}
+    top = max(values) if values else 0.0
+    last = pairs[-1][1] if pairs else missing
+    return [values.get(round(float(k), 6), last if k > top else missing) for k in np.asarray(marks, dtype=float)]
+
+
 def sure_by_rotation(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> dict[str, dict[str, float]] | None:
     """Method ``m``'s fraction of trials sure (stated probability at least the study's confidence) and
     sure and wrong (error not within the success radius) at every mark of rotation, {"5": {"sure": ...,
     "sure_wrong": ...}, ...}; a trial keeps its last statement past its last mark. None where the trials
     have no ``<m>_mass_curve`` (studies run before it) or the method states nothing."""
-    from .scoring import MARK_DEG, parse_curve
-
     if not rows or not any(r.get(f"{m}_mass_curve") for r in rows):
         return None
-    confidence = study.reactive.confidence
-    top_mark = max(study.reactive.max_rotation_deg, sum(abs(a) for a in study.rolls_deg))
-    marks = np.arange(MARK_DEG, top_mark + 1e-9, MARK_DEG)
-    sure, wrong = np.zeros(marks.size), np.zeros(marks.size)
-    for r in rows:
-        masses = {round(k, 6): p for k, p in parse_curve(r.get(f"{m}_mass_curve", ""))}
-        errors = {round(k, 6): e for k, e in parse_curve(r.get(f"{m}_curve", ""))}
-        if not masses:
-            continue
-        last = max(masses)
-        for j, k in enumerate(np.round(marks, 6)):
-            at = k if k in masses else (last if k > last else None)
-            if at is None or not masses[at] >= confidence:
-                continue
-            sure[j] += 1
-            wrong[j] += not errors.get(at, math.inf) < study.success_radius
+    marks = rotation_marks(study)
+    stated = np.array([at_marks(r.get(f"{m}_mass_curve", ""), marks, math.nan) for r in rows])
+    errors = np.array([at_marks(r.get(f"{m}_curve", ""), marks, math.inf) for r in rows])
+    sure = stated >= study.reactive.confidence
+    wrong = sure & ~(errors < study.success_radius)
     n = len(rows)
-    return {f"{k:g}": {"sure": float(a / n), "sure_wrong": float(b / n)} for k, a, b in zip(marks, sure, wrong)}
+    return {
+        f"{k:g}": {"sure": float(sure[:, j].sum() / n), "sure_wrong": float(wrong[:, j].sum() / n)}
+        for j, k in enumerate(marks)
+    }
 
 
 #: Bins of stated confidence in the reliability diagram and the calibration error (fine near 1, where the
