@@ -183,7 +183,8 @@ def _restarted(calls: Sequence[Call]) -> bool:
 
 def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, **changes: Any) -> VariantResult:
     """Feed ``rec``'s calls to a filter with its settings, ``changes`` applied; with ``at_deg``, only those
-    made before the rolling first turned that many degrees (the belief the filter had there). Without
+    made before the rolling had turned that many degrees in all (:func:`calls_until`: the belief the
+    filter had there). Without
     ``margin`` the true start's margin and the noise scale are not weighed (NaN; a second filter that
     prunes nothing, most of the cost); the error is then from the filter's own nominal contacts."""
     settings = {**rec.settings, **changes}
@@ -205,9 +206,7 @@ def replay(rec: Recorded, at_deg: float | None = None, *, margin: bool = True, *
         error = math.nan  # the filter started again from another contact: the trial's start is not its start
     mismatched = belief.mismatch is not None or not belief.consistent
     if not margin:
-        return VariantResult(
-            settings=dict(changes), mass=belief.mass, error_mm=error, margin=math.nan, noise_scale=math.nan
-        )
+        return VariantResult(dict(changes), belief.mass, error, math.nan, math.nan, mismatched)
     ll = full.log_likelihood() / full.temper
     near, far = ll[off < NEAR], ll[off >= NEAR]
     best_near = float(near.max()) if near.size else -math.inf

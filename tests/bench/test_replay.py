@@ -85,6 +85,7 @@ def test_without_the_margin_the_belief_is_the_same(recorded):
     _, rec = recorded
     quick, whole = replay(rec, 20.0, margin=False), replay(rec, 20.0)
     assert quick.mass == whole.mass and quick.error_mm == pytest.approx(whole.error_mm)
+    assert quick.mismatch == whole.mismatch
     assert math.isnan(quick.margin) and math.isnan(quick.noise_scale)
 
 
@@ -99,3 +100,10 @@ def test_a_run_that_started_its_filter_again_is_replayed_whole():
     as_run = replay(rec)
     assert as_run.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-9)
     assert math.isnan(as_run.error_mm)  # the trial's start is no longer the filter's
+
+
+def test_a_run_that_ended_on_a_mismatch_says_so_in_every_replay():
+    # world-tuning trial 0: the burr's readings did not fit the part; the run ended "mismatch"
+    rec = record_trial(ROOT / "bench" / "studies" / "world-tuning.toml", 0, 0)
+    assert rec.row["reactive_stopped"] == "mismatch"
+    assert replay(rec).mismatch and replay(rec, margin=False).mismatch
