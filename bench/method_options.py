@@ -26,6 +26,7 @@ class ReactiveOptions:
     sd_scale: float | None = None
     sd_slope: float | str | None = None  # "auto": from the study's noise model
     min_spread: float = 0.05
+    seek: bool | None = None  # None: driver.jaw.ReactivePolicy's default; true: the information-seeking direction rule
     noise_scales: tuple[float, ...] | None = None  # None: localizer.NOISE_SCALES
     temper: float | None = None  # None: the filter's default
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)
@@ -33,6 +34,7 @@ class ReactiveOptions:
     defect_window: float | None = None  # None: localizer.DEFECT_WINDOW (mm); 0: trust every stretch, test none
     lookalike_slope: float | None = None  # None: localizer.LOOKALIKE_SLOPE; 0: no look-alike check
     corner_ends: bool | None = None  # None: the filter's default (True); false: the uniform prior over a corner
+    stretch_weight: float | None = None  # None: localizer.STRETCH_WEIGHT; 1: the least of the checks
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,7 @@ def reactive_filter(
     for key in ("noise_scales", "slope_envelope"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)
-    for key in ("temper", "shape_spacing", "defect_window", "lookalike_slope", "corner_ends"):
+    for key in ("temper", "shape_spacing", "defect_window", "lookalike_slope", "corner_ends", "stretch_weight"):
         if getattr(o, key) is not None:
             given[key] = getattr(o, key)
     cls = ContactFilter if filter_class is None else filter_class
@@ -72,6 +72,7 @@ def reactive_policy(study: Study) -> ReactivePolicy:
         check_every=o.check_every,
         min_spread=o.min_spread,
         confirm=CONFIRM if o.confirm is None else o.confirm,
+        **({} if o.seek is None else {"seek": o.seek}),
     )
 
 

@@ -52,6 +52,10 @@ Several methods on the same trials (instead of ``method``)::
                                          #   0: no such check)
     corner_ends = true                   # optional: the stated mass must hold too under a prior that
                                          #   lays the jaw on a corner only at its jump's ends (drawings)
+    stretch_weight = 0.06                # optional: the weight of the stretch check in the stated
+                                         #   mass (default localizer.STRETCH_WEIGHT; 1: the least)
+    seek = true                          # optional: the information-seeking direction rule (default:
+                                         #   driver.jaw.ReactivePolicy's)
 
     [world]                              # optional: how each trial's world differs from the model
     defects = 1                          #   (sim2d.world_part): defects near the start, or anywhere,
@@ -438,9 +442,9 @@ def _options(path: Path, table: object, cls: type[_Options], name: str) -> _Opti
         if key == "sd_slope" and value == "auto":
             values[key] = "auto"
             continue
-        if key == "corner_ends":
+        if key in ("corner_ends", "seek"):
             if not isinstance(value, bool):
-                raise StudyError(f"study {path}: [{name}] corner_ends={value!r} must be true or false")
+                raise StudyError(f"study {path}: [{name}] {key}={value!r} must be true or false")
             values[key] = value
             continue
         if key in ("noise_scales", "slope_envelope"):
@@ -454,6 +458,11 @@ def _options(path: Path, table: object, cls: type[_Options], name: str) -> _Opti
             ):
                 raise StudyError(f"study {path}: [{name}] {key}={value!r} must be a list of positive factors")
             values[key] = tuple(float(v) for v in value)
+            continue
+        if key == "stretch_weight":
+            if type(value) not in (int, float) or not 0 <= value <= 1:
+                raise StudyError(f"study {path}: [{name}] stretch_weight={value!r} must be a probability in [0, 1]")
+            values[key] = float(value)
             continue
         if key in ("defect_window", "lookalike_slope") and type(value) in (int, float) and value == 0:
             values[key] = 0.0

@@ -23,9 +23,11 @@ from .reactive_policy import (
     MAX_LEAVES,
     MAX_ROTATION,
     REACTIVE_POLICY,
+    SEEK_HYPOTHESES,
     ReactivePolicy,
     ReactiveRun,
     clear_ahead,
+    information_by_direction,
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
@@ -68,6 +70,8 @@ __all__ = [
     "ReactiveRun",
     "clear_ahead",
     "spread_by_direction",
+    "information_by_direction",
+    "SEEK_HYPOTHESES",
     "JawReadings",
     "RollResult",
     "RollingRun",

@@ -33,6 +33,7 @@ from .reactive_policy import (
     ReactivePolicy,
     ReactiveRun,
     clear_ahead,
+    information_by_direction,
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
@@ -438,13 +439,17 @@ class _Roller(JawReadings):
         strong = [m for m in belief.modes if m.mass >= flt.mode_floor]
         if len(strong) < 2 or self.blocked[-direction]:
             return None
-        ccw, cw = spread_by_direction(flt, p.lookahead, tuple(self.explored), [m.start_arc for m in strong[:2]])
-        ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
-        if (
-            ahead < p.min_spread
-            and behind > 3 * p.min_spread
-            and clear_ahead(flt, -direction, p.lookahead, at=beyond) >= 0.5
-        ):
+        if p.seek:
+            # ... or, seeking information: turn round when the other way tells more of the belief apart per
+            # radian, the way back to its unexplored edge counted
+            ccw, cw = information_by_direction(flt, p.lookahead, tuple(self.explored))
+            ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
+            turn = behind > p.seek_margin * ahead
+        else:
+            ccw, cw = spread_by_direction(flt, p.lookahead, tuple(self.explored), [m.start_arc for m in strong[:2]])
+            ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
+            turn = ahead < p.min_spread and behind > 3 * p.min_spread
+        if turn and clear_ahead(flt, -direction, p.lookahead, at=beyond) >= 0.5:
             self.direction = -direction
             self.reversals += 1
         return None

@@ -69,7 +69,9 @@ __all__ = [
     "MAX_ROTATION",
     "ReactiveRun",
     "spread_by_direction",
+    "information_by_direction",
     "clear_ahead",
+    "SEEK_HYPOTHESES",
     "ReactivePolicy",
     "REACTIVE_POLICY",
 ]
@@ -168,6 +170,63 @@ def spread_by_direction(
     return tuple(out)
 
 
+#: How many of the most probable starts the information-seeking rule weighs (:func:`information_by_direction`):
+#: beyond a few dozen the rest carry too little of the belief to change which way is better.
+SEEK_HYPOTHESES = 64
+
+
+def information_by_direction(
+    flt: ContactFilter,
+    lookahead: float,
+    explored: tuple[float, ...] = (0.0, 0.0),
+    hypotheses: int = SEEK_HYPOTHESES,
+) -> tuple[float, ...]:
+    """(ccw, cw): how much the next unexplored stretch each way is expected to raise the probability of
+    the right place, per radian of rolling.
+
+    Over the most probable ``hypotheses`` starts, weighted by the posterior: each start predicts the
+    contact's travel over the next ``lookahead`` rad of *unexplored* rotation that way. Were start i the
+    truth, the readings would show its travel, and the belief would weigh each start j by its weight times
+    the likelihood of that travel, exp(−Δ²/4σ²) (Δ the two travels' difference, σ the filter's reading
+    noise times its noise scale: a travel is the difference of two readings); the probability it then puts
+    on i's *place* (the starts whose present contacts are within the filter's radius of i's) is what the
+    belief would know. Its expectation over i, less what the belief puts on the right place now, is the
+    gain; it is divided by the rotation it costs: the way back to that way's unexplored edge, then
+    ``lookahead``. Telling two starts apart that sit at the same place gains nothing, nor does telling
+    apart the offsets within two places that stay alike (a symmetric part's twin places). A start that
+    cannot roll that way without bridging a concavity counts as not moving (as :func:`spread_by_direction`).
+
+    Returns
+    -------
+    tuple of float, per rad
+        Expected gain in the probability of the right place per radian of rolling counter-clockwise,
+        clockwise.
+    """
+    w = flt.posterior()
+    top = np.argsort(w)[::-1][: max(int(hypotheses), 2)]
+    top = top[w[top] > 0]
+    if top.size < 2:
+        return (0.0, 0.0)
+    wt = w[top] / w[top].sum()
+    mean, _ = flt.shift()
+    present = flt.part.wrap_arc(flt.current[top] + mean[top])
+    same = np.abs(flt.part.arc_offset(present[:, None], present[None, :])) <= flt.radius
+    now = float(wt @ (same @ wt))
+    variance = 2.0 * (flt.sd_position * flt.noise_scale()) ** 2
+    jaw = _jaw_now(flt, top)
+    out: list[float] = []
+    for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
+        a, ok_a = flt.tracks.roll(top, edge, **jaw)
+        b, ok_b = flt.tracks.roll(top, edge + sign * lookahead, **jaw)
+        moved = np.where(ok_a & ok_b, b - a, 0.0)
+        # row i: the belief over starts j were i the truth and its travel read
+        after = wt[None, :] * np.exp(-((moved[:, None] - moved[None, :]) ** 2) / (2.0 * variance))
+        after /= after.sum(axis=1, keepdims=True)
+        right = float(wt @ np.sum(after * same, axis=1))
+        out.append(max(right - now, 0.0) / (abs(edge - flt.turn) + lookahead))
+    return tuple(out)
+
+
 def clear_ahead(flt: ContactFilter, direction: int, lookahead: float, at: float | None = None) -> float:
     """Probability that the jaw can roll ``lookahead`` rad further ``direction``-wise without the
     contact leaving its convex stretch (over every hypothesis with weight).
@@ -223,6 +282,14 @@ class ReactivePolicy:
     reread_jump : float, mm
         A reading whose contact moved more than this on the jaw in one step is read twice more and the
         middle of the three kept (a spike of the wrist's DAQ is one reading; a real jump reads the same).
+    seek : bool
+        The direction rule seeks information: while the belief has two or more modes, turn round when the
+        other way is expected to raise the probability of the right place more per radian of rolling, the
+        way back to it included, by the factor ``seek_margin`` (:func:`information_by_direction`). False:
+        the two leading modes' spread rule (``min_spread``), the baseline.
+    seek_margin : float
+        How much more the other way must be expected to gain, per radian, before the jaw turns round
+        (at least 1; above, so that two ways about as good do not rock the jaw).
     """
 
     step: float = ROLL_STEP
@@ -238,6 +305,8 @@ class ReactivePolicy:
     min_spread: float = 0.05
     confirm: int = CONFIRM
     reread_jump: float = 1.0
+    seek: bool = False
+    seek_margin: float = 1.5
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.step) and self.step > 0):
@@ -248,6 +317,8 @@ class ReactivePolicy:
             raise RigError(f"direction={self.direction!r}: use 1 (counter-clockwise), -1 or None")
         if not 0 < self.confidence < 1:
             raise RigError(f"confidence={self.confidence!r} must be in (0, 1)")
+        if not (math.isfinite(self.seek_margin) and self.seek_margin >= 1):
+            raise RigError(f"seek_margin={self.seek_margin!r} must be at least 1")
         for name in ("confirm", "check_every", "n"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:

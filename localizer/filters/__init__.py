@@ -14,6 +14,7 @@ from ._contact_settings import (
     NOISE_SCALES,
     SCALE_SD,
     SLOPE_ENVELOPE,
+    STRETCH_WEIGHT,
     TEMPER,
 )
 from ._particle_filter import ParticleFilter
@@ -35,6 +36,7 @@ __all__ = [
     "ENCODER_SD",
     "LOOKALIKE_RADIUS",
     "LOOKALIKE_SLOPE",
+    "STRETCH_WEIGHT",
     "NOISE_SCALES",
     "SCALE_SD",
     "SLOPE_ENVELOPE",

@@ -112,6 +112,12 @@ class ContactFilter(ContactFit):
         Also state at most the probability under a prior that lays the jaw on a convex corner only at the
         ends of its jump (on one of the two pieces beside it), not at any angle within it (docs/filter.md,
         "A jaw laid on a corner"). No effect on a part without convex corners.
+    stretch_weight : float
+        The prior probability, in [0, 1], that a short stretch of the readings comes from a defect the
+        model does not have: the stated mass is then ``(1 - q)·m + q·min(m, s)``, with ``m`` the mass the
+        checks above leave and ``s`` the least mass without any one stretch of ``defect_window``
+        (:meth:`stretch_mass`). 1: the least of the two (a stretch check that leaves nothing vetoes);
+        default :data:`localizer.STRETCH_WEIGHT` (docs/filter.md, "A stretch check that weighs").
     noise_scales : sequence of float
         Common factors on ``sd_position``, ``sd_scale``, ``sd_slope`` and ``sd_jaw`` that the filter weighs
         with equal prior probability (the real noise is rarely what the settings say; docs/filter.md,
@@ -353,13 +359,14 @@ class ContactFilter(ContactFit):
         if self.slope_envelope:
             self._prune_under_every_prior()
         modes = self._modes(w, present, radius)
-        # sure only if sure without any one short stretch of the readings (a burr, a dent, debris):
-        # asked only where it would decide, at the confidence, once per state of the readings
+        # ... and, with the weight ``stretch_weight``, without any one short stretch of the readings (a burr,
+        # a dent, debris): asked only where it could decide, at the confidence, once per state of the readings
         if mass >= self.confidence and self.defect_window > 0:
             key = (self._version, radius, map_arc)
             if self._stretch_cache[0] != key:
                 self._stretch_cache = (key, self.stretch_mass(map_arc, radius)[0])
-            mass = min(mass, self._stretch_cache[1])
+            q = self.stretch_weight
+            mass = (1.0 - q) * mass + q * min(mass, self._stretch_cache[1])
         # do the readings still fit the part? Tested every FIT_EVERY readings and before a sure stop,
         # under the most probable starts: a stretch that fits none of them is taken out of the
         # likelihood (quarantined: it costs its readings, not the answer) and the belief asked again

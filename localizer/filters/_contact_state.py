@@ -21,6 +21,7 @@ from ._contact_settings import (
     SCALE_SD,
     SLOPE_ENVELOPE,
     SLOPE_RHO_MAX,
+    STRETCH_WEIGHT,
     TEMPER,
     TURN_MARGIN,
 )
@@ -66,6 +67,7 @@ class ContactState:
         temper: float = TEMPER,
         sd_drift: float = 1e-4,
         defect_window: float = DEFECT_WINDOW,
+        stretch_weight: float = STRETCH_WEIGHT,
     ) -> None:
         for name, value in (("spacing", spacing), ("sd_position", sd_position), ("radius", radius)):
             if not (math.isfinite(value) and value > 0):
@@ -100,6 +102,11 @@ class ContactState:
         if not (math.isfinite(defect_window) and defect_window >= 0):
             raise QueryError(f"defect_window={defect_window!r} mm must be ≥ 0 (0: trust every stretch)")
         self.defect_window = float(defect_window)
+        if isinstance(stretch_weight, bool) or not (
+            isinstance(stretch_weight, (int, float, np.number)) and 0 <= stretch_weight <= 1
+        ):
+            raise QueryError(f"stretch_weight={stretch_weight!r} must be a probability in [0, 1] (1: the least)")
+        self.stretch_weight = float(stretch_weight)
         # the stretches the fit test judges: twice the envelope's (a burr's misfit and its edges)
         self._fit_width = FIT_WIDTH * self.defect_window
         self.part = part

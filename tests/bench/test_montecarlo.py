@@ -116,6 +116,14 @@ def test_dask_local_cluster_gives_the_same_table(reference):
             "defect_window=False must be a positive number",
         ),
         (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\nstretch_weight = 1.5',
+            r"stretch_weight=1.5 must be a probability in \[0, 1\]",
+        ),
+        (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\nstretch_weight = true',
+            "stretch_weight=True must be a probability",
+        ),
+        (
             'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\ncheck_every = 2.5',
             "check_every=2.5 must be a whole number",
         ),

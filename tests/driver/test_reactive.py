@@ -3,9 +3,17 @@
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from driver.jaw import ReactivePolicy, calibrate, clear_ahead, localize_reactively, spread_by_direction
+from driver.jaw import (
+    ReactivePolicy,
+    calibrate,
+    clear_ahead,
+    information_by_direction,
+    localize_reactively,
+    spread_by_direction,
+)
 from driver.link import Emulator, SerialRig
 from driver.rig import RigError
 from localizer import ContactFilter, load_part
@@ -145,6 +153,65 @@ def test_direction_helpers_on_a_symmetric_belief():
     assert clear_ahead(flt, 1, math.radians(15)) == pytest.approx(1.0)  # convex all round
 
 
+def rolled(part, start_arc, steps, **settings):
+    """A filter given the exact readings of ``steps`` 0.2° steps from ``start_arc`` (its own tracks)."""
+    flt = ContactFilter(part, **settings)
+    i = int(round(start_arc / flt.tracks.h)) % flt.grid.size
+    turns = math.radians(0.2) * np.arange(1, steps + 1)
+    arcs, ok = flt.tracks.advance(np.full(steps, i), turns)
+    assert ok.all()
+    for z, t in zip(arcs - flt.grid[i], turns):
+        flt.update(float(z), float(t))
+    return flt, float(turns[-1])
+
+
+def test_seeking_gains_nothing_between_twin_places():
+    # an ellipse's two halves are alike: rolled from a quarter, the belief is split between twin places
+    # half a perimeter apart, which no rolling either way can tell apart
+    part = load_part(PARTS / "ellipse.json")
+    flt, turned = rolled(part, part.perimeter / 4 + 5.0, 75, sd_position=0.01)
+    places = [m for m in flt.belief().modes if m.mass > 0.1]
+    assert len(places) == 2
+    assert abs(part.arc_offset(places[0].arc, places[1].arc)) == pytest.approx(part.perimeter / 2, abs=0.5)
+    ccw, cw = information_by_direction(flt, math.radians(15), (0.0, turned))
+    assert ccw * math.radians(15) < 0.02 and cw * math.radians(30) < 0.02
+
+
+def test_seeking_gains_at_most_what_the_belief_lacks(trefoil):
+    part, _ = trefoil
+    flt, turned = rolled(part, 300 * 0.02, 50)
+    # the probability the belief puts within the radius of the truth, expected over the truth drawn from
+    # it (every start, brute force): two places after 10°, and rolling cannot gain more than the rest
+    w = flt.posterior()
+    mean, _ = flt.shift()
+    live = np.flatnonzero(w > 1e-12)
+    present = part.wrap_arc(flt.current[live] + mean[live])
+    near = np.abs(part.arc_offset(present[:, None], present[None, :])) <= flt.radius
+    lacks = 1.0 - float(w[live] @ (near @ w[live]))
+    assert lacks > 0.3
+    for explored in ((0.0, turned), (-0.2, turned)):
+        ccw, cw = information_by_direction(flt, math.radians(15), explored)
+        # within what the 64 starts weighed leave out of the belief (5%)
+        assert 0 < ccw * (explored[1] - turned + math.radians(15)) <= lacks + 0.05
+        assert 0 <= cw * (turned - explored[0] + math.radians(15)) <= lacks + 0.05
+
+
+def test_seeking_it_stops_when_sure_and_is_right(trefoil):
+    part, cal = trefoil
+    rig = SimRig(part, noise="none", seed=1)
+    flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
+    run = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=flt,
+        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+        policy=ReactivePolicy(confidence=0.95, seek=True),
+    )
+    assert run.stopped == "confident"
+    assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
+
+
 def test_bad_arguments(trefoil):
     part, cal = trefoil
     rig = SimRig(part, seed=0)
@@ -156,6 +223,7 @@ def test_bad_arguments(trefoil):
         ({"step": -1}, "step=-1"),
         ({"confirm": 0}, "confirm=0"),
         ({"confirm": 1.5}, "confirm=1.5"),
+        ({"seek_margin": 0.5}, "seek_margin=0.5"),
     ):
         with pytest.raises(RigError, match=match):
             localize_reactively(rig, part, calibration=cal, approach_pose=pose, policy=ReactivePolicy(**kwargs))

@@ -351,6 +351,8 @@ def test_a_look_alike_that_the_slope_term_explains_is_not_stated_sure():
         verdicts[envelope] = sure_checks(rec, part, ContactFilter(part, radius=0.3, confidence=0.95, **settings))
     assert verdicts[()][1] >= 50, verdicts
     assert verdicts[SLOPE_ENVELOPE][1] == 0, verdicts
+    # and with every check (the stretch check weighed: localizer.STRETCH_WEIGHT): never sure and wrong either
+    assert sure_checks(rec, part, ContactFilter(part, radius=0.3, confidence=0.95))[1] == 0
 
 
 def test_a_look_alike_is_not_stated_sure_on_a_part_a_form_tolerance_off_its_model():

@@ -120,6 +120,32 @@ def test_no_belief_rests_on_one_short_stretch(cam):
     assert flt.belief().mass < 0.95
 
 
+def test_the_stretch_check_is_weighed_with_the_model(cam):
+    # the same readings as above: the stated mass is the mixture (1 - q)·m + q·min(m, s) of the model's
+    # mass and the least without any one stretch, asked because the model alone is sure; weight 1 is the least
+    turns = STEP * np.arange(1, 31)
+    weighed = {q: ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0, stretch_weight=q) for q in (0.3, 1)}
+    ungarded = ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0, defect_window=0.0)
+    z, _ = exact(ungarded, 57.3, turns)
+    for k in range(turns.size):
+        ungarded.update(float(z[k]), float(turns[k]))
+        for flt in weighed.values():
+            flt.update(float(z[k]), float(turns[k]))
+    model = ungarded.belief().mass
+    stretch, _ = weighed[1].stretch_mass(ungarded.belief().map_arc)
+    assert model > 0.95 and stretch < 0.5
+    for q, flt in weighed.items():
+        assert flt.belief().mass == pytest.approx((1 - q) * model + q * stretch, abs=1e-9)
+    # a weight above 1 - confidence on a stretch check that leaves little keeps the belief from being sure
+    assert not weighed[0.3].belief().sure(0.95)
+
+
+@pytest.mark.parametrize("bad", [1.5, -0.1, math.nan, True, "x"])
+def test_a_stretch_weight_that_is_not_a_probability_is_refused(cam, bad):
+    with pytest.raises(QueryError, match="stretch_weight"):
+        ContactFilter(cam, stretch_weight=bad)
+
+
 def test_when_nothing_fits_the_belief_says_so(cam):
     flt = ContactFilter(cam)
     flt.update(0.1, STEP)
