@@ -37,7 +37,7 @@ __all__ = [
 ]
 
 #: driver's command groups, in the order ``rolltouch --help`` lists them.
-COMMAND_GROUPS = ("driver.cli.offline", "driver.cli.simulated", "driver.cli.rig")
+COMMAND_GROUPS = ("driver.cli.offline", "driver.cli.simulated", "driver.cli.rig", "driver.cli.export")
 #: The entry-point group through which other packages add command groups (a ``register(sub)`` each).
 ENTRY_POINT_GROUP = "rolltouch.commands"
 #: What an interrupted command says it did unless the arm's safe stop says (the exception's notes) or

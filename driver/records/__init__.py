@@ -1,5 +1,6 @@
 """What a run leaves: traces (npz) of both fingers, run logs (JSON lines), the filter's logged calls
-and their replay, plots, and the part's record that keeps a trace from being scored on another part.
+and their replay, plots, the part's record that keeps a trace from being scored on another part, and
+any of them as an MCAP file.
 """
 
 from .filter_log import (
@@ -12,6 +13,7 @@ from .filter_log import (
     calls_from_events,
     replay_log,
 )
+from .mcap_export import READING_PERIOD, SCHEMAS, TOPICS, Message, export_mcap, run_messages, write_mcap
 from .part_match import SAME_PART_FLAG, PartMismatch, check_same_part, part_record
 from .plotting import draw_part, plot_localization, plot_reactive, plot_run
 from .runlog import LOG_FORMAT, RunLog, read_log
@@ -27,6 +29,13 @@ __all__ = [
     "calls_event",
     "calls_from_events",
     "replay_log",
+    "READING_PERIOD",
+    "SCHEMAS",
+    "TOPICS",
+    "Message",
+    "export_mcap",
+    "run_messages",
+    "write_mcap",
     "PartMismatch",
     "SAME_PART_FLAG",
     "check_same_part",
