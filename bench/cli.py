@@ -7,7 +7,7 @@ import argparse
 
 from driver.cli import UsageError, add_command
 
-__all__ = ["register", "montecarlo_command"]
+__all__ = ["register", "montecarlo_command", "report_command"]
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -28,6 +28,15 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     mc.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask distributed scheduler")
     mc.add_argument("--resume", action="store_true", help="keep finished trials, run only the missing ones")
     mc.set_defaults(interrupted="finished trials are kept; rerun with --resume")
+    rep = add_command(
+        sub,
+        "report",
+        report_command,
+        help="write a study's outputs as one HTML page",
+        description="Write STUDY_DIR/report.html: the settings, each method's results per level and per part, "
+        "the plots, and the trials not right with the command that replays each (bench.reports.study_page).",
+    )
+    rep.add_argument("study_dir", metavar="STUDY_DIR", help="the --out folder of 'rolltouch montecarlo'")
 
 
 def montecarlo_command(args: argparse.Namespace) -> int:
@@ -40,4 +49,11 @@ def montecarlo_command(args: argparse.Namespace) -> int:
     study = load_study(args.study).with_overrides(trials=args.trials, engine=args.engine)
     summary = run_study(study, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume)
     print_summary(summary)
+    return 0
+
+
+def report_command(args: argparse.Namespace) -> int:
+    from .reports.study_page import write_report
+
+    print(f"written {write_report(args.study_dir)}")
     return 0
