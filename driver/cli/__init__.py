@@ -37,7 +37,13 @@ __all__ = [
 ]
 
 #: driver's command groups, in the order ``rolltouch --help`` lists them.
-COMMAND_GROUPS = ("driver.cli.offline", "driver.cli.simulated", "driver.cli.rig", "driver.cli.export")
+COMMAND_GROUPS = (
+    "driver.cli.offline",
+    "driver.cli.simulated",
+    "driver.cli.rig",
+    "driver.cli.export",
+    "driver.cli.show",
+)
 #: The entry-point group through which other packages add command groups (a ``register(sub)`` each).
 ENTRY_POINT_GROUP = "rolltouch.commands"
 #: What an interrupted command says it did unless the arm's safe stop says (the exception's notes) or

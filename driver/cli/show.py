@@ -1,0 +1,83 @@
+"""``rolltouch show``: a picture of how a run's belief narrowed."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import numpy as np
+
+from ..rig import RigError
+from ._options import add_command, writable_file
+
+__all__ = ["register", "show_command"]
+
+
+def register(sub: Any) -> None:
+    """Add ``show`` to the subparsers ``sub``."""
+    p = add_command(
+        sub,
+        "show",
+        show_command,
+        help="draw how a reactive rolling's belief narrowed (PNG)",
+        description=(
+            "Make a reactive rolling's filter calls again (a straight jaw's trace from 'simulate --reactive', or "
+            "a run log of 'run --reactive') and draw the belief along the part against the rotation rolled, "
+            "the truth where known, the rolling's events, and the final places on the part."
+        ),
+    )
+    p.add_argument("trace", metavar="TRACE", help="a reactive trace (.npz) or run log (.jsonl)")
+    p.add_argument("--part", required=True, help="part file (the model the run was given)")
+    p.add_argument("--out", required=True, metavar="FILE.png", help="the picture to write")
+    p.add_argument(
+        "--same-part",
+        action="store_true",
+        help="draw the record on --part although it was made on another part file (one known to be the same)",
+    )
+
+
+def show_command(args: argparse.Namespace) -> int:
+    from localizer import ContactFilter, load_part
+
+    from ..records import (
+        LOG_COLUMNS,
+        REACTIVE_FORMAT,
+        calls_from_events,
+        check_same_part,
+        plot_belief_history,
+        read_archive,
+        read_log,
+        replay_beliefs,
+        trace_format,
+    )
+
+    writable_file(args.out, "--out", (".png",))
+    path = str(args.trace)
+    if path.endswith(".jsonl"):
+        events = read_log(path)
+        columns = calls_from_events(events)
+        if columns is None:
+            raise RigError(f"run log {path} holds no filter calls: only a reactive run's log, ended, can be shown")
+        recorded, readings = events[0].get("part"), None
+    else:
+        kind = trace_format(path)
+        if kind != REACTIVE_FORMAT:
+            raise RigError(
+                f"trace {path}: format {kind!r}; 'show' draws a straight jaw's reactive rolling ({REACTIVE_FORMAT}) "
+                "('locate' localizes the others)"
+            )
+        meta, columns = read_archive(path, LOG_COLUMNS)
+        readings = read_archive(path, ("arcs", "turns", "true_arcs"))[1]
+        recorded = meta.get("part")
+    part = load_part(args.part)
+    check_same_part(recorded, part, args.part, f"trace {path}", same=args.same_part)
+    history = replay_beliefs(ContactFilter(part), columns, readings)
+    if not history.rotation.size:
+        raise RigError(f"trace {path}: the rolling never asked its belief; nothing to draw")
+    plot_belief_history(part, history, args.out)
+    b = history.final
+    print(
+        f"{args.out}: {history.rotation.size} checks over {np.degrees(history.rotation[-1]):.1f} degrees; "
+        f"the last belief {b.mass:.1%} within {b.radius:g} mm of arc {b.map_arc:.2f} mm"
+    )
+    return 0

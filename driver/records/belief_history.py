@@ -1,0 +1,208 @@
+"""How a reactive rolling's belief narrowed: its filter calls made again, the belief kept at every check, and
+drawn as one picture.
+
+:func:`replay_beliefs` makes the kept calls of a straight jaw's reactive rolling
+(:meth:`driver.records.LoggedFilter.columns`) on a fresh filter, as :func:`driver.records.replay_log` does,
+and at every ``belief`` call (every check of the rolling) keeps the belief over the present contact as a
+histogram along the part's arc, with the rotation rolled by then. :func:`plot_belief_history` draws it:
+the belief as an image (rotation across, arc on the part up), the truth over it where known, the
+events of the rolling marked, and beside it the part with the final places and their probabilities.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from localizer import Belief, ContactFilter, Outline, Part
+
+from .filter_log import CALLS, LOG_COLUMNS, _arg
+
+__all__ = ["BeliefHistory", "replay_beliefs", "plot_belief_history", "ARC_BINS"]
+
+#: Bins along the part's arc of the belief's picture (a 300 mm part: 0.4 mm a bin).
+ARC_BINS = 720
+
+
+class BeliefHistory(NamedTuple):
+    """The belief at every check of a rolling.
+
+    Attributes
+    ----------
+    rotation : ndarray, rad
+        Rotation rolled by each check (both ways counted).
+    edges : ndarray, mm
+        The bins' edges along the part's arc (``ARC_BINS`` + 1).
+    mass : ndarray
+        (checks, bins): the belief's probability in each bin.
+    map_arc, stated : ndarray
+        The most probable present contact (mm) and the stated probability within the radius, per check.
+    true_arc : ndarray, mm
+        The true contact at each check (NaN where unknown).
+    events : list of (str, float)
+        What the rolling did, at which rotation (rad): "turned round", "regrasp", "bridge", "restart".
+    final : Belief
+        The belief after the last call.
+    """
+
+    rotation: NDArray[np.float64]
+    edges: NDArray[np.float64]
+    mass: NDArray[np.float64]
+    map_arc: NDArray[np.float64]
+    stated: NDArray[np.float64]
+    true_arc: NDArray[np.float64]
+    events: list[tuple[str, float]]
+    final: Belief
+
+
+def replay_beliefs(
+    flt: ContactFilter, columns: dict[str, np.ndarray], readings: dict[str, np.ndarray] | None = None
+) -> BeliefHistory:
+    """Make a kept log's calls on ``flt`` (a fresh filter) and keep the belief at every ``belief`` call.
+
+    ``readings``: a simulated rolling's readings, ``arcs`` (mm), ``turns`` (rad) and ``true_arcs`` (mm), as its
+    trace holds them; a check's truth is that of the last reading given to the filter, found among them by
+    its arc and turn (the trace also holds readings the filter never took: a bridge's, a re-read spike).
+    None or empty on a real rig.
+    """
+    part = flt.part
+    edges = np.linspace(0.0, part.perimeter, ARC_BINS + 1)
+    rows_arc, rows_turn, rows_true = (
+        (np.asarray(readings[k], dtype=float) for k in ("arcs", "turns", "true_arcs"))
+        if readings
+        else (np.zeros(0), np.zeros(0), np.zeros(0))
+    )
+    found, now_true = 0, float(rows_true[0]) if rows_true.size else math.nan
+    rows: list[NDArray[np.float64]] = []
+    rotation: list[float] = []
+    map_arc: list[float] = []
+    stated: list[float] = []
+    true_arc: list[float] = []
+    events: list[tuple[str, float]] = []
+    rolled, last_turn, last_sign, taken = 0.0, 0.0, 0.0, 0
+    belief: Belief | None = None
+    for code, arc, turn, jaw, value in zip(*(np.asarray(columns[c]) for c in LOG_COLUMNS), strict=True):
+        name = CALLS[int(code)]
+        if name in ("update", "regrasp"):
+            step = float(turn) - last_turn
+            sign = math.copysign(1.0, step) if step else last_sign
+            if last_sign and sign != last_sign:
+                events.append(("turned round", rolled))
+            rolled += abs(step)
+            last_turn, last_sign = float(turn), sign
+            taken += 1
+            match = np.flatnonzero(
+                (np.abs(rows_turn[found:] - float(turn)) < 1e-12) & (np.abs(rows_arc[found:] - float(arc)) < 1e-9)
+            )
+            if match.size:
+                found += int(match[0]) + 1
+                now_true = float(rows_true[found - 1])
+            if name == "regrasp":
+                events.append(("regrasp", rolled))
+                flt.regrasp(float(arc), float(turn), _arg(jaw))
+            else:
+                flt.update(float(arc), float(turn), _arg(jaw))
+        elif name == "reset":
+            if taken:
+                events.append(("restart", rolled))
+            flt.reset()
+            last_turn, last_sign = 0.0, 0.0
+        elif name == "touch":
+            flt.touch(float(jaw))
+        elif name == "bridged":
+            events.append(("bridge", rolled))
+            flt.bridged(float(turn), _arg(jaw), float(value))
+        else:
+            belief = flt.belief(_arg(value))
+            w = flt.posterior()
+            mean, _ = flt.shift()
+            present = part.wrap_arc(flt.current + mean)
+            hist, _ = np.histogram(present, bins=edges, weights=w)
+            rows.append(hist / max(float(hist.sum()), 1e-300))
+            rotation.append(rolled)
+            map_arc.append(belief.map_arc)
+            stated.append(belief.mass)
+            true_arc.append(now_true)
+    final = belief if belief is not None else flt.belief()
+    return BeliefHistory(
+        np.asarray(rotation),
+        edges,
+        np.asarray(rows).reshape(-1, ARC_BINS),
+        np.asarray(map_arc),
+        np.asarray(stated),
+        np.asarray(true_arc),
+        events,
+        final,
+    )
+
+
+def plot_belief_history(
+    part: Part | Outline, history: BeliefHistory, path: str | os.PathLike[str], *, title: str = ""
+) -> None:
+    """Draw ``history`` to the PNG ``path``: the belief along the part's arc against the rotation rolled (darker
+    is more probable, each check against its own most probable place; the truth a line, the most probable
+    contact dots, the rolling's events as dashed lines),
+    the stated probability under it, and the part with the final places and the truth beside it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .plotting import draw_part
+
+    if not history.rotation.size:
+        raise ValueError("a rolling that never asked its belief has no history to draw")
+    deg = np.degrees(history.rotation)
+    fig = plt.figure(figsize=(12, 6.2), layout="constrained")
+    grid = fig.add_gridspec(2, 2, width_ratios=(1.7, 1.0), height_ratios=(3.2, 1.0))
+    ax, ax_p, ax_part = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[:, 1])
+    right = deg[-1] + (deg[-1] - deg[-2] if deg.size > 1 else 1.0)
+    columns = np.concatenate([deg, [right]])
+    # each check's belief against its own most probable bin: where it is at every moment, however spread
+    shade = history.mass / np.maximum(history.mass.max(axis=1, keepdims=True), 1e-300)
+    ax.pcolormesh(columns, history.edges, shade.T, cmap="Greys", vmin=0.0, vmax=1.0, shading="flat", rasterized=True)
+    ax.plot(deg, history.map_arc, ".", color="tab:red", ms=3, label="most probable contact")
+    if np.isfinite(history.true_arc).any():
+        # broken where the contact passes the arc's origin, not drawn across the picture
+        line = history.true_arc.copy()
+        line[1:][np.abs(np.diff(line)) > 0.5 * part.perimeter] = np.nan
+        ax.plot(deg, line, "-", color="tab:blue", lw=1.2, alpha=0.8, label="true contact")
+    colours = {"turned round": "tab:green", "regrasp": "tab:purple", "bridge": "tab:orange", "restart": "black"}
+    shown: set[str] = set()
+    for what, at in history.events:
+        ax.axvline(math.degrees(at), color=colours[what], lw=0.8, ls="--", label=None if what in shown else what)
+        shown.add(what)
+    ax.set_xlim(0.0, right)
+    ax.set_ylim(0.0, part.perimeter)
+    ax.set_ylabel("arc on the part, mm")
+    fig.suptitle(title or f"the belief while rolling on {part.name}", fontsize=11)
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=6, fontsize=7, frameon=False)
+    ax_p.plot(deg, history.stated, "-", color="tab:red", lw=1.2)
+    ax_p.set_xlim(0.0, right)
+    ax_p.set_ylim(0.0, 1.02)
+    ax_p.set_xlabel("rotation rolled, degrees")
+    ax_p.set_ylabel(f"P(within {history.final.radius:g} mm)", fontsize=8)
+    ax_p.grid(alpha=0.3)
+    draw_part(ax_part, part)
+    for k, m in enumerate(history.final.modes[:4]):
+        xy = part.point_at_arc(m.arc)
+        ax_part.plot(*xy, "*", ms=14 if k == 0 else 9, color="tab:red", alpha=1.0 if k == 0 else 0.6)
+        ax_part.annotate(
+            f"{m.mass:.0%}",
+            (float(xy[0]), float(xy[1])),
+            textcoords="offset points",
+            xytext=(6, 6),
+            fontsize=8,
+            color="tab:red",
+        )
+    if np.isfinite(history.true_arc[-1]):
+        ax_part.plot(*part.point_at_arc(history.true_arc[-1]), "o", mfc="none", color="tab:blue", ms=10)
+    ax_part.set_title("the final places and their probabilities;\nthe truth (blue circle)", fontsize=9)
+    ax_part.set_aspect("equal")
+    ax_part.axis("off")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,65 @@
+"""rolltouch show: how a reactive rolling's belief narrowed, replayed from its trace."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from driver.cli import main
+from driver.records import CALLS, LOG_COLUMNS, read_archive, replay_beliefs, replay_log
+from localizer import ContactFilter, load_part
+
+PARTS = Path(__file__).resolve().parents[2] / "parts"
+
+
+@pytest.fixture(scope="module")
+def reactive_trace(tmp_path_factory):
+    out = tmp_path_factory.mktemp("show") / "r.npz"
+    args = ["simulate", str(PARTS / "trefoil.json"), "--start", "120", "--reactive", "--noise", "paper", "--seed", "3"]
+    assert main([*args, "--engine", "kinematic", "--out", str(out)]) == 0
+    return out
+
+
+def test_the_history_is_the_replayed_belief_at_every_check(reactive_trace):
+    part = load_part(PARTS / "trefoil.json")
+    _, columns = read_archive(reactive_trace, LOG_COLUMNS)
+    readings = read_archive(reactive_trace, ("arcs", "turns", "true_arcs"))[1]
+    truth = readings["true_arcs"]
+    history = replay_beliefs(ContactFilter(part), columns, readings)
+    final = replay_log(ContactFilter(part), columns)
+    checks = int(np.count_nonzero(columns["call"] == CALLS.index("belief")))
+    assert history.rotation.size == history.stated.size == history.mass.shape[0] == checks > 10
+    assert history.final.mass == pytest.approx(final.mass) and history.final.map_arc == pytest.approx(final.map_arc)
+    assert history.stated[-1] == pytest.approx(final.mass)
+    assert np.allclose(history.mass.sum(axis=1), 1.0)
+    assert np.all(np.diff(history.rotation) >= 0) and history.rotation[-1] > 0
+    # each check's most probable contact lies where the histogram holds mass, and the truth is the trace's
+    bins = np.clip(np.searchsorted(history.edges, history.map_arc) - 1, 0, history.mass.shape[1] - 1)
+    near = np.maximum.reduce(
+        [history.mass[np.arange(checks), np.clip(bins + d, 0, history.mass.shape[1] - 1)] for d in (-1, 0, 1)]
+    )
+    assert np.all(near > 0)
+    assert history.true_arc[-1] == pytest.approx(truth[-1])
+    assert set(history.true_arc[np.isfinite(history.true_arc)]) <= set(truth)
+
+
+def test_show_draws_the_picture(reactive_trace, tmp_path, capsys):
+    out = tmp_path / "b.png"
+    assert main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "checks over" in capsys.readouterr().out
+
+
+def test_what_show_cannot_draw_is_refused_by_name(reactive_trace, tmp_path, capsys):
+    out = str(tmp_path / "b.png")
+    assert main(["show", str(reactive_trace), "--part", str(PARTS / "cam.json"), "--out", out]) == 2
+    assert "cam" in capsys.readouterr().err  # made on the trefoil
+    fixed = tmp_path / "f.npz"
+    args = ["simulate", str(PARTS / "trefoil.json"), "--start", "120", "--roll", "20", "--engine", "kinematic"]
+    assert main([*args, "--out", str(fixed)]) == 0
+    capsys.readouterr()
+    assert main(["show", str(fixed), "--part", str(PARTS / "trefoil.json"), "--out", out]) == 2
+    assert "'show' draws a straight jaw's reactive rolling" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", str(tmp_path / "b.jpg")])
+    assert "must end in .png" in capsys.readouterr().err
