@@ -28,12 +28,12 @@ from typing import Any, ClassVar, TypeAlias, cast
 
 import numpy as np
 
-from localizer import Belief, Boundary, ContactFilter
+from localizer import Belief, Boundary, ContactFilter, Outline, Part
 
 from .study import load_study
 from .trial import TrialSpec, run_trial
 
-__all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "calls_until", "VariantResult"]
+__all__ = ["FilterRecorder", "Recorded", "record_trial", "replay", "calls_until", "VariantResult", "log_columns"]
 
 #: A start within this of the true one counts as the true start (mm).
 NEAR = 2.0
@@ -241,7 +241,14 @@ def main(argv: list[str] | None = None) -> int:
         help="ContactFilter settings for one variant, space-separated (repeat for more variants)",
     )
     ap.add_argument("--at", type=float, metavar="DEG", help="the beliefs after this many degrees of rolling")
+    ap.add_argument(
+        "--show",
+        metavar="FILE.png",
+        help="also draw how the trial's belief narrowed (as 'rolltouch show' draws a trace)",
+    )
     args = ap.parse_args(argv)
+    if args.show is not None and not args.show.lower().endswith(".png"):
+        ap.error(f"--show {args.show}: the file name must end in .png")
     variants: list[dict[str, Any]] = [{}]
     for group in args.set:
         variant = {}
@@ -270,7 +277,52 @@ def main(argv: list[str] | None = None) -> int:
             f"true-start margin {v.margin:+8.2f} nats  noise scale {v.noise_scale:.2f}"
             + ("  MISMATCH" if v.mismatch else "")
         )
+    if args.show is not None:
+        from driver.records import plot_belief_history, replay_beliefs
+
+        history = replay_beliefs(ContactFilter(rec.part, **rec.settings), log_columns(rec.calls))
+        title = f"{Path(str(r['part'])).name}, {r['value']}, trial {args.trial}: the belief while rolling"
+        plot_belief_history(cast("Part | Outline", rec.part), history, args.show, title=title)
+        print(f"  drawn to {args.show}")
     return 0
+
+
+def log_columns(calls: Sequence[Call]) -> dict[str, np.ndarray]:
+    """Recorded calls as the kept log's columns (:data:`driver.records.LOG_COLUMNS`), which
+    :func:`driver.records.replay_log` and :func:`driver.records.replay_beliefs` make again."""
+    from driver.records import CALLS, LOG_COLUMNS
+
+    def number(x: object) -> float:
+        return math.nan if x is None else float(x)  # type: ignore[arg-type]
+
+    rows = []
+    for name, args, kwargs in calls:
+        given = dict(zip(_SIGNATURES[name], args)) | kwargs
+        value = given.get("jump", given.get("radius"))
+        rows.append(
+            (
+                CALLS.index(name),
+                number(given.get("arc")),
+                number(given.get("turn")),
+                number(given.get("jaw")),
+                number(value),
+            )
+        )
+    table = np.array(rows, dtype=float).reshape(-1, len(LOG_COLUMNS))
+    out = {k: table[:, i] for i, k in enumerate(LOG_COLUMNS)}
+    out["call"] = table[:, 0].astype(np.int8)
+    return out
+
+
+#: The positional parameters of each recorded call, by name.
+_SIGNATURES = {
+    "update": ("arc", "turn", "jaw"),
+    "regrasp": ("arc", "turn", "jaw"),
+    "touch": ("jaw",),
+    "bridged": ("turn", "jaw", "jump"),
+    "belief": ("radius",),
+    "reset": (),
+}
 
 
 if __name__ == "__main__":

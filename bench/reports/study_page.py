@@ -4,8 +4,8 @@ One self-contained HTML file (its pictures inlined as data URIs, no script, no o
 ``rolltouch montecarlo`` left in the folder: the study's settings (study.json); per level, a table of
 the methods (success with its Wilson interval, sure, sure and wrong, mismatch, rotation, calibration
 error); per part, each method's success over the levels; the study's plots (reliability, success
-against rotation, ...); and the trials that failed or were sure and wrong, each with the command that
-replays it (:mod:`bench.replay`).
+against rotation, ...); and the trials that failed or were sure and wrong, each reactive one with the
+command that replays it and draws how its belief narrowed (:mod:`bench.replay` ``--show``).
 """
 
 from __future__ import annotations
@@ -129,7 +129,10 @@ def _trials(folder: Path, study: dict[str, Any], methods: list[str]) -> str:
                 continue
             what = "sure and wrong" if sure_wrong else f"not right ({stopped or 'fixed'})"
             level, trial = row.get("level"), row.get("trial")
-            replay = f"python -m bench.replay {source} --level {level} --trial {trial}" if name == "reactive" else ""
+            show = f"--show trial-{level}-{trial}.png"
+            replay = (
+                f"python -m bench.replay {source} --level {level} --trial {trial} {show}" if name == "reactive" else ""
+            )
             listed.append(
                 [
                     level,

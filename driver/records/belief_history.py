@@ -201,7 +201,7 @@ def plot_belief_history(
         )
     if np.isfinite(history.true_arc[-1]):
         ax_part.plot(*part.point_at_arc(history.true_arc[-1]), "o", mfc="none", color="tab:blue", ms=10)
-    ax_part.set_title("the final places and their probabilities;\nthe truth (blue circle)", fontsize=9)
+    ax_part.set_title("the final places, each with its share of the belief;\nthe truth (blue circle)", fontsize=9)
     ax_part.set_aspect("equal")
     ax_part.axis("off")
     fig.savefig(path, dpi=110)

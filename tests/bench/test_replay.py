@@ -4,7 +4,9 @@ from pathlib import Path
 
 import pytest
 
-from bench.replay import main, record_trial, replay
+from bench.replay import log_columns, main, record_trial, replay
+from driver.records import replay_log
+from localizer import ContactFilter
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -34,6 +36,15 @@ def test_the_recorded_calls_give_back_the_run_belief(recorded):
     assert as_run.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
     assert as_run.error_mm == pytest.approx(float(rec.row["reactive_error_mm"]), abs=0.06)
     assert as_run.margin > 0  # it localized: the true start leads
+
+
+def test_the_recorded_calls_as_a_kept_log_give_back_the_run_belief(recorded, tmp_path, capsys):
+    f, rec = recorded
+    b = replay_log(ContactFilter(rec.part, **rec.settings), log_columns(rec.calls))
+    assert b.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
+    out = tmp_path / "t.png"
+    assert main([str(f), "--level", "0", "--trial", "0", "--show", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and "drawn to" in capsys.readouterr().out
 
 
 def test_a_variant_changes_only_the_filter(recorded):

@@ -115,7 +115,10 @@ def test_the_page_holds_the_study_its_tables_and_its_pictures(study_dir, capsys)
     assert sorted((t[0], t[2], t[4]) for t in trials) == sorted(wrong)
     for t in trials:
         if t[4] == "reactive":
-            assert t[-1] == f"python -m bench.replay {study_dir.parent / 's.toml'} --level {t[0]} --trial {t[2]}"
+            study = study_dir.parent / "s.toml"
+            assert (
+                t[-1] == f"python -m bench.replay {study} --level {t[0]} --trial {t[2]} --show trial-{t[0]}-{t[2]}.png"
+            )
 
 
 def test_a_folder_without_a_study_is_refused_by_name(tmp_path, capsys):
