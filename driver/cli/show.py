@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..rig import RigError
-from ._options import add_command, writable_file
+from ._options import UsageError, add_command, writable_file
 
 __all__ = ["register", "show_command"]
 
@@ -19,7 +19,7 @@ def register(sub: Any) -> None:
         sub,
         "show",
         show_command,
-        help="draw how a reactive rolling's belief narrowed (PNG)",
+        help="draw how a reactive rolling's belief narrowed (PNG), or animate it (GIF, MP4)",
         description=(
             "Make a reactive rolling's filter calls again (a straight jaw's trace from 'simulate --reactive', or "
             "a run log of 'run --reactive') and draw the belief along the part against the rotation rolled, "
@@ -28,7 +28,13 @@ def register(sub: Any) -> None:
     )
     p.add_argument("trace", metavar="TRACE", help="a reactive trace (.npz) or run log (.jsonl)")
     p.add_argument("--part", required=True, help="part file (the model the run was given)")
-    p.add_argument("--out", required=True, metavar="FILE.png", help="the picture to write")
+    p.add_argument(
+        "--out",
+        required=True,
+        metavar="FILE",
+        help="the output: .png the belief against rotation; .gif or .mp4 (with ffmpeg) the rolling animated",
+    )
+    p.add_argument("--fps", type=int, default=10, metavar="N", help="frames per second of an animation (default 10)")
     p.add_argument(
         "--same-part",
         action="store_true",
@@ -40,6 +46,7 @@ def show_command(args: argparse.Namespace) -> int:
     from localizer import ContactFilter, load_part
 
     from ..records import (
+        FILM_SUFFIXES,
         LOG_COLUMNS,
         REACTIVE_FORMAT,
         calls_from_events,
@@ -49,9 +56,12 @@ def show_command(args: argparse.Namespace) -> int:
         read_log,
         replay_beliefs,
         trace_format,
+        write_film,
     )
 
-    writable_file(args.out, "--out", (".png",))
+    writable_file(args.out, "--out", (".png", *FILM_SUFFIXES))
+    if not 1 <= args.fps <= 60:
+        raise UsageError(f"--fps {args.fps} must be from 1 to 60")
     path = str(args.trace)
     if path.endswith(".jsonl"):
         events = read_log(path)
@@ -74,10 +84,14 @@ def show_command(args: argparse.Namespace) -> int:
     history = replay_beliefs(ContactFilter(part), columns, readings)
     if not history.rotation.size:
         raise RigError(f"trace {path}: the rolling never asked its belief; nothing to draw")
-    plot_belief_history(part, history, args.out)
+    if str(args.out).lower().endswith(".png"):
+        plot_belief_history(part, history, args.out)
+        drawn = f"{history.rotation.size} checks"
+    else:
+        drawn = f"{write_film(part, history, args.out, fps=args.fps)} frames"
     b = history.final
     print(
-        f"{args.out}: {history.rotation.size} checks over {np.degrees(history.rotation[-1]):.1f} degrees; "
+        f"{args.out}: {drawn} over {np.degrees(history.rotation[-1]):.1f} degrees; "
         f"the last belief {b.mass:.1%} within {b.radius:g} mm of arc {b.map_arc:.2f} mm"
     )
     return 0

@@ -3,6 +3,7 @@ and their replay, plots, the part's record that keeps a trace from being scored 
 any of them as an MCAP file.
 """
 
+from .belief_film import FILM_SUFFIXES, MAX_FRAMES, write_film
 from .belief_history import ARC_BINS, BeliefHistory, plot_belief_history, replay_beliefs
 from .filter_log import (
     CALLS,
@@ -22,6 +23,9 @@ from .trace import COLUMNS, FORMAT, Trace, read_archive, trace_format
 from .wheel_trace import WHEEL_COLUMNS, WHEEL_FORMAT, WheelTrace
 
 __all__ = [
+    "FILM_SUFFIXES",
+    "MAX_FRAMES",
+    "write_film",
     "ARC_BINS",
     "BeliefHistory",
     "plot_belief_history",

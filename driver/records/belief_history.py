@@ -47,6 +47,10 @@ class BeliefHistory(NamedTuple):
         What the rolling did, at which rotation (rad): "turned round", "regrasp", "bridge", "restart".
     final : Belief
         The belief after the last call.
+    readings : ndarray
+        (readings, 4), one row per reading given to the filter: the rotation rolled by then (rad), the
+        contact's measured place on the jaw (mm, NaN if not given), the true contact (mm, NaN where unknown)
+        and the index of the last check before it (−1 before the first).
     """
 
     rotation: NDArray[np.float64]
@@ -57,6 +61,7 @@ class BeliefHistory(NamedTuple):
     true_arc: NDArray[np.float64]
     events: list[tuple[str, float]]
     final: Belief
+    readings: NDArray[np.float64]
 
 
 def replay_beliefs(
@@ -83,6 +88,7 @@ def replay_beliefs(
     stated: list[float] = []
     true_arc: list[float] = []
     events: list[tuple[str, float]] = []
+    taken_rows: list[tuple[float, float, float, float]] = []
     rolled, last_turn, last_sign, taken = 0.0, 0.0, 0.0, 0
     belief: Belief | None = None
     for code, arc, turn, jaw, value in zip(*(np.asarray(columns[c]) for c in LOG_COLUMNS), strict=True):
@@ -101,6 +107,7 @@ def replay_beliefs(
             if match.size:
                 found += int(match[0]) + 1
                 now_true = float(rows_true[found - 1])
+            taken_rows.append((rolled, float(jaw), now_true, float(len(rows) - 1)))  # jaw: NaN where not given
             if name == "regrasp":
                 events.append(("regrasp", rolled))
                 flt.regrasp(float(arc), float(turn), _arg(jaw))
@@ -137,6 +144,7 @@ def replay_beliefs(
         np.asarray(true_arc),
         events,
         final,
+        np.asarray(taken_rows, dtype=float).reshape(-1, 4),
     )
 
 

@@ -1,5 +1,6 @@
 """rolltouch show: how a reactive rolling's belief narrowed, replayed from its trace."""
 
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -63,3 +64,30 @@ def test_what_show_cannot_draw_is_refused_by_name(reactive_trace, tmp_path, caps
     with pytest.raises(SystemExit):
         main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", str(tmp_path / "b.jpg")])
     assert "must end in .png" in capsys.readouterr().err
+
+
+def test_the_animation_has_a_frame_a_reading_up_to_its_bound(reactive_trace, tmp_path, capsys):
+    from PIL import Image
+
+    from driver.records import MAX_FRAMES
+
+    out = tmp_path / "b.gif"
+    assert (
+        main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", str(out), "--fps", "5"]) == 0
+    )
+    _, columns = read_archive(reactive_trace, LOG_COLUMNS)
+    readings = int(np.count_nonzero(np.isin(columns["call"], [CALLS.index("update"), CALLS.index("regrasp")])))
+    with Image.open(out) as gif:
+        assert gif.n_frames == min(readings, MAX_FRAMES) >= 20
+        assert gif.info["duration"] == 200  # ms a frame at 5 frames per second
+    assert f"{min(readings, MAX_FRAMES)} frames" in capsys.readouterr().out
+
+
+def test_an_animation_that_cannot_be_written_is_refused_by_name(reactive_trace, tmp_path, capsys):
+    args = ["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json")]
+    with pytest.raises(SystemExit):
+        main([*args, "--out", str(tmp_path / "b.gif"), "--fps", "0"])
+    assert "--fps 0 must be from 1 to 60" in capsys.readouterr().err
+    if shutil.which("ffmpeg") is None:
+        assert main([*args, "--out", str(tmp_path / "b.mp4")]) == 2
+        assert "needs ffmpeg" in capsys.readouterr().err
