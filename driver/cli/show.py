@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..rig import RigError
 from ._options import UsageError, add_command, writable_file
+
+if TYPE_CHECKING:
+    from ..records import WheelTrace
 
 __all__ = ["register", "show_command"]
 
@@ -21,9 +24,9 @@ def register(sub: Any) -> None:
         show_command,
         help="draw how a reactive rolling's belief narrowed (PNG), or animate it (GIF, MP4)",
         description=(
-            "Make a reactive rolling's filter calls again (a straight jaw's trace from 'simulate --reactive', or "
-            "a run log of 'run --reactive') and draw the belief along the part against the rotation rolled, "
-            "the truth where known, the rolling's events, and the final places on the part."
+            "Make a reactive rolling's filter calls again (a straight jaw's or a wheel's trace from 'simulate "
+            "--reactive', or a run log of 'run --reactive') and draw the belief along the part against the rotation "
+            "rolled, the truth where known, the rolling's events, and the final places on the part; or animate it."
         ),
     )
     p.add_argument("trace", metavar="TRACE", help="a reactive trace (.npz) or run log (.jsonl)")
@@ -43,18 +46,20 @@ def register(sub: Any) -> None:
 
 
 def show_command(args: argparse.Namespace) -> int:
-    from localizer import ContactFilter, load_part
+    from localizer import ContactFilter, WheelFilter, load_part
 
     from ..records import (
         FILM_SUFFIXES,
         LOG_COLUMNS,
         REACTIVE_FORMAT,
+        WHEEL_FORMAT,
         calls_from_events,
         check_same_part,
         plot_belief_history,
         read_archive,
         read_log,
         replay_beliefs,
+        replay_wheel_beliefs,
         trace_format,
         write_film,
     )
@@ -63,35 +68,55 @@ def show_command(args: argparse.Namespace) -> int:
     if not 1 <= args.fps <= 60:
         raise UsageError(f"--fps {args.fps} must be from 1 to 60")
     path = str(args.trace)
-    if path.endswith(".jsonl"):
-        events = read_log(path)
-        columns = calls_from_events(events)
-        if columns is None:
-            raise RigError(f"run log {path} holds no filter calls: only a reactive run's log, ended, can be shown")
-        recorded, readings = events[0].get("part"), None
+    wheel = _wheel_record(path)
+    if wheel is not None:
+        part = load_part(args.part)
+        check_same_part(wheel.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
+        history = replay_wheel_beliefs(WheelFilter(part, wheel.wheel), wheel.columns)
+        radius: float | None = wheel.wheel.radius
     else:
-        kind = trace_format(path)
-        if kind != REACTIVE_FORMAT:
-            raise RigError(
-                f"trace {path}: format {kind!r}; 'show' draws a straight jaw's reactive rolling ({REACTIVE_FORMAT}) "
-                "('locate' localizes the others)"
-            )
-        meta, columns = read_archive(path, LOG_COLUMNS)
-        readings = read_archive(path, ("arcs", "turns", "true_arcs"))[1]
-        recorded = meta.get("part")
-    part = load_part(args.part)
-    check_same_part(recorded, part, args.part, f"trace {path}", same=args.same_part)
-    history = replay_beliefs(ContactFilter(part), columns, readings)
+        if path.endswith(".jsonl"):
+            events = read_log(path)
+            columns = calls_from_events(events)
+            if columns is None:
+                raise RigError(f"run log {path} holds no filter calls: only a reactive run's log, ended, can be shown")
+            recorded, readings = events[0].get("part"), None
+        else:
+            kind = trace_format(path)
+            if kind != REACTIVE_FORMAT:
+                raise RigError(
+                    f"trace {path}: format {kind!r}; 'show' draws a reactive rolling ({REACTIVE_FORMAT}, "
+                    f"{WHEEL_FORMAT}; 'locate' localizes fixed rolls)"
+                )
+            meta, columns = read_archive(path, LOG_COLUMNS)
+            readings = read_archive(path, ("arcs", "turns", "true_arcs"))[1]
+            recorded = meta.get("part")
+        part = load_part(args.part)
+        check_same_part(recorded, part, args.part, f"trace {path}", same=args.same_part)
+        history = replay_beliefs(ContactFilter(part), columns, readings)
+        radius = None
     if not history.rotation.size:
         raise RigError(f"trace {path}: the rolling never asked its belief; nothing to draw")
     if str(args.out).lower().endswith(".png"):
         plot_belief_history(part, history, args.out)
         drawn = f"{history.rotation.size} checks"
     else:
-        drawn = f"{write_film(part, history, args.out, fps=args.fps)} frames"
+        drawn = f"{write_film(part, history, args.out, fps=args.fps, wheel_radius=radius)} frames"
     b = history.final
     print(
         f"{args.out}: {drawn} over {np.degrees(history.rotation[-1]):.1f} degrees; "
         f"the last belief {b.mass:.1%} within {b.radius:g} mm of arc {b.map_arc:.2f} mm"
     )
     return 0
+
+
+def _wheel_record(path: str) -> WheelTrace | None:
+    """The wheel's trace or run log at ``path``, or None if it is a straight jaw's record."""
+    from ..records import WHEEL_FORMAT, WheelTrace, read_log, trace_format
+
+    if path.endswith(".jsonl"):
+        if not str(read_log(path)[0].get("jaw", "straight")).startswith("wheel"):
+            return None
+    elif trace_format(path) != WHEEL_FORMAT:
+        return None
+    return WheelTrace.load(path)

@@ -4,7 +4,7 @@ any of them as an MCAP file.
 """
 
 from .belief_film import FILM_SUFFIXES, MAX_FRAMES, write_film
-from .belief_history import ARC_BINS, BeliefHistory, plot_belief_history, replay_beliefs
+from .belief_history import ARC_BINS, BeliefHistory, plot_belief_history, replay_beliefs, replay_wheel_beliefs
 from .filter_log import (
     CALLS,
     FILTER_CALLS_EVENT,
@@ -30,6 +30,7 @@ __all__ = [
     "BeliefHistory",
     "plot_belief_history",
     "replay_beliefs",
+    "replay_wheel_beliefs",
     "CALLS",
     "FILTER_CALLS_EVENT",
     "LOG_COLUMNS",

@@ -1,8 +1,9 @@
-"""A reactive rolling as an animation: the jaw on the part at every reading, the belief along the boundary.
+"""A reactive rolling as an animation: the finger on the part at every reading, the belief along the boundary.
 
 Each frame is one reading of a :class:`~driver.records.BeliefHistory` (at most :data:`MAX_FRAMES`, evenly
 chosen, the last always among them): the part, the straight jaw laid on it (tangent at the contact, the
-contact at its measured place on the jaw; the true contact where known, else the most probable one), the
+contact at its measured place on the jaw) or the wheel touching it (the true contact where known, else
+the most probable one), the
 belief of the last check as a band of colour along the boundary, the leading places with their shares,
 and the stated probability growing under it. GIF by Pillow (matplotlib's own dependency); MP4 by ffmpeg
 where it is installed.
@@ -54,8 +55,17 @@ def _places(mass: NDArray[np.float64], edges: NDArray[np.float64], k: int = 3) -
     return sorted(runs, key=lambda r: -r[1])[:k]
 
 
-def write_film(part: Part | Outline, history: BeliefHistory, path: str | os.PathLike[str], *, fps: int = 10) -> int:
+def write_film(
+    part: Part | Outline,
+    history: BeliefHistory,
+    path: str | os.PathLike[str],
+    *,
+    fps: int = 10,
+    wheel_radius: float | None = None,
+) -> int:
     """Write the animation of ``history`` to ``path`` (.gif, or .mp4 with ffmpeg installed); returns the frames.
+
+    ``wheel_radius`` (mm): draw a wheel finger of that radius on the part instead of the straight jaw.
 
     Raises
     ------
@@ -99,6 +109,7 @@ def write_film(part: Part | Outline, history: BeliefHistory, path: str | os.Path
     cmap = matplotlib.colormaps["Reds"].with_extremes(bad=(0.0, 0.0, 0.0, 0.0))  # no belief: the part shows
     band = ax.scatter(ring[:, 0], ring[:, 1], c=np.zeros(len(ring)), cmap=cmap, vmin=0, vmax=1, s=30, zorder=5)
     (jaw_line,) = ax.plot([], [], "-", color="tab:blue", lw=4, alpha=0.8, solid_capstyle="butt", zorder=4)
+    circle = np.exp(1j * np.linspace(0.0, 2.0 * math.pi, 49))
     (contact,) = ax.plot([], [], "o", color="tab:blue", ms=5, mfc="none", zorder=6)
     labels = [ax.text(0, 0, "", fontsize=9, color="darkred", zorder=6) for _ in range(3)]
     title = ax.set_title("", fontsize=10)
@@ -121,9 +132,13 @@ def write_film(part: Part | Outline, history: BeliefHistory, path: str | os.Path
             p = part.point_at_arc(where)
             angle = float(part.tangent_angle_at_arc(where))
             e = np.array([math.cos(angle), math.sin(angle)])
-            centre = p - (jaw if math.isfinite(jaw) else 0.0) * e
-            ends = np.array([centre - half * e, centre + half * e])
-            jaw_line.set_data(ends[:, 0], ends[:, 1])
+            if wheel_radius is None:  # the jaw along the tangent, the contact at its measured place on it
+                centre = p - (jaw if math.isfinite(jaw) else 0.0) * e
+                ends = np.array([centre - half * e, centre + half * e])
+                jaw_line.set_data(ends[:, 0], ends[:, 1])
+            else:  # the disc outside the part, touching it at the contact (outward normal: the tangent turned -90°)
+                hub = p + wheel_radius * np.array([e[1], -e[0]])
+                jaw_line.set_data(hub[0] + wheel_radius * circle.real, hub[1] + wheel_radius * circle.imag)
             contact.set_data([p[0]], [p[1]])
         for label, (arc, share) in zip(labels, _places(mass, history.edges) if c >= 0 else []):
             xy = part.point_at_arc(arc)

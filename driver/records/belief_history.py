@@ -18,11 +18,11 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from localizer import Belief, ContactFilter, Outline, Part
+from localizer import Belief, ContactFilter, Outline, Part, WheelFilter
 
 from .filter_log import CALLS, LOG_COLUMNS, _arg
 
-__all__ = ["BeliefHistory", "replay_beliefs", "plot_belief_history", "ARC_BINS"]
+__all__ = ["BeliefHistory", "replay_beliefs", "replay_wheel_beliefs", "plot_belief_history", "ARC_BINS"]
 
 #: Bins along the part's arc of the belief's picture (a 300 mm part: 0.4 mm a bin).
 ARC_BINS = 720
@@ -134,6 +134,59 @@ def replay_beliefs(
             map_arc.append(belief.map_arc)
             stated.append(belief.mass)
             true_arc.append(now_true)
+    final = belief if belief is not None else flt.belief()
+    return BeliefHistory(
+        np.asarray(rotation),
+        edges,
+        np.asarray(rows).reshape(-1, ARC_BINS),
+        np.asarray(map_arc),
+        np.asarray(stated),
+        np.asarray(true_arc),
+        events,
+        final,
+        np.asarray(taken_rows, dtype=float).reshape(-1, 4),
+    )
+
+
+def replay_wheel_beliefs(flt: WheelFilter, columns: dict[str, np.ndarray], check_every: int = 4) -> BeliefHistory:
+    """A wheel's readings (a :class:`~driver.records.WheelTrace`'s ``segment``, ``length``, ``turn``,
+    ``true_arc``) given to ``flt`` (a fresh filter for its finger), the belief kept every ``check_every``
+    readings (the wheel's rolling checks every 4) and at the end. The rolling started afresh at every new
+    segment, and so does the filter (a "restart"); the jumps the rolling told its filter are not in a
+    trace, so the replay's belief may differ a little from the run's.
+    """
+    part = flt.part
+    edges = np.linspace(0.0, part.perimeter, ARC_BINS + 1)
+    segment, length, turn, truth = (np.asarray(columns[k]) for k in ("segment", "length", "turn", "true_arc"))
+    rows: list[NDArray[np.float64]] = []
+    rotation: list[float] = []
+    map_arc: list[float] = []
+    stated: list[float] = []
+    true_arc: list[float] = []
+    events: list[tuple[str, float]] = []
+    taken_rows: list[tuple[float, float, float, float]] = []
+    rolled, last_turn, last_sign, belief = 0.0, 0.0, 0.0, None
+    for k in range(length.size):
+        if k and segment[k] != segment[k - 1]:
+            events.append(("restart", rolled))
+            flt.reset()
+            last_turn, last_sign = 0.0, 0.0
+        step = float(turn[k]) - last_turn
+        sign = math.copysign(1.0, step) if step else last_sign
+        if last_sign and sign != last_sign:
+            events.append(("turned round", rolled))
+        rolled += abs(step)
+        last_turn, last_sign = float(turn[k]), sign
+        flt.update(float(length[k]), float(turn[k]))  # as WheelTrace.relocalize gives them
+        taken_rows.append((rolled, math.nan, float(truth[k]), float(len(rows) - 1)))
+        if (k + 1) % check_every == 0 or k == length.size - 1:
+            belief = flt.belief()
+            hist, _ = np.histogram(flt.present(), bins=edges, weights=flt.posterior())
+            rows.append(hist / max(float(hist.sum()), 1e-300))
+            rotation.append(rolled)
+            map_arc.append(belief.map_arc)
+            stated.append(belief.mass)
+            true_arc.append(float(truth[k]))
     final = belief if belief is not None else flt.belief()
     return BeliefHistory(
         np.asarray(rotation),
