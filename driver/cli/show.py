@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..rig import RigError
-from ._options import UsageError, add_command, writable_file
+from ._options import UsageError, add_command, jaw_argument, writable_file
 
 if TYPE_CHECKING:
     from ..records import WheelTrace
@@ -38,6 +38,7 @@ def register(sub: Any) -> None:
         help="the output: .png the belief against rotation; .gif or .mp4 (with ffmpeg) the rolling animated",
     )
     p.add_argument("--fps", type=int, default=10, metavar="N", help="frames per second of an animation (default 10)")
+    jaw_argument(p, default=None)
     p.add_argument(
         "--same-part",
         action="store_true",
@@ -46,7 +47,7 @@ def register(sub: Any) -> None:
 
 
 def show_command(args: argparse.Namespace) -> int:
-    from localizer import ContactFilter, WheelFilter, load_part
+    from localizer import DEFAULT_JAW, ContactFilter, WheelFilter, load_part
 
     from ..records import (
         FILM_SUFFIXES,
@@ -69,6 +70,9 @@ def show_command(args: argparse.Namespace) -> int:
         raise UsageError(f"--fps {args.fps} must be from 1 to 60")
     path = str(args.trace)
     wheel = _wheel_record(path)
+    finger = wheel.metadata["jaw"] if wheel is not None else str(DEFAULT_JAW)
+    if args.jaw is not None and str(args.jaw) != finger:
+        raise RigError(f"trace {path} is of the {finger} finger, not of --jaw {args.jaw}")
     if wheel is not None:
         part = load_part(args.part)
         check_same_part(wheel.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)

@@ -61,6 +61,11 @@ def test_what_show_cannot_draw_is_refused_by_name(reactive_trace, tmp_path, caps
     capsys.readouterr()
     assert main(["show", str(fixed), "--part", str(PARTS / "trefoil.json"), "--out", out]) == 2
     assert "'show' draws a reactive rolling" in capsys.readouterr().err
+    assert (
+        main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", out, "--jaw", "wheel:5"])
+        == 2
+    )
+    assert "of the straight:100 finger, not of --jaw wheel:5" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", str(tmp_path / "b.jpg")])
     assert "must end in .png" in capsys.readouterr().err
