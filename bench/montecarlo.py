@@ -18,6 +18,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any, TextIO
 
+from tqdm import tqdm
+
 from driver.link import LockHeld, hold_lock
 from localizer import fingerprint, load_part
 
@@ -142,6 +144,8 @@ def _run_locked(
     finished = len(done)
     successes = sum(int(r["success"]) for r in read_trials(table)) if done else 0
     t0 = time.monotonic()
+    # the progress line: trials done of all, rate, time left, and the success rate so far (tqdm)
+    bar = tqdm(total=total, initial=finished, unit="trial", disable=not progress, file=sys.stderr, mininterval=0.5)
 
     def record(row: dict[str, Any], f: TextIO, writer: csv.DictWriter[str]) -> None:
         nonlocal finished, successes
@@ -149,13 +153,8 @@ def _run_locked(
         f.flush()
         finished += 1
         successes += int(row["success"])
-        if progress:
-            rate = (finished - len(done)) / max(time.monotonic() - t0, 1e-9)
-            bar = "#" * int(30 * finished / total)
-            sys.stderr.write(
-                f"\r[{bar:<30}] {finished}/{total} trials  {rate:.2f}/s  success {successes / max(finished, 1):.1%} "
-            )
-            sys.stderr.flush()
+        bar.set_postfix_str(f"success {successes / max(finished, 1):.1%}", refresh=False)
+        bar.update(1)
 
     with open(table, "a", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=study.columns)
@@ -193,13 +192,11 @@ def _run_locked(
                 # Ctrl-C (or a failure): the queued trials are dropped, not waited for; the finished
                 # ones are in the table already and stay there, summarized below
                 pool.shutdown(wait=False, cancel_futures=True)
-                if progress:
-                    sys.stderr.write("\n")
+                bar.close()
                 _write_summary(study, table, out, t0)
                 raise
             pool.shutdown()
-    if progress:
-        sys.stderr.write("\n")
+    bar.close()
     return _write_summary(study, table, out, t0)
 
 
