@@ -160,14 +160,21 @@ def spread_by_direction(
     if starts is None:
         starts = [m.start_arc for m in flt.belief().modes[:2]]
     idx = flt.tracks.node_at(starts)
+    return tuple(float(np.std(moved)) for moved, _ in _windows(flt, idx, lookahead, explored))
+
+
+def _windows(
+    flt: ContactFilter, idx: NDArray[np.intp], lookahead: float, explored: tuple[float, ...]
+) -> list[tuple[NDArray[np.float64], float]]:
+    """Counter-clockwise, then clockwise: each start's contact travel over the next ``lookahead`` rad of
+    unexplored rotation that way (0 where it would bridge a concavity), and where that window starts (rad)."""
     jaw = _jaw_now(flt, idx)
-    out: list[float] = []
+    out = []
     for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
         a, ok_a = flt.tracks.roll(idx, edge, **jaw)
         b, ok_b = flt.tracks.roll(idx, edge + sign * lookahead, **jaw)
-        moved = np.where(ok_a & ok_b, b - a, 0.0)
-        out.append(float(np.std(moved)))
-    return tuple(out)
+        out.append((np.where(ok_a & ok_b, b - a, 0.0), edge))
+    return out
 
 
 #: How many of the most probable starts the information-seeking rule weighs (:func:`information_by_direction`):
@@ -213,12 +220,8 @@ def information_by_direction(
     same = np.abs(flt.part.arc_offset(present[:, None], present[None, :])) <= flt.radius
     now = float(wt @ (same @ wt))
     variance = 2.0 * (flt.sd_position * flt.noise_scale()) ** 2
-    jaw = _jaw_now(flt, top)
     out: list[float] = []
-    for sign, edge in ((1.0, explored[1]), (-1.0, explored[0])):
-        a, ok_a = flt.tracks.roll(top, edge, **jaw)
-        b, ok_b = flt.tracks.roll(top, edge + sign * lookahead, **jaw)
-        moved = np.where(ok_a & ok_b, b - a, 0.0)
+    for moved, edge in _windows(flt, top, lookahead, explored):
         # row i: the belief over starts j were i the truth and its travel read
         after = wt[None, :] * np.exp(-((moved[:, None] - moved[None, :]) ** 2) / (2.0 * variance))
         after /= after.sum(axis=1, keepdims=True)

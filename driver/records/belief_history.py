@@ -18,9 +18,11 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from localizer import Belief, ContactFilter, Outline, Part, WheelFilter
+from localizer import Belief, Boundary, ContactFilter, Outline, Part, WheelFilter
 
 from .filter_log import CALLS, LOG_COLUMNS, _arg
+
+FloatArray = NDArray[np.float64]
 
 __all__ = ["BeliefHistory", "replay_beliefs", "replay_wheel_beliefs", "plot_belief_history", "ARC_BINS"]
 
@@ -64,6 +66,61 @@ class BeliefHistory(NamedTuple):
     readings: NDArray[np.float64]
 
 
+class _Keeper:
+    """What a replay keeps as it goes: the rotation rolled, the turns round, every reading and every check."""
+
+    def __init__(self, part: Boundary) -> None:
+        self.edges = np.linspace(0.0, part.perimeter, ARC_BINS + 1)
+        self.rows: list[NDArray[np.float64]] = []
+        self.checks: list[tuple[float, float, float, float]] = []  # rotation, map arc, stated, truth
+        self.readings: list[tuple[float, float, float, float]] = []
+        self.events: list[tuple[str, float]] = []
+        self.rolled, self.last_turn, self.last_sign = 0.0, 0.0, 0.0
+        self.belief: Belief | None = None
+
+    def event(self, what: str) -> None:
+        self.events.append((what, self.rolled))
+
+    def restart(self) -> None:
+        """The filter starts afresh: the next reading's net turn counts from 0 again."""
+        if self.readings:
+            self.event("restart")
+        self.last_turn, self.last_sign = 0.0, 0.0
+
+    def reading(self, turn: float, jaw: float, true_arc: float) -> None:
+        """A reading at net turn ``turn`` (rad), the contact ``jaw`` mm along the jaw (NaN: not given)."""
+        step = turn - self.last_turn
+        sign = math.copysign(1.0, step) if step else self.last_sign
+        if self.last_sign and sign != self.last_sign:
+            self.event("turned round")
+        self.rolled += abs(step)
+        self.last_turn, self.last_sign = turn, sign
+        self.readings.append((self.rolled, jaw, true_arc, float(len(self.rows) - 1)))
+
+    def check(
+        self, belief: Belief, present: NDArray[np.float64], weights: NDArray[np.float64], true_arc: float
+    ) -> None:
+        """A belief asked: its mass along the arc (each start's present contact, weighted)."""
+        hist, _ = np.histogram(present, bins=self.edges, weights=weights)
+        self.rows.append(hist / max(float(hist.sum()), 1e-300))
+        self.checks.append((self.rolled, belief.map_arc, belief.mass, true_arc))
+        self.belief = belief
+
+    def history(self, final: Belief) -> BeliefHistory:
+        checks = np.asarray(self.checks, dtype=float).reshape(-1, 4)
+        return BeliefHistory(
+            checks[:, 0],
+            self.edges,
+            np.asarray(self.rows).reshape(-1, ARC_BINS),
+            checks[:, 1],
+            checks[:, 2],
+            checks[:, 3],
+            self.events,
+            final,
+            np.asarray(self.readings, dtype=float).reshape(-1, 4),
+        )
+
+
 def replay_beliefs(
     flt: ContactFilter, columns: dict[str, np.ndarray], readings: dict[str, np.ndarray] | None = None
 ) -> BeliefHistory:
@@ -74,78 +131,41 @@ def replay_beliefs(
     its arc and turn (the trace also holds readings the filter never took: a bridge's, a re-read spike).
     None or empty on a real rig.
     """
-    part = flt.part
-    edges = np.linspace(0.0, part.perimeter, ARC_BINS + 1)
+    keep = _Keeper(flt.part)
     rows_arc, rows_turn, rows_true = (
         (np.asarray(readings[k], dtype=float) for k in ("arcs", "turns", "true_arcs"))
         if readings
         else (np.zeros(0), np.zeros(0), np.zeros(0))
     )
     found, now_true = 0, float(rows_true[0]) if rows_true.size else math.nan
-    rows: list[NDArray[np.float64]] = []
-    rotation: list[float] = []
-    map_arc: list[float] = []
-    stated: list[float] = []
-    true_arc: list[float] = []
-    events: list[tuple[str, float]] = []
-    taken_rows: list[tuple[float, float, float, float]] = []
-    rolled, last_turn, last_sign, taken = 0.0, 0.0, 0.0, 0
-    belief: Belief | None = None
     for code, arc, turn, jaw, value in zip(*(np.asarray(columns[c]) for c in LOG_COLUMNS), strict=True):
         name = CALLS[int(code)]
         if name in ("update", "regrasp"):
-            step = float(turn) - last_turn
-            sign = math.copysign(1.0, step) if step else last_sign
-            if last_sign and sign != last_sign:
-                events.append(("turned round", rolled))
-            rolled += abs(step)
-            last_turn, last_sign = float(turn), sign
-            taken += 1
             match = np.flatnonzero(
                 (np.abs(rows_turn[found:] - float(turn)) < 1e-12) & (np.abs(rows_arc[found:] - float(arc)) < 1e-9)
             )
             if match.size:
                 found += int(match[0]) + 1
                 now_true = float(rows_true[found - 1])
-            taken_rows.append((rolled, float(jaw), now_true, float(len(rows) - 1)))  # jaw: NaN where not given
+            keep.reading(float(turn), float(jaw), now_true)  # jaw: NaN where not given
             if name == "regrasp":
-                events.append(("regrasp", rolled))
+                keep.event("regrasp")
                 flt.regrasp(float(arc), float(turn), _arg(jaw))
             else:
                 flt.update(float(arc), float(turn), _arg(jaw))
         elif name == "reset":
-            if taken:
-                events.append(("restart", rolled))
+            keep.restart()
             flt.reset()
-            last_turn, last_sign = 0.0, 0.0
         elif name == "touch":
             flt.touch(float(jaw))
         elif name == "bridged":
-            events.append(("bridge", rolled))
+            keep.event("bridge")
             flt.bridged(float(turn), _arg(jaw), float(value))
         else:
             belief = flt.belief(_arg(value))
-            w = flt.posterior()
             mean, _ = flt.shift()
-            present = part.wrap_arc(flt.current + mean)
-            hist, _ = np.histogram(present, bins=edges, weights=w)
-            rows.append(hist / max(float(hist.sum()), 1e-300))
-            rotation.append(rolled)
-            map_arc.append(belief.map_arc)
-            stated.append(belief.mass)
-            true_arc.append(now_true)
-    final = belief if belief is not None else flt.belief()
-    return BeliefHistory(
-        np.asarray(rotation),
-        edges,
-        np.asarray(rows).reshape(-1, ARC_BINS),
-        np.asarray(map_arc),
-        np.asarray(stated),
-        np.asarray(true_arc),
-        events,
-        final,
-        np.asarray(taken_rows, dtype=float).reshape(-1, 4),
-    )
+            keep.check(belief, flt.part.wrap_arc(flt.current + mean), flt.posterior(), now_true)
+    return keep.history(keep.belief if keep.belief is not None else flt.belief())
 
 
 def replay_wheel_beliefs(flt: WheelFilter, columns: dict[str, np.ndarray], check_every: int = 4) -> BeliefHistory:
@@ -155,50 +175,17 @@ def replay_wheel_beliefs(flt: WheelFilter, columns: dict[str, np.ndarray], check
     segment, and so does the filter (a "restart"); the jumps the rolling told its filter are not in a
     trace, so the replay's belief may differ a little from the run's.
     """
-    part = flt.part
-    edges = np.linspace(0.0, part.perimeter, ARC_BINS + 1)
+    keep = _Keeper(flt.part)
     segment, length, turn, truth = (np.asarray(columns[k]) for k in ("segment", "length", "turn", "true_arc"))
-    rows: list[NDArray[np.float64]] = []
-    rotation: list[float] = []
-    map_arc: list[float] = []
-    stated: list[float] = []
-    true_arc: list[float] = []
-    events: list[tuple[str, float]] = []
-    taken_rows: list[tuple[float, float, float, float]] = []
-    rolled, last_turn, last_sign, belief = 0.0, 0.0, 0.0, None
     for k in range(length.size):
         if k and segment[k] != segment[k - 1]:
-            events.append(("restart", rolled))
+            keep.restart()
             flt.reset()
-            last_turn, last_sign = 0.0, 0.0
-        step = float(turn[k]) - last_turn
-        sign = math.copysign(1.0, step) if step else last_sign
-        if last_sign and sign != last_sign:
-            events.append(("turned round", rolled))
-        rolled += abs(step)
-        last_turn, last_sign = float(turn[k]), sign
+        keep.reading(float(turn[k]), math.nan, float(truth[k]))
         flt.update(float(length[k]), float(turn[k]))  # as WheelTrace.relocalize gives them
-        taken_rows.append((rolled, math.nan, float(truth[k]), float(len(rows) - 1)))
         if (k + 1) % check_every == 0 or k == length.size - 1:
-            belief = flt.belief()
-            hist, _ = np.histogram(flt.present(), bins=edges, weights=flt.posterior())
-            rows.append(hist / max(float(hist.sum()), 1e-300))
-            rotation.append(rolled)
-            map_arc.append(belief.map_arc)
-            stated.append(belief.mass)
-            true_arc.append(float(truth[k]))
-    final = belief if belief is not None else flt.belief()
-    return BeliefHistory(
-        np.asarray(rotation),
-        edges,
-        np.asarray(rows).reshape(-1, ARC_BINS),
-        np.asarray(map_arc),
-        np.asarray(stated),
-        np.asarray(true_arc),
-        events,
-        final,
-        np.asarray(taken_rows, dtype=float).reshape(-1, 4),
-    )
+            keep.check(flt.belief(), flt.present(), flt.posterior(), float(truth[k]))
+    return keep.history(keep.belief if keep.belief is not None else flt.belief())
 
 
 def plot_belief_history(

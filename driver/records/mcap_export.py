@@ -163,13 +163,7 @@ def _reactive_messages(path: str | os.PathLike[str]) -> tuple[list[Message], dic
             history = np.array(data["history"], dtype=float).reshape(-1, 4) if "history" in data.files else None
     except (OSError, ValueError):
         raise RigError(f"trace {path}: its belief history is damaged") from None
-    out: list[Message] = []
-    for k in range(c["arcs"].size):
-        t = k * READING_PERIOD
-        out.append(Message(TOPICS["wrist"], t, {"arc": float(c["arcs"][k]), "segment": int(c["segments"][k])}))
-        out.append(Message(TOPICS["arm"], t, {"turn": float(c["turns"][k])}))
-        if math.isfinite(float(c["true_arcs"][k])):
-            out.append(Message(TOPICS["truth"], t, {"true_arc": float(c["true_arcs"][k])}))
+    out = _rolling_messages(c["arcs"], c["segments"], c["turns"], c["true_arcs"])
     if history is not None and history.size:
         # each check at the first reading by which the jaw had rolled its rotation
         rolled = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(c["turns"])))])
@@ -187,13 +181,19 @@ def _reactive_messages(path: str | os.PathLike[str]) -> tuple[list[Message], dic
 
 def _wheel_messages(trace: WheelTrace) -> list[Message]:
     c = trace.columns
+    return _rolling_messages(c["length"], c["segment"], c["turn"], c["true_arc"])
+
+
+def _rolling_messages(arc: np.ndarray, segment: np.ndarray, turn: np.ndarray, true_arc: np.ndarray) -> list[Message]:
+    """A reactive rolling's or a wheel's readings, numbered :data:`READING_PERIOD` apart: the contact travel
+    given to the filter and its segment, the net turn, the truth where known."""
     out: list[Message] = []
-    for k in range(c["length"].size):
+    for k in range(arc.size):
         t = k * READING_PERIOD
-        out.append(Message(TOPICS["wrist"], t, {"arc": float(c["length"][k]), "segment": int(c["segment"][k])}))
-        out.append(Message(TOPICS["arm"], t, {"turn": float(c["turn"][k])}))
-        if math.isfinite(float(c["true_arc"][k])):
-            out.append(Message(TOPICS["truth"], t, {"true_arc": float(c["true_arc"][k])}))
+        out.append(Message(TOPICS["wrist"], t, {"arc": float(arc[k]), "segment": int(segment[k])}))
+        out.append(Message(TOPICS["arm"], t, {"turn": float(turn[k])}))
+        if math.isfinite(float(true_arc[k])):
+            out.append(Message(TOPICS["truth"], t, {"true_arc": float(true_arc[k])}))
     return out
 
 

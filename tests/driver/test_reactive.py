@@ -38,7 +38,8 @@ def trefoil():
     return part, calibration(part)
 
 
-def test_it_stops_when_sure_and_is_right(trefoil):
+@pytest.mark.parametrize("seek", [False, True])
+def test_it_stops_when_sure_and_is_right(trefoil, seek):
     part, cal = trefoil
     rig = SimRig(part, noise="none", seed=1)
     flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
@@ -48,7 +49,7 @@ def test_it_stops_when_sure_and_is_right(trefoil):
         calibration=cal,
         filter=flt,
         approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
-        policy=ReactivePolicy(confidence=0.95),
+        policy=ReactivePolicy(confidence=0.95, seek=seek),
     )
     assert run.stopped == "confident" and run.belief.mass >= 0.95
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
@@ -194,22 +195,6 @@ def test_seeking_gains_at_most_what_the_belief_lacks(trefoil):
         # within what the 64 starts weighed leave out of the belief (5%)
         assert 0 < ccw * (explored[1] - turned + math.radians(15)) <= lacks + 0.05
         assert 0 <= cw * (turned - explored[0] + math.radians(15)) <= lacks + 0.05
-
-
-def test_seeking_it_stops_when_sure_and_is_right(trefoil):
-    part, cal = trefoil
-    rig = SimRig(part, noise="none", seed=1)
-    flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
-    run = localize_reactively(
-        rig,
-        part,
-        calibration=cal,
-        filter=flt,
-        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
-        policy=ReactivePolicy(confidence=0.95, seek=True),
-    )
-    assert run.stopped == "confident"
-    assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
 
 
 def test_bad_arguments(trefoil):
