@@ -54,26 +54,11 @@ __all__ = ["TrialInputs", "Scorer", "SCORERS", "score_trial", "score_methods", "
 def fixed_readings(rolls: Sequence[RollResult], part: Part | Outline) -> dict[str, FloatArray]:
     """The fixed rolls as one step sequence: cumulative signed arc z (mm), net measured turn (rad),
     the true contact (mm), each step's signed arc, and the contact's place on the jaw (mm)."""
-    from localizer import arc_from_jaw_positions
+    from driver.jaw import step_sequence
 
-    z, turns, truth, steps, jaw = [0.0], [0.0], [rolls[0].truth[0].contact_arc], [], [rolls[0].positions[0]]
-    phi0 = rolls[0].angles[0]
-    for r in rolls:
-        sign = 1.0 if r.step > 0 else -1.0
-        for i in range(1, len(r.positions)):
-            a = sign * arc_from_jaw_positions(r.positions[i - 1 : i + 1], r.step, r.offset)
-            steps.append(a)
-            z.append(z[-1] + a)
-            turns.append(r.angles[i] - phi0)
-            truth.append(r.truth[i].contact_arc)
-            jaw.append(r.positions[i])
-    return {
-        "z": np.array(z),
-        "turn": np.array(turns),
-        "truth": np.array(truth),
-        "steps": np.array(steps),
-        "jaw": np.array(jaw),
-    }
+    seq = step_sequence([(r.positions, r.angles, r.step, r.offset) for r in rolls])
+    truth = [rolls[0].truth[0].contact_arc] + [t.contact_arc for r in rolls for t in r.truth[1 : len(r.positions)]]
+    return {**seq, "truth": np.array(truth)}
 
 
 def reading_noise(seq: dict[str, FloatArray], part: Part | Outline, noise: NoiseModel) -> tuple[float, float]:

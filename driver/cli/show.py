@@ -22,14 +22,17 @@ def register(sub: Any) -> None:
         sub,
         "show",
         show_command,
-        help="draw how a reactive rolling's belief narrowed (PNG), or animate it (GIF, MP4)",
+        help="draw how a rolling's belief narrowed (PNG), or animate it (GIF, MP4)",
         description=(
-            "Make a reactive rolling's filter calls again (a straight jaw's or a wheel's trace from 'simulate "
-            "--reactive', or a run log of 'run --reactive') and draw the belief along the part against the rotation "
-            "rolled, the truth where known, the rolling's events, and the final places on the part; or animate it."
+            "Make a rolling's filter calls again (a straight jaw's or a wheel's trace from 'simulate --reactive', "
+            "a run log of 'run --reactive', or fixed rolls given to the reactive method's filter) and draw the belief "
+            "along the part against the rotation rolled, the truth where known, the rolling's events, and the final "
+            "places on the part; or animate it."
         ),
     )
-    p.add_argument("trace", metavar="TRACE", help="a reactive trace (.npz) or run log (.jsonl)")
+    p.add_argument(
+        "trace", metavar="TRACE", help="a trace (.npz, fixed rolls or reactive, either finger) or run log (.jsonl)"
+    )
     p.add_argument("--part", required=True, help="part file (the model the run was given)")
     p.add_argument(
         "--out",
@@ -53,7 +56,7 @@ def show_command(args: argparse.Namespace) -> int:
         FILM_SUFFIXES,
         LOG_COLUMNS,
         REACTIVE_FORMAT,
-        WHEEL_FORMAT,
+        Trace,
         calls_from_events,
         check_same_part,
         plot_belief_history,
@@ -61,6 +64,7 @@ def show_command(args: argparse.Namespace) -> int:
         read_log,
         replay_beliefs,
         replay_wheel_beliefs,
+        sequence_calls,
         trace_format,
         write_film,
     )
@@ -79,22 +83,20 @@ def show_command(args: argparse.Namespace) -> int:
         history = replay_wheel_beliefs(WheelFilter(part, wheel.wheel), wheel.columns)
         radius: float | None = wheel.wheel.radius
     else:
-        if path.endswith(".jsonl"):
-            events = read_log(path)
-            columns = calls_from_events(events)
-            if columns is None:
-                raise RigError(f"run log {path} holds no filter calls: only a reactive run's log, ended, can be shown")
-            recorded, readings = events[0].get("part"), None
-        else:
-            kind = trace_format(path)
-            if kind != REACTIVE_FORMAT:
-                raise RigError(
-                    f"trace {path}: format {kind!r}; 'show' draws a reactive rolling ({REACTIVE_FORMAT}, "
-                    f"{WHEEL_FORMAT}; 'locate' localizes fixed rolls)"
-                )
+        if path.endswith(".jsonl") and (calls := calls_from_events(read_log(path))) is not None:
+            columns, recorded, readings = calls, read_log(path)[0].get("part"), None
+        elif trace_format(path) == REACTIVE_FORMAT:
             meta, columns = read_archive(path, LOG_COLUMNS)
             readings = read_archive(path, ("arcs", "turns", "true_arcs"))[1]
             recorded = meta.get("part")
+        else:  # fixed rolls: their readings given to the reactive method's filter, as the studies' grid method
+            if path.endswith(".jsonl") and any(e.get("event") == "belief" for e in read_log(path)):
+                raise RigError(f"run log {path}: a reactive run's log without its filter calls (it ended before them)")
+            trace = Trace.load(path)
+            seq = trace.step_sequence()
+            columns = sequence_calls(seq)
+            readings = {"arcs": seq["z"], "turns": seq["turn"], "true_arcs": seq["truth"]}
+            recorded = trace.metadata.get("part")
         part = load_part(args.part)
         check_same_part(recorded, part, args.part, f"trace {path}", same=args.same_part)
         history = replay_beliefs(ContactFilter(part), columns, readings)

@@ -31,7 +31,7 @@ from .reactive_policy import (
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
-from .roll_result import RollingRun, RollResult
+from .roll_result import RollingRun, RollResult, step_sequence
 from .rolling import (
     FACE_ANGLE_TOL,
     FACE_JUMP_TOL,
@@ -48,6 +48,7 @@ from .rolling import (
 from .simulated import calibrate_simulated
 
 __all__ = [
+    "step_sequence",
     "Calibration",
     "calibrate",
     "ANGLE_SLACK",

@@ -3,16 +3,44 @@ and a whole rolling run's rolls and localization."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from localizer import (
     Localization,
+    arc_from_jaw_positions,
 )
 
 from ..rig import Reading, Truth
 
-__all__ = ["RollResult", "RollingRun"]
+__all__ = ["RollResult", "RollingRun", "step_sequence"]
+
+
+def step_sequence(rolls: Sequence[tuple[ArrayLike, ArrayLike, float, float]]) -> dict[str, NDArray[np.float64]]:
+    """Fixed rolls as one step sequence, as the sequential filters take it.
+
+    ``rolls``: per roll, the contact's places on the jaw before it and after each step (mm), the arm's φ at
+    the same moments (rad), its step (rad, signed) and the jaw's edge offset (mm). Returns ``z`` (the
+    cumulative signed arc, mm, 0 first), ``turn`` (the net measured turn since the first reading, rad),
+    ``steps`` (each step's signed arc, mm) and ``jaw`` (the contact's place on the jaw at each reading, mm).
+    """
+    first_positions, first_angles = (np.asarray(v, dtype=float) for v in rolls[0][:2])
+    z, turns, steps, jaw = [0.0], [0.0], [], [float(first_positions[0])]
+    phi0 = float(first_angles[0])
+    for positions, angles, step, offset in rolls:
+        p, a = np.asarray(positions, dtype=float), np.asarray(angles, dtype=float)
+        sign = 1.0 if step > 0 else -1.0
+        for i in range(1, len(p)):
+            arc = sign * arc_from_jaw_positions(p[i - 1 : i + 1], step, offset)
+            steps.append(arc)
+            z.append(z[-1] + arc)
+            turns.append(float(a[i]) - phi0)
+            jaw.append(float(p[i]))
+    return {"z": np.array(z), "turn": np.array(turns), "steps": np.array(steps), "jaw": np.array(jaw)}
 
 
 @dataclass(frozen=True)

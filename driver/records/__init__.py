@@ -4,7 +4,14 @@ any of them as an MCAP file.
 """
 
 from .belief_film import FILM_SUFFIXES, MAX_FRAMES, write_film
-from .belief_history import ARC_BINS, BeliefHistory, plot_belief_history, replay_beliefs, replay_wheel_beliefs
+from .belief_history import (
+    ARC_BINS,
+    BeliefHistory,
+    plot_belief_history,
+    replay_beliefs,
+    replay_wheel_beliefs,
+    sequence_calls,
+)
 from .filter_log import (
     CALLS,
     FILTER_CALLS_EVENT,
@@ -31,6 +38,7 @@ __all__ = [
     "plot_belief_history",
     "replay_beliefs",
     "replay_wheel_beliefs",
+    "sequence_calls",
     "CALLS",
     "FILTER_CALLS_EVENT",
     "LOG_COLUMNS",

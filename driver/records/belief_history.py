@@ -24,7 +24,14 @@ from .filter_log import CALLS, LOG_COLUMNS, _arg
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["BeliefHistory", "replay_beliefs", "replay_wheel_beliefs", "plot_belief_history", "ARC_BINS"]
+__all__ = [
+    "BeliefHistory",
+    "replay_beliefs",
+    "replay_wheel_beliefs",
+    "sequence_calls",
+    "plot_belief_history",
+    "ARC_BINS",
+]
 
 #: Bins along the part's arc of the belief's picture (a 300 mm part: 0.4 mm a bin).
 ARC_BINS = 720
@@ -166,6 +173,23 @@ def replay_beliefs(
             mean, _ = flt.shift()
             keep.check(belief, flt.part.wrap_arc(flt.current + mean), flt.posterior(), now_true)
     return keep.history(keep.belief if keep.belief is not None else flt.belief())
+
+
+def sequence_calls(seq: dict[str, np.ndarray], check_every: int = 5) -> dict[str, np.ndarray]:
+    """Fixed rolls' step sequence (:meth:`driver.records.Trace.step_sequence`) as the calls a sequential
+    filter would have had: the first contact's place on the jaw, every later reading, and the belief asked
+    every ``check_every`` readings and at the end (a kept log, :data:`LOG_COLUMNS`)."""
+    z, turn, jaw = (np.asarray(seq[k], dtype=float) for k in ("z", "turn", "jaw"))
+    nan = math.nan
+    rows = [(CALLS.index("touch"), nan, nan, float(jaw[0]), nan)]
+    for j in range(1, z.size):
+        rows.append((CALLS.index("update"), float(z[j]), float(turn[j]), float(jaw[j]), nan))
+        if j % check_every == 0 or j == z.size - 1:
+            rows.append((CALLS.index("belief"), nan, nan, nan, nan))
+    table = np.array(rows, dtype=float).reshape(-1, len(LOG_COLUMNS))
+    out = {k: table[:, i] for i, k in enumerate(LOG_COLUMNS)}
+    out["call"] = table[:, 0].astype(np.int8)
+    return out
 
 
 def replay_wheel_beliefs(flt: WheelFilter, columns: dict[str, np.ndarray], check_every: int = 4) -> BeliefHistory:

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from localizer import arc_from_jaw_positions, check_size
 
-from ..jaw import Calibration, RollingRun
+from ..jaw import Calibration, RollingRun, step_sequence
 from ..rig import RigError
 
 __all__ = ["Trace", "COLUMNS", "FORMAT", "read_archive", "trace_format"]
@@ -238,3 +238,19 @@ class Trace:
         """Calibrated contact locations on the jaw of every reading, mm."""
         cal = self.calibration
         return np.array([cal.position(a / b) for a, b in zip(self.columns["dv2"], self.columns["dv1"])])
+
+    def step_sequence(self) -> dict[str, NDArray[np.float64]]:
+        """The rolls' readings as one step sequence (:func:`driver.jaw.step_sequence`: ``z``, ``turn``,
+        ``steps``, ``jaw``), and ``truth``, the true contact at each of its readings (NaN without truth)."""
+        rolls, jaw, truth = self.columns["roll"], self.jaw_positions(), self.columns["true_arc"]
+        picked = [np.flatnonzero(rolls == k) for k in range(len(self.metadata["steps"]))]
+        if not picked or any(sel.size < 2 for sel in picked):
+            raise RigError("a roll of the trace has fewer than two readings")
+        seq = step_sequence(
+            [
+                (jaw[sel], self.columns["phi"][sel], float(step), float(offset))
+                for sel, step, offset in zip(picked, self.metadata["steps"], self.metadata["offsets"])
+            ]
+        )
+        seq["truth"] = np.concatenate([truth[picked[0][:1]], *(truth[sel[1:]] for sel in picked)]).astype(float)
+        return seq

@@ -55,12 +55,10 @@ def test_what_show_cannot_draw_is_refused_by_name(reactive_trace, tmp_path, caps
     out = str(tmp_path / "b.png")
     assert main(["show", str(reactive_trace), "--part", str(PARTS / "cam.json"), "--out", out]) == 2
     assert "cam" in capsys.readouterr().err  # made on the trefoil
-    fixed = tmp_path / "f.npz"
-    args = ["simulate", str(PARTS / "trefoil.json"), "--start", "120", "--roll", "20", "--engine", "kinematic"]
-    assert main([*args, "--out", str(fixed)]) == 0
-    capsys.readouterr()
-    assert main(["show", str(fixed), "--part", str(PARTS / "trefoil.json"), "--out", out]) == 2
-    assert "'show' draws a reactive rolling" in capsys.readouterr().err
+    other = tmp_path / "x.npz"
+    np.savez(other, metadata=np.array('{"format": "something-else/1"}'))
+    assert main(["show", str(other), "--part", str(PARTS / "trefoil.json"), "--out", out]) == 2
+    assert "not a rolltouch trace of this kind (something-else/1)" in capsys.readouterr().err
     assert (
         main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", out, "--jaw", "wheel:5"])
         == 2
@@ -119,3 +117,26 @@ def test_a_wheel_rolling_is_shown_and_animated(tmp_path, capsys):
         assert main(["show", str(trace_file), "--part", str(PARTS / "kidney.csv"), "--out", str(out)]) == 0
     with Image.open(tmp_path / "w.gif") as gif:
         assert gif.n_frames == min(trace.columns["length"].size, 160)
+
+
+def test_fixed_rolls_are_shown_as_the_reactive_filter_takes_them(tmp_path):
+    from driver.records import Trace, sequence_calls
+
+    trace_file = tmp_path / "f.npz"
+    args = ["simulate", str(PARTS / "trefoil.json"), "--start", "120", "--roll", "20", "--roll", "15"]
+    assert main([*args, "--noise", "paper", "--engine", "kinematic", "--out", str(trace_file)]) == 0
+    part = load_part(PARTS / "trefoil.json")
+    seq = Trace.load(trace_file).step_sequence()
+    assert seq["z"].size == seq["truth"].size == round(35 / 0.2) + 1
+    # the filter fed the readings by hand: the history's last belief is its belief
+    flt = ContactFilter(part)
+    flt.touch(float(seq["jaw"][0]))
+    for j in range(1, seq["z"].size):
+        flt.update(float(seq["z"][j]), float(seq["turn"][j]), float(seq["jaw"][j]))
+    readings = {"arcs": seq["z"], "turns": seq["turn"], "true_arcs": seq["truth"]}
+    history = replay_beliefs(ContactFilter(part), sequence_calls(seq), readings)
+    assert history.rotation.size == 35  # a check every fifth reading
+    assert history.final.map_arc == pytest.approx(flt.belief().map_arc, abs=0.05)
+    assert history.true_arc[-1] == pytest.approx(seq["truth"][-1])
+    out = tmp_path / "f.png"
+    assert main(["show", str(trace_file), "--part", str(PARTS / "trefoil.json"), "--out", str(out)]) == 0
