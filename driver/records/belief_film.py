@@ -140,11 +140,12 @@ def write_film(
                 hub = p + wheel_radius * np.array([e[1], -e[0]])
                 jaw_line.set_data(hub[0] + wheel_radius * circle.real, hub[1] + wheel_radius * circle.imag)
             contact.set_data([p[0]], [p[1]])
-        for label, (arc, share) in zip(labels, _places(mass, history.edges) if c >= 0 else []):
+        places = _places(mass, history.edges) if c >= 0 else []
+        for label, (arc, share) in zip(labels, places):
             xy = part.point_at_arc(arc)
             label.set_position((float(xy[0]), float(xy[1])))
             label.set_text(f" {share:.0%}")
-        for label in labels[len(_places(mass, history.edges)) if c >= 0 else 0 :]:
+        for label in labels[len(places) :]:
             label.set_text("")
         stated = history.stated[c] if c >= 0 else 0.0
         title.set_text(f"{part.name}: {math.degrees(rotation):.0f}° rolled, {stated:.0%} within the radius")
