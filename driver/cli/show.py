@@ -104,7 +104,7 @@ def show_command(args: argparse.Namespace) -> int:
     if not history.rotation.size:
         raise RigError(f"trace {path}: the rolling never asked its belief; nothing to draw")
     if str(args.out).lower().endswith(".png"):
-        plot_belief_history(part, history, args.out)
+        plot_belief_history(part, history, args.out, wheel_radius=radius)
         drawn = f"{history.rotation.size} checks"
     else:
         drawn = f"{write_film(part, history, args.out, fps=args.fps, wheel_radius=radius)} frames"

@@ -7,6 +7,7 @@ from .belief_film import FILM_SUFFIXES, MAX_FRAMES, write_film
 from .belief_history import (
     ARC_BINS,
     BeliefHistory,
+    finger_outline,
     plot_belief_history,
     replay_beliefs,
     replay_wheel_beliefs,
@@ -39,6 +40,7 @@ __all__ = [
     "replay_beliefs",
     "replay_wheel_beliefs",
     "sequence_calls",
+    "finger_outline",
     "CALLS",
     "FILTER_CALLS_EVENT",
     "LOG_COLUMNS",

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from localizer import DEFAULT_JAW, Outline, Part
 
 from ..rig import RigError
-from .belief_history import BeliefHistory
+from .belief_history import BeliefHistory, finger_outline
 
 __all__ = ["write_film", "MAX_FRAMES", "FILM_SUFFIXES"]
 
@@ -109,7 +109,6 @@ def write_film(
     cmap = matplotlib.colormaps["Reds"].with_extremes(bad=(0.0, 0.0, 0.0, 0.0))  # no belief: the part shows
     band = ax.scatter(ring[:, 0], ring[:, 1], c=np.zeros(len(ring)), cmap=cmap, vmin=0, vmax=1, s=30, zorder=5)
     (jaw_line,) = ax.plot([], [], "-", color="tab:blue", lw=4, alpha=0.8, solid_capstyle="butt", zorder=4)
-    circle = np.exp(1j * np.linspace(0.0, 2.0 * math.pi, 49))
     (contact,) = ax.plot([], [], "o", color="tab:blue", ms=5, mfc="none", zorder=6)
     labels = [ax.text(0, 0, "", fontsize=9, color="darkred", zorder=6) for _ in range(3)]
     title = ax.set_title("", fontsize=10)
@@ -129,16 +128,9 @@ def write_film(
         band.set_array(np.ma.masked_less(mass / max(float(mass.max()), 1e-300), 0.02))
         where = true_arc if math.isfinite(true_arc) else (history.map_arc[c] if c >= 0 else math.nan)
         if math.isfinite(where):
+            outline = finger_outline(part, float(where), float(jaw), wheel_radius)
+            jaw_line.set_data(outline[:, 0], outline[:, 1])
             p = part.point_at_arc(where)
-            angle = float(part.tangent_angle_at_arc(where))
-            e = np.array([math.cos(angle), math.sin(angle)])
-            if wheel_radius is None:  # the jaw along the tangent, the contact at its measured place on it
-                centre = p - (jaw if math.isfinite(jaw) else 0.0) * e
-                ends = np.array([centre - half * e, centre + half * e])
-                jaw_line.set_data(ends[:, 0], ends[:, 1])
-            else:  # the disc outside the part, touching it at the contact (outward normal: the tangent turned -90°)
-                hub = p + wheel_radius * np.array([e[1], -e[0]])
-                jaw_line.set_data(hub[0] + wheel_radius * circle.real, hub[1] + wheel_radius * circle.imag)
             contact.set_data([p[0]], [p[1]])
         places = _places(mass, history.edges) if c >= 0 else []
         for label, (arc, share) in zip(labels, places):

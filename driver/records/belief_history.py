@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from localizer import Belief, Boundary, ContactFilter, Outline, Part, WheelFilter
+from localizer import DEFAULT_JAW, Belief, Boundary, ContactFilter, Outline, Part, WheelFilter
 
 from .filter_log import CALLS, LOG_COLUMNS, _arg
 
@@ -29,6 +29,7 @@ __all__ = [
     "replay_beliefs",
     "replay_wheel_beliefs",
     "sequence_calls",
+    "finger_outline",
     "plot_belief_history",
     "ARC_BINS",
 ]
@@ -212,8 +213,32 @@ def replay_wheel_beliefs(flt: WheelFilter, columns: dict[str, np.ndarray], check
     return keep.history(keep.belief if keep.belief is not None else flt.belief())
 
 
+def finger_outline(part: Boundary, arc: float, jaw: float, wheel_radius: float | None = None) -> FloatArray:
+    """The finger touching the part at ``arc`` (mm), as points (n, 2) mm to draw: the straight jaw along the
+    tangent there with the contact ``jaw`` mm along it (0 where NaN), or a wheel of ``wheel_radius`` mm
+    outside the part (its hub along the outward normal: the tangent turned −90°)."""
+    p = part.point_at_arc(arc)
+    angle = float(part.tangent_angle_at_arc(arc))
+    e = np.array([math.cos(angle), math.sin(angle)])
+    if wheel_radius is None:
+        centre = p - (jaw if math.isfinite(jaw) else 0.0) * e
+        return np.array([centre - DEFAULT_JAW.half * e, centre + DEFAULT_JAW.half * e])
+    hub = p + wheel_radius * np.array([e[1], -e[0]])
+    t = np.linspace(0.0, 2.0 * math.pi, 49)
+    return np.column_stack([hub[0] + wheel_radius * np.cos(t), hub[1] + wheel_radius * np.sin(t)])
+
+
+#: How many moments of the rolling the picture draws the finger at, beside the belief.
+FINGER_MOMENTS = 4
+
+
 def plot_belief_history(
-    part: Part | Outline, history: BeliefHistory, path: str | os.PathLike[str], *, title: str = ""
+    part: Part | Outline,
+    history: BeliefHistory,
+    path: str | os.PathLike[str],
+    *,
+    title: str = "",
+    wheel_radius: float | None = None,
 ) -> None:
     """Draw ``history`` to the PNG ``path``: the belief along the part's arc against the rotation rolled (darker
     is more probable, each check against its own most probable place; the truth a line, the most probable
@@ -260,6 +285,17 @@ def plot_belief_history(
     ax_p.set_ylabel(f"P(within {history.final.radius:g} mm)", fontsize=8)
     ax_p.grid(alpha=0.3)
     draw_part(ax_part, part)
+    # the finger at a few moments, fainter the earlier, where the contact was (the truth, else the estimate)
+    rows = history.readings
+    for n, k in enumerate(np.linspace(0, rows.shape[0] - 1, FINGER_MOMENTS).round().astype(int) if rows.size else []):
+        rotation, jaw, true_arc, check = rows[k]
+        arc = true_arc if math.isfinite(true_arc) else history.map_arc[max(int(check), 0)]
+        xy = finger_outline(part, float(arc), float(jaw), wheel_radius)
+        alpha = 0.25 + 0.6 * n / max(FINGER_MOMENTS - 1, 1)
+        ax_part.plot(xy[:, 0], xy[:, 1], "-", color="tab:blue", lw=2.5, alpha=alpha, solid_capstyle="butt")
+        ax_part.annotate(
+            f"{math.degrees(rotation):.0f}°", (float(xy[-1, 0]), float(xy[-1, 1])), fontsize=7, color="tab:blue"
+        )
     for k, m in enumerate(history.final.modes[:4]):
         xy = part.point_at_arc(m.arc)
         ax_part.plot(*xy, "*", ms=14 if k == 0 else 9, color="tab:red", alpha=1.0 if k == 0 else 0.6)
@@ -273,7 +309,11 @@ def plot_belief_history(
         )
     if np.isfinite(history.true_arc[-1]):
         ax_part.plot(*part.point_at_arc(history.true_arc[-1]), "o", mfc="none", color="tab:blue", ms=10)
-    ax_part.set_title("the final places, each with its share of the belief;\nthe truth (blue circle)", fontsize=9)
+    ax_part.set_title(
+        "the finger at a few moments (blue), the final places\n"
+        "with their shares of the belief (red), the truth (circle)",
+        fontsize=9,
+    )
     ax_part.set_aspect("equal")
     ax_part.axis("off")
     fig.savefig(path, dpi=110)

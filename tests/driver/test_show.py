@@ -140,3 +140,27 @@ def test_fixed_rolls_are_shown_as_the_reactive_filter_takes_them(tmp_path):
     assert history.true_arc[-1] == pytest.approx(seq["truth"][-1])
     out = tmp_path / "f.png"
     assert main(["show", str(trace_file), "--part", str(PARTS / "trefoil.json"), "--out", str(out)]) == 0
+
+
+@pytest.mark.parametrize("arc", [10.0, 66.0, 150.0])
+def test_the_finger_is_drawn_touching_the_part_where_the_contact_is(arc):
+    from driver.records import finger_outline
+
+    part = load_part(PARTS / "kidney.csv")
+    p = part.point_at_arc(arc)
+    angle = float(part.tangent_angle_at_arc(arc))
+    e = np.array([np.cos(angle), np.sin(angle)])
+    a, b = finger_outline(
+        part, arc, -12.0
+    )  # the straight jaw: 100 mm along the tangent, the contact 12 mm before its middle
+    assert np.linalg.norm(b - a) == pytest.approx(100.0)
+    assert (b - a)[0] * e[1] - (b - a)[1] * e[0] == pytest.approx(0.0, abs=1e-9)  # along the tangent
+    assert np.dot(p - 0.5 * (a + b), e) == pytest.approx(-12.0)
+    assert (p - a)[0] * e[1] - (p - a)[1] * e[0] == pytest.approx(0.0, abs=1e-9)  # through the contact
+    disc = finger_outline(part, arc, float("nan"), wheel_radius=5.0)
+    hub = disc[:-1].mean(axis=0)  # the outline closes on its first point
+    assert np.allclose(np.linalg.norm(disc - hub, axis=1), 5.0, atol=0.05)
+    assert np.linalg.norm(p - hub) == pytest.approx(5.0, abs=0.05)
+    # outside: no point of the part is nearer the hub than the disc's radius
+    ring = part.point_at_arc(np.linspace(0.0, part.perimeter, 2000, endpoint=False))
+    assert np.min(np.linalg.norm(ring - hub, axis=1)) > 5.0 - 0.05
