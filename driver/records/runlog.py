@@ -31,7 +31,7 @@ from localizer import check_size
 
 from ..rig import RigError
 
-__all__ = ["RunLog", "read_log", "LOG_FORMAT"]
+__all__ = ["RunLog", "read_log", "LOG_FORMAT", "check_event", "check_calibration"]
 
 LOG_FORMAT = "rolltouch-log/1"
 
@@ -116,3 +116,48 @@ def read_log(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     if not events or events[0].get("event") != "start" or events[0].get("format") != LOG_FORMAT:
         raise RigError(f"run log {path}: not a rolltouch run log (no '{LOG_FORMAT}' start event)")
     return events
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def check_event(
+    path: str | os.PathLike[str],
+    k: int,
+    event: dict[str, Any],
+    whole: tuple[str, ...] = (),
+    numbers: tuple[str, ...] = (),
+) -> None:
+    """Refuse, naming the event and the field, a logged event whose ``whole`` fields are not whole numbers or
+    whose ``numbers`` are not numbers (or null: a value the rig could not read), where they are present.
+
+    Raises
+    ------
+    RigError
+    """
+    for key in whole:
+        if key in event and not (isinstance(event[key], int) and not isinstance(event[key], bool)):
+            raise RigError(
+                f"run log {path}: event {k + 1} ({event.get('event')}) has {key}={event[key]!r}, not a whole number"
+            )
+    for key in numbers:
+        if key in event and event[key] is not None and not _number(event[key]):
+            raise RigError(
+                f"run log {path}: event {k + 1} ({event.get('event')}) has {key}={event[key]!r}, not a number"
+            )
+
+
+def check_calibration(path: str | os.PathLike[str], cal: object, keys: tuple[str, ...]) -> dict[str, Any]:
+    """A logged calibration: a JSON object holding ``keys``, each a number or a list of numbers; else a RigError
+    naming what is wrong."""
+    if not isinstance(cal, dict):
+        raise RigError(f"run log {path}: its calibration is {type(cal).__name__}, not a JSON object")
+    missing = [key for key in keys if key not in cal]
+    if missing:
+        raise RigError(f"run log {path}: its calibration has no {', '.join(missing)}")
+    for key in keys:
+        value = cal[key]
+        if not (_number(value) or (isinstance(value, list) and all(_number(v) for v in value))):
+            raise RigError(f"run log {path}: its calibration's {key}={value!r} is not a number or a list of numbers")
+    return cal

@@ -137,7 +137,7 @@ class Trace:
 
         Rolls that the log shows begun but without two readings are dropped.
         """
-        from .runlog import read_log
+        from .runlog import check_calibration, check_event, read_log
 
         events = read_log(path)
         start = events[0]
@@ -152,6 +152,8 @@ class Trace:
             missing = [key for key in need.get(e.get("event"), ()) if key not in e]
             if missing:
                 raise RigError(f"run log {path}: event {k + 1} ({e.get('event')}) has no {', '.join(missing)}")
+            if e.get("event") in need:
+                check_event(path, k, e, whole=("roll",), numbers=(*COLUMNS[2:], "offset"))
         rolls = {e["roll"]: e for e in events if e.get("event") == "roll"}
         rows = [e for e in events if e.get("event") == "reading"]
         counts: dict[int, int] = {}
@@ -168,7 +170,10 @@ class Trace:
         meta = {k: v for k, v in start.items() if k not in ("event", "format", "time")}
         cal = [e for e in events if e.get("event") == "calibration"]
         if cal and "calibration" not in meta:
-            meta["calibration"] = {k: cal[0][k] for k in ("positions", "ratios", "target")}
+            meta["calibration"] = cal[0]
+        if "calibration" in meta:
+            found = check_calibration(path, meta["calibration"], ("positions", "ratios", "target"))
+            meta["calibration"] = {k: found[k] for k in ("positions", "ratios", "target")}
         meta.update(
             {
                 "format": FORMAT,

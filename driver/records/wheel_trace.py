@@ -71,7 +71,7 @@ class WheelTrace:
     def from_log(cls, path: str | os.PathLike[str]) -> WheelTrace:
         """A trace from a wheel's run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not: its
         ``reading`` events (L, Ω) and the calibration it logged."""
-        from .runlog import read_log
+        from .runlog import check_event, read_log
 
         events = read_log(path)
         start = events[0]
@@ -84,9 +84,14 @@ class WheelTrace:
         ]
         if bad:
             raise RigError(f"run log {path}: reading {bad[0] + 1} has no length and turn")
+        for k, e in enumerate(events):
+            if e.get("event") == "reading":
+                check_event(path, k, e, whole=("segment",), numbers=("length", "turn"))
         cal = start.get("calibration") or next((e for e in events if e.get("event") == "calibration"), None)
         if cal is None:
             raise RigError(f"run log {path}: it logged no calibration")
+        if not isinstance(cal, dict):
+            raise RigError(f"run log {path}: its calibration is {type(cal).__name__}, not a JSON object")
         columns = {
             "segment": np.array([int(e.get("segment", 0)) for e in rows], dtype=np.int64),
             "length": np.array([e["length"] for e in rows], dtype=float),

@@ -162,6 +162,46 @@ def test_locate_bad_trace(tmp_path, capsys):
         Trace.load(tmp_path / "missing.npz")
 
 
+START = {"event": "start", "format": "rolltouch-log/1", "calibration": {"positions": [0], "ratios": [1], "target": 1}}
+ROLL = {"event": "roll", "roll": 0, "step": 0.1, "offset": 1.0}
+
+
+def reading(**change):
+    return {"event": "reading", "roll": 0, "step": 0, "dv1": 1.0, "dv2": 0.5, "phi": 0.0, **change}
+
+
+@pytest.mark.parametrize(
+    "events, jaw, match",
+    [
+        ([START, {**ROLL, "roll": [1]}], "straight", r"event 2 \(roll\) has roll=\[1\], not a whole number"),
+        (
+            [START, ROLL, reading(dv1="x"), reading(step=1)],
+            "straight",
+            "event 3 \\(reading\\) has dv1='x', not a number",
+        ),
+        ([{**START, "calibration": {"positions": [0]}}], "straight", "its calibration has no ratios, target"),
+        (
+            [{**START, "calibration": {"positions": "x", "ratios": [1], "target": 1}}],
+            "straight",
+            "positions='x' is not",
+        ),
+        ([{**START, "jaw": "wheel:5", "calibration": "x"}], "wheel", "its calibration is str, not a JSON object"),
+        (
+            [{**START, "jaw": "wheel:5"}, {"event": "reading", "length": 1.0, "turn": 0.1, "segment": "a"}],
+            "wheel",
+            "has segment='a', not a whole number",
+        ),
+    ],
+)
+def test_a_malformed_run_log_is_refused_naming_the_event_and_field(tmp_path, events, jaw, match):
+    from driver.records import WheelTrace
+
+    log = tmp_path / "bad.jsonl"
+    log.write_text("".join(json.dumps(e) + "\n" for e in events))
+    with pytest.raises(RigError, match=match):
+        (WheelTrace if jaw == "wheel" else Trace).load(log)
+
+
 def test_a_start_the_jaw_cannot_be_laid_on_is_refused_before_anything_moves(tmp_path, capsys):
     from localizer import load_part
 
