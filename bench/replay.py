@@ -288,30 +288,17 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def log_columns(calls: Sequence[Call]) -> dict[str, np.ndarray]:
-    """Recorded calls as the kept log's columns (:data:`driver.records.LOG_COLUMNS`), which
+    """Recorded calls as the kept log's columns (:func:`driver.records.log_table`), which
     :func:`driver.records.replay_log` and :func:`driver.records.replay_beliefs` make again."""
-    from driver.records import CALLS, LOG_COLUMNS
+    from driver.records import log_table
+    from localizer import BRIDGE_JUMP
 
-    def number(x: object) -> float:
-        return math.nan if x is None else float(x)  # type: ignore[arg-type]
-
-    rows = []
+    kept = []
     for name, args, kwargs in calls:
         given = dict(zip(_SIGNATURES[name], args)) | kwargs
-        value = given.get("jump", given.get("radius"))
-        rows.append(
-            (
-                CALLS.index(name),
-                number(given.get("arc")),
-                number(given.get("turn")),
-                number(given.get("jaw")),
-                number(value),
-            )
-        )
-    table = np.array(rows, dtype=float).reshape(-1, len(LOG_COLUMNS))
-    out = {k: table[:, i] for i, k in enumerate(LOG_COLUMNS)}
-    out["call"] = table[:, 0].astype(np.int8)
-    return out
+        value = given.get("jump", BRIDGE_JUMP) if name == "bridged" else given.get("radius")
+        kept.append((name, given.get("arc"), given.get("turn"), given.get("jaw"), value))
+    return log_table(kept)
 
 
 #: The positional parameters of each recorded call, by name.

@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from sim2d import WheelRig
 
     from ..jaw import Calibration
-    from ..records import RunLog
+    from ..records import RunLog, RunRecord
     from ..wheel import WheelCalibration, WheelPolicy, WheelRun
 
 __all__ = [
@@ -217,13 +217,13 @@ def run_wheel(
     return _emit(args, doc, part, run, None)
 
 
-def locate_wheel(args: argparse.Namespace, path: str) -> int:
-    """'locate TRACE --part PART' of a wheel's trace: its readings replayed into the filter for its finger."""
+def locate_wheel(args: argparse.Namespace, record: RunRecord) -> int:
+    """'locate TRACE --part PART' of a wheel's trace or run log: its readings replayed into the filter for its
+    finger."""
     from localizer import load_part
 
-    from ..records import WheelTrace
-
-    trace = WheelTrace.load(path)
+    path = record.path
+    trace = record.wheel()
     if args.jaw is not None and str(args.jaw) != trace.metadata["jaw"]:
         raise RigError(f"trace {path} is of a {trace.metadata['jaw']} finger, not of {args.jaw}")
     part = load_part(args.part)

@@ -28,11 +28,10 @@ from localizer import (
 
 from ..records import (
     CALLS,
-    LOG_COLUMNS,
-    REACTIVE_FORMAT,
     SAME_PART_FLAG,
-    calls_from_events,
     check_same_part,
+    open_record,
+    reactive_calls,
     replay_log,
 )
 from ..rig import RigError
@@ -204,37 +203,18 @@ def localize_command(args: argparse.Namespace) -> int:
 
 
 def locate_command(args: argparse.Namespace) -> int:
-    from driver.records import WHEEL_FORMAT, Trace, trace_format
-
     check_before_moving(args, {"plot": PLOT_SUFFIXES})
-    if str(args.trace).endswith(".jsonl"):
-        from driver.records import read_log
-
-        events = read_log(args.trace)
-        if str(events[0].get("jaw", "straight")).startswith("wheel"):
-            return locate_wheel(args, args.trace)
-        columns = calls_from_events(events)
-        if columns is not None:
-            result: dict[str, Any] = next((e for e in reversed(events) if e.get("event") == "result"), {})
-            meta = {**result, "part": events[0].get("part")}
-            return locate_reactive(args, args.trace, meta, columns, np.array([], dtype=float))
-        if any(e.get("event") == "belief" for e in events):
-            raise RigError(
-                f"run log {args.trace} is of a reactive run whose filter calls it does not hold (the run ended "
-                "before its result, or was logged before they were): its last belief event is its answer"
-            )
-    elif trace_format(args.trace) == WHEEL_FORMAT:
-        return locate_wheel(args, args.trace)
-    elif trace_format(args.trace) == REACTIVE_FORMAT:
-        from driver.records import read_archive
-
-        meta, columns = read_archive(args.trace, LOG_COLUMNS)
-        truth = read_archive(args.trace, ("true_arcs",))[1]["true_arcs"]  # one per reading: another length
+    record = open_record(args.trace)
+    if record.kind == "wheel":
+        return locate_wheel(args, record)
+    if record.kind == "reactive":
+        meta, columns, readings = reactive_calls(record)
+        truth = readings["true_arcs"] if readings is not None else np.array([], dtype=float)
         return locate_reactive(args, args.trace, meta, columns, truth)
     if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
         raise RigError(f"trace {args.trace} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
     part = load_part(args.part)
-    trace = Trace.load(args.trace)
+    trace = record.fixed()
     check_same_part(trace.metadata.get("part"), part, args.part, f"trace {args.trace}", same=args.same_part)
     if not trace.metadata["steps"]:
         raise RigError(f"trace {args.trace} holds no roll: nothing to localize from")

@@ -3,15 +3,12 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from ..rig import RigError
 from ._options import UsageError, add_command, jaw_argument, writable_file
-
-if TYPE_CHECKING:
-    from ..records import WheelTrace
 
 __all__ = ["register", "show_command"]
 
@@ -54,18 +51,13 @@ def show_command(args: argparse.Namespace) -> int:
 
     from ..records import (
         FILM_SUFFIXES,
-        LOG_COLUMNS,
-        REACTIVE_FORMAT,
-        Trace,
-        calls_from_events,
         check_same_part,
+        open_record,
         plot_belief_history,
-        read_archive,
-        read_log,
+        reactive_calls,
         replay_beliefs,
         replay_wheel_beliefs,
         sequence_calls,
-        trace_format,
         write_film,
     )
 
@@ -73,34 +65,28 @@ def show_command(args: argparse.Namespace) -> int:
     if not 1 <= args.fps <= 60:
         raise UsageError(f"--fps {args.fps} must be from 1 to 60")
     path = str(args.trace)
-    wheel = _wheel_record(path)
+    record = open_record(path)
+    wheel = record.wheel() if record.kind == "wheel" else None
     finger = wheel.metadata["jaw"] if wheel is not None else str(DEFAULT_JAW)
     if args.jaw is not None and str(args.jaw) != finger:
         raise RigError(f"trace {path} is of the {finger} finger, not of --jaw {args.jaw}")
+    radius: float | None = None
     if wheel is not None:
         part = load_part(args.part)
         check_same_part(wheel.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
         history = replay_wheel_beliefs(WheelFilter(part, wheel.wheel), wheel.columns)
-        radius: float | None = wheel.wheel.radius
+        radius = wheel.wheel.radius
     else:
-        if path.endswith(".jsonl") and (calls := calls_from_events(read_log(path))) is not None:
-            columns, recorded, readings = calls, read_log(path)[0].get("part"), None
-        elif trace_format(path) == REACTIVE_FORMAT:
-            meta, columns = read_archive(path, LOG_COLUMNS)
-            readings = read_archive(path, ("arcs", "turns", "true_arcs"))[1]
-            recorded = meta.get("part")
+        if record.kind == "reactive":
+            meta, columns, readings = reactive_calls(record)
         else:  # fixed rolls: their readings given to the reactive method's filter, as the studies' grid method
-            if path.endswith(".jsonl") and any(e.get("event") == "belief" for e in read_log(path)):
-                raise RigError(f"run log {path}: a reactive run's log without its filter calls (it ended before them)")
-            trace = Trace.load(path)
+            trace = record.fixed()
             seq = trace.step_sequence()
-            columns = sequence_calls(seq)
+            meta, columns = trace.metadata, sequence_calls(seq)
             readings = {"arcs": seq["z"], "turns": seq["turn"], "true_arcs": seq["truth"]}
-            recorded = trace.metadata.get("part")
         part = load_part(args.part)
-        check_same_part(recorded, part, args.part, f"trace {path}", same=args.same_part)
+        check_same_part(meta.get("part"), part, args.part, f"trace {path}", same=args.same_part)
         history = replay_beliefs(ContactFilter(part), columns, readings)
-        radius = None
     if not history.rotation.size:
         raise RigError(f"trace {path}: the rolling never asked its belief; nothing to draw")
     if str(args.out).lower().endswith(".png"):
@@ -114,15 +100,3 @@ def show_command(args: argparse.Namespace) -> int:
         f"the last belief {b.mass:.1%} within {b.radius:g} mm of arc {b.map_arc:.2f} mm"
     )
     return 0
-
-
-def _wheel_record(path: str) -> WheelTrace | None:
-    """The wheel's trace or run log at ``path``, or None if it is a straight jaw's record."""
-    from ..records import WHEEL_FORMAT, WheelTrace, read_log, trace_format
-
-    if path.endswith(".jsonl"):
-        if not str(read_log(path)[0].get("jaw", "straight")).startswith("wheel"):
-            return None
-    elif trace_format(path) != WHEEL_FORMAT:
-        return None
-    return WheelTrace.load(path)

@@ -21,11 +21,13 @@ from .filter_log import (
     LoggedFilter,
     calls_event,
     calls_from_events,
+    log_table,
     replay_log,
 )
 from .mcap_export import READING_PERIOD, SCHEMAS, TOPICS, Message, export_mcap, run_messages, write_mcap
 from .part_match import SAME_PART_FLAG, PartMismatch, check_same_part, part_record
 from .plotting import draw_part, plot_localization, plot_reactive, plot_run
+from .run_record import RECORD_KINDS, RunRecord, open_record, reactive_calls
 from .runlog import LOG_FORMAT, RunLog, read_log
 from .trace import COLUMNS, FORMAT, Trace, read_archive, trace_format
 from .wheel_trace import WHEEL_COLUMNS, WHEEL_FORMAT, WheelTrace
@@ -49,6 +51,7 @@ __all__ = [
     "calls_event",
     "calls_from_events",
     "replay_log",
+    "log_table",
     "READING_PERIOD",
     "SCHEMAS",
     "TOPICS",
@@ -64,6 +67,10 @@ __all__ = [
     "plot_localization",
     "plot_reactive",
     "plot_run",
+    "RECORD_KINDS",
+    "RunRecord",
+    "open_record",
+    "reactive_calls",
     "LOG_FORMAT",
     "RunLog",
     "read_log",

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from localizer import DEFAULT_JAW, Outline, Part
 
 from ..rig import RigError
-from .belief_history import BeliefHistory, finger_outline
+from .belief_history import BeliefHistory, finger_outline, stated_axes
 
 __all__ = ["write_film", "MAX_FRAMES", "FILM_SUFFIXES"]
 
@@ -115,11 +115,7 @@ def write_film(
     deg = np.degrees(history.rotation)
     ax_p.plot(deg, history.stated, "-", color="0.8", lw=1)
     (grown,) = ax_p.plot([], [], "-", color="tab:red", lw=1.6)
-    ax_p.set_xlim(0.0, max(float(deg[-1]), 1.0))
-    ax_p.set_ylim(0.0, 1.02)
-    ax_p.set_xlabel("rotation rolled, degrees")
-    ax_p.set_ylabel(f"P(within {history.final.radius:g} mm)", fontsize=8)
-    ax_p.grid(alpha=0.3)
+    stated_axes(ax_p, history, max(float(deg[-1]), 1.0))
 
     def draw(k: int) -> list[Artist]:
         rotation, jaw, true_arc, check = readings[k]

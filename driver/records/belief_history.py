@@ -1,10 +1,11 @@
-"""How a reactive rolling's belief narrowed: its filter calls made again, the belief kept at every check, and
-drawn as one picture.
+"""How a rolling's belief narrowed: its filter calls made again, the belief kept at every check, and drawn
+as one picture.
 
-:func:`replay_beliefs` makes the kept calls of a straight jaw's reactive rolling
-(:meth:`driver.records.LoggedFilter.columns`) on a fresh filter, as :func:`driver.records.replay_log` does,
-and at every ``belief`` call (every check of the rolling) keeps the belief over the present contact as a
-histogram along the part's arc, with the rotation rolled by then. :func:`plot_belief_history` draws it:
+:func:`replay_beliefs` makes the kept calls of a straight jaw's rolling (a reactive rolling's
+:meth:`driver.records.LoggedFilter.columns`, or fixed rolls' :func:`sequence_calls`) on a fresh filter with
+:func:`driver.records.replay_log`, and at every ``belief`` call (every check of the rolling) keeps the belief
+over the present contact as a histogram along the part's arc, with the rotation rolled by then;
+:func:`replay_wheel_beliefs` does the same with a wheel's readings. :func:`plot_belief_history` draws it:
 the belief as an image (rotation across, arc on the part up), the truth over it where known, the
 events of the rolling marked, and beside it the part with the final places and their probabilities.
 """
@@ -13,14 +14,17 @@ from __future__ import annotations
 
 import math
 import os
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from localizer import DEFAULT_JAW, Belief, Boundary, ContactFilter, Outline, Part, WheelFilter
 
-from .filter_log import CALLS, LOG_COLUMNS, _arg
+from .filter_log import KeptCall, log_table, replay_log
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 FloatArray = NDArray[np.float64]
 
@@ -30,6 +34,7 @@ __all__ = [
     "replay_wheel_beliefs",
     "sequence_calls",
     "finger_outline",
+    "stated_axes",
     "plot_belief_history",
     "ARC_BINS",
 ]
@@ -146,34 +151,26 @@ def replay_beliefs(
         else (np.zeros(0), np.zeros(0), np.zeros(0))
     )
     found, now_true = 0, float(rows_true[0]) if rows_true.size else math.nan
-    for code, arc, turn, jaw, value in zip(*(np.asarray(columns[c]) for c in LOG_COLUMNS), strict=True):
-        name = CALLS[int(code)]
+
+    def observe(name: str, arc: float, turn: float, jaw: float, value: float, belief: Belief | None) -> None:
+        nonlocal found, now_true
         if name in ("update", "regrasp"):
-            match = np.flatnonzero(
-                (np.abs(rows_turn[found:] - float(turn)) < 1e-12) & (np.abs(rows_arc[found:] - float(arc)) < 1e-9)
-            )
+            match = np.flatnonzero((np.abs(rows_turn[found:] - turn) < 1e-12) & (np.abs(rows_arc[found:] - arc) < 1e-9))
             if match.size:
                 found += int(match[0]) + 1
                 now_true = float(rows_true[found - 1])
-            keep.reading(float(turn), float(jaw), now_true)  # jaw: NaN where not given
+            keep.reading(turn, jaw, now_true)  # jaw: NaN where not given
             if name == "regrasp":
                 keep.event("regrasp")
-                flt.regrasp(float(arc), float(turn), _arg(jaw))
-            else:
-                flt.update(float(arc), float(turn), _arg(jaw))
         elif name == "reset":
             keep.restart()
-            flt.reset()
-        elif name == "touch":
-            flt.touch(float(jaw))
         elif name == "bridged":
             keep.event("bridge")
-            flt.bridged(float(turn), _arg(jaw), float(value))
-        else:
-            belief = flt.belief(_arg(value))
+        elif belief is not None:
             mean, _ = flt.shift()
             keep.check(belief, flt.part.wrap_arc(flt.current + mean), flt.posterior(), now_true)
-    return keep.history(keep.belief if keep.belief is not None else flt.belief())
+
+    return keep.history(replay_log(flt, columns, observe))
 
 
 def sequence_calls(seq: dict[str, np.ndarray], check_every: int = 5) -> dict[str, np.ndarray]:
@@ -181,16 +178,12 @@ def sequence_calls(seq: dict[str, np.ndarray], check_every: int = 5) -> dict[str
     filter would have had: the first contact's place on the jaw, every later reading, and the belief asked
     every ``check_every`` readings and at the end (a kept log, :data:`LOG_COLUMNS`)."""
     z, turn, jaw = (np.asarray(seq[k], dtype=float) for k in ("z", "turn", "jaw"))
-    nan = math.nan
-    rows = [(CALLS.index("touch"), nan, nan, float(jaw[0]), nan)]
+    calls: list[KeptCall] = [("touch", None, None, float(jaw[0]), None)]
     for j in range(1, z.size):
-        rows.append((CALLS.index("update"), float(z[j]), float(turn[j]), float(jaw[j]), nan))
+        calls.append(("update", float(z[j]), float(turn[j]), float(jaw[j]), None))
         if j % check_every == 0 or j == z.size - 1:
-            rows.append((CALLS.index("belief"), nan, nan, nan, nan))
-    table = np.array(rows, dtype=float).reshape(-1, len(LOG_COLUMNS))
-    out = {k: table[:, i] for i, k in enumerate(LOG_COLUMNS)}
-    out["call"] = table[:, 0].astype(np.int8)
-    return out
+            calls.append(("belief", None, None, None, None))
+    return log_table(calls)
 
 
 def replay_wheel_beliefs(flt: WheelFilter, columns: dict[str, np.ndarray], check_every: int = 4) -> BeliefHistory:
@@ -228,6 +221,15 @@ def finger_outline(part: Boundary, arc: float, jaw: float, wheel_radius: float |
     return np.column_stack([hub[0] + wheel_radius * np.cos(t), hub[1] + wheel_radius * np.sin(t)])
 
 
+def stated_axes(ax: Axes, history: BeliefHistory, right: float) -> None:
+    """The axes of the stated probability against the rotation rolled (to ``right`` degrees)."""
+    ax.set_xlim(0.0, right)
+    ax.set_ylim(0.0, 1.02)
+    ax.set_xlabel("rotation rolled, degrees")
+    ax.set_ylabel(f"P(within {history.final.radius:g} mm)", fontsize=8)
+    ax.grid(alpha=0.3)
+
+
 #: How many moments of the rolling the picture draws the finger at, beside the belief.
 FINGER_MOMENTS = 4
 
@@ -242,8 +244,9 @@ def plot_belief_history(
 ) -> None:
     """Draw ``history`` to the PNG ``path``: the belief along the part's arc against the rotation rolled (darker
     is more probable, each check against its own most probable place; the truth a line, the most probable
-    contact dots, the rolling's events as dashed lines),
-    the stated probability under it, and the part with the final places and the truth beside it."""
+    contact dots, the rolling's events as dashed lines), the stated probability under it, and beside it the
+    part with the finger (a ``wheel_radius`` mm disc, else the straight jaw) at a few moments, the final places
+    and the truth."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -279,11 +282,7 @@ def plot_belief_history(
     fig.suptitle(title or f"the belief while rolling on {part.name}", fontsize=11)
     ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=6, fontsize=7, frameon=False)
     ax_p.plot(deg, history.stated, "-", color="tab:red", lw=1.2)
-    ax_p.set_xlim(0.0, right)
-    ax_p.set_ylim(0.0, 1.02)
-    ax_p.set_xlabel("rotation rolled, degrees")
-    ax_p.set_ylabel(f"P(within {history.final.radius:g} mm)", fontsize=8)
-    ax_p.grid(alpha=0.3)
+    stated_axes(ax_p, history, right)
     draw_part(ax_part, part)
     # the finger at a few moments, fainter the earlier, where the contact was (the truth, else the estimate)
     rows = history.readings

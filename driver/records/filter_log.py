@@ -12,6 +12,7 @@ settings give the same belief.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable
 from typing import Any, cast
 
 import numpy as np
@@ -21,6 +22,8 @@ from localizer import BRIDGE_JUMP, Belief, ContactFilter
 __all__ = [
     "LoggedFilter",
     "replay_log",
+    "log_table",
+    "Observer",
     "calls_event",
     "calls_from_events",
     "LOG_COLUMNS",
@@ -52,11 +55,28 @@ def _arg(x: float) -> float | None:
     return None if math.isnan(x) else float(x)
 
 
+#: A kept call as :func:`log_table` takes it: its name (one of :data:`CALLS`), then arc, turn, jaw and value
+#: (None where it takes none or was given None).
+KeptCall = tuple[str, float | None, float | None, float | None, float | None]
+#: Told of each call :func:`replay_log` makes: its name, arc, turn, jaw, value (NaN where none) and, for a
+#: ``belief`` call, the belief it gave (else None).
+Observer = Callable[[str, float, float, float, float, Belief | None], object]
+
+
+def log_table(calls: Iterable[KeptCall]) -> dict[str, np.ndarray]:
+    """Calls as a kept log's columns (:data:`LOG_COLUMNS`; ``call``: int8 codes of :data:`CALLS`, NaN for None)."""
+    rows = [(CALLS.index(name), _num(arc), _num(turn), _num(jaw), _num(value)) for name, arc, turn, jaw, value in calls]
+    table = np.array(rows, dtype=float).reshape(-1, len(LOG_COLUMNS))
+    out = {name: table[:, k] for k, name in enumerate(LOG_COLUMNS)}
+    out["call"] = table[:, 0].astype(np.int8)
+    return out
+
+
 class LoggedFilter(ContactFilter):
     """A :class:`localizer.ContactFilter` that keeps the calls made to it (:meth:`columns`)."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        self._kept: list[tuple[int, float, float, float, float]] = []
+        self._kept: list[KeptCall] = []
         self._log_depth = 0
         super().__init__(*args, **kwargs)
         self._kept.clear()  # the constructor's own reset is not a call
@@ -66,7 +86,7 @@ class LoggedFilter(ContactFilter):
         """Keep the call if it is the outermost one; True then."""
         if self._log_depth:
             return False
-        self._kept.append((CALLS.index(name), _num(arc), _num(turn), _num(jaw), _num(value)))
+        self._kept.append((name, arc, turn, jaw, value))
         return True
 
     def _call(self, method: Any, *args: Any) -> Any:
@@ -102,12 +122,8 @@ class LoggedFilter(ContactFilter):
         return cast(Belief, self._call(super().belief, radius))
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The calls kept so far, as the arrays :data:`LOG_COLUMNS` names (``call``: int8 codes of
-        :data:`CALLS`)."""
-        rows = np.array(self._kept, dtype=float).reshape(-1, len(LOG_COLUMNS))
-        out = {name: rows[:, k] for k, name in enumerate(LOG_COLUMNS)}
-        out["call"] = rows[:, 0].astype(np.int8)
-        return out
+        """The calls kept so far, as the arrays :data:`LOG_COLUMNS` names (:func:`log_table`)."""
+        return log_table(self._kept)
 
 
 def calls_event(columns: dict[str, np.ndarray]) -> dict[str, Any]:
@@ -126,9 +142,10 @@ def calls_from_events(events: list[dict[str, Any]]) -> dict[str, np.ndarray] | N
     return {k: np.array([math.nan if v is None else v for v in found[-1][k]], dtype=float) for k in LOG_COLUMNS}
 
 
-def replay_log(flt: ContactFilter, columns: dict[str, np.ndarray]) -> Belief:
+def replay_log(flt: ContactFilter, columns: dict[str, np.ndarray], observe: Observer | None = None) -> Belief:
     """Make the calls of a kept log (:meth:`LoggedFilter.columns`) on ``flt``, a fresh filter; the belief
-    after the last of them (asked once more if the log does not end with one)."""
+    after the last of them (asked once more if the log does not end with one). ``observe`` is told of each
+    call after it is made (what a picture of the rolling keeps: :func:`driver.records.replay_beliefs`)."""
     belief = None
     for code, arc, turn, jaw, value in zip(*(np.asarray(columns[c]) for c in LOG_COLUMNS), strict=True):
         name = CALLS[int(code)]
@@ -145,4 +162,6 @@ def replay_log(flt: ContactFilter, columns: dict[str, np.ndarray]) -> Belief:
             flt.regrasp(float(arc), float(turn), _arg(jaw))
         else:
             belief = flt.belief(_arg(value))
+        if observe is not None:
+            observe(name, float(arc), float(turn), float(jaw), float(value), belief)
     return belief if belief is not None else flt.belief()

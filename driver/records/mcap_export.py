@@ -39,7 +39,7 @@ import numpy as np
 
 from ..rig import RigError
 from .filter_log import REACTIVE_FORMAT
-from .runlog import _clean, read_log
+from .runlog import _clean, check_event, read_log
 from .trace import COLUMNS, FORMAT, Trace, read_archive, trace_format
 from .wheel_trace import WHEEL_FORMAT, WheelTrace
 
@@ -109,13 +109,31 @@ def _finite(x: object) -> bool:
     return isinstance(x, (int, float)) and math.isfinite(x)
 
 
+#: The fields of a logged reading, sample, check or roll that must be numbers where present.
+_NUMBERS = (
+    *COLUMNS[2:],
+    "jaw_position",
+    "length",
+    "turn",
+    "v1",
+    "v2",
+    "rotation",
+    "map_arc",
+    "mass",
+    "angle",
+    "offset",
+)
+
+
 def _log_messages(path: str | os.PathLike[str]) -> tuple[list[Message], dict[str, Any]]:
     events = read_log(path)
     t = float(events[0]["time"]) if _finite(events[0].get("time")) else 0.0
     out: list[Message] = []
-    for e in events[1:]:
+    for k, e in enumerate(events[1:], start=1):
         t = float(e["time"]) if _finite(e.get("time")) else t  # an event without a clock: the last one's time
         kind = e.get("event")
+        if kind in ("reading", "sample", "belief", "roll"):
+            check_event(path, k, e, whole=("roll", "segment"), numbers=_NUMBERS)
         if kind == "reading" and "dv1" in e:  # a straight jaw's reading
             out.append(Message(TOPICS["wrist"], t, _pick(e, ("roll", "step", "dv1", "dv2", "jaw_position"))))
             out.append(Message(TOPICS["arm"], t, _pick(e, ("x", "y", "phi_command", "phi"))))

@@ -132,14 +132,14 @@ class Trace:
         np.savez(path, metadata=np.array(json.dumps(self.metadata)), **cast(dict[str, Any], self.columns))
 
     @classmethod
-    def from_log(cls, path: str | os.PathLike[str]) -> Trace:
+    def from_log(cls, path: str | os.PathLike[str], events: list[dict[str, Any]] | None = None) -> Trace:
         """A trace from a run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not.
 
         Rolls that the log shows begun but without two readings are dropped.
         """
         from .runlog import check_calibration, check_event, read_log
 
-        events = read_log(path)
+        events = read_log(path) if events is None else events  # ``events``: the log already read
         start = events[0]
         jaw = str(start.get("jaw", "straight:100"))  # logs from before fingers were named: the paper's jaw
         if not jaw.startswith("straight"):

@@ -68,12 +68,12 @@ class WheelTrace:
         return cls(columns, meta)
 
     @classmethod
-    def from_log(cls, path: str | os.PathLike[str]) -> WheelTrace:
+    def from_log(cls, path: str | os.PathLike[str], events: list[dict[str, Any]] | None = None) -> WheelTrace:
         """A trace from a wheel's run log (JSON Lines, :mod:`driver.records.runlog`), cut short or not: its
         ``reading`` events (L, Ω) and the calibration it logged."""
         from .runlog import check_event, read_log
 
-        events = read_log(path)
+        events = read_log(path) if events is None else events  # ``events``: the log already read
         start = events[0]
         jaw = start.get("jaw")
         if not (isinstance(jaw, str) and jaw.startswith("wheel")):

@@ -1,0 +1,79 @@
+"""Which kind of run a record holds: fixed rolls, a straight jaw's reactive rolling or a wheel's, whether a
+trace (``.npz``) or a run log (``.jsonl``, read once), for the commands that read any of them."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ..rig import RigError
+from .filter_log import LOG_COLUMNS, REACTIVE_FORMAT, calls_from_events
+from .runlog import read_log
+from .trace import Trace, read_archive, trace_format
+from .wheel_trace import WHEEL_FORMAT, WheelTrace
+
+__all__ = ["RunRecord", "open_record", "reactive_calls", "RECORD_KINDS"]
+
+#: The kinds of run a record can hold.
+RECORD_KINDS = ("fixed", "reactive", "wheel")
+
+
+class RunRecord(NamedTuple):
+    """A run's record: its kind (one of :data:`RECORD_KINDS`), its path, and a run log's events (None for a
+    trace)."""
+
+    kind: str
+    path: str
+    events: list[dict[str, Any]] | None
+
+    def fixed(self) -> Trace:
+        """The fixed rolls' trace (a run log made into one)."""
+        return Trace.from_log(self.path, self.events) if self.events is not None else Trace.load(self.path)
+
+    def wheel(self) -> WheelTrace:
+        """The wheel's trace (a run log made into one)."""
+        return WheelTrace.from_log(self.path, self.events) if self.events is not None else WheelTrace.load(self.path)
+
+
+def open_record(path: str | os.PathLike[str]) -> RunRecord:
+    """The record at ``path`` and which kind of run it holds.
+
+    Raises
+    ------
+    RigError
+        Not a rolltouch trace or run log; a reactive run's log that ended before it logged its filter calls
+        (its last belief event is its answer, and nothing can be replayed).
+    """
+    path = str(path)
+    if not path.endswith(".jsonl"):
+        kind = {WHEEL_FORMAT: "wheel", REACTIVE_FORMAT: "reactive"}.get(trace_format(path), "fixed")
+        return RunRecord(kind, path, None)
+    events = read_log(path)
+    if str(events[0].get("jaw", "straight")).startswith("wheel"):
+        return RunRecord("wheel", path, events)
+    if calls_from_events(events) is not None:
+        return RunRecord("reactive", path, events)
+    if any(e.get("event") == "belief" for e in events):
+        raise RigError(
+            f"run log {path} is of a reactive run whose filter calls it does not hold (the run ended before its "
+            "result, or was logged before they were): its last belief event is its answer"
+        )
+    return RunRecord("fixed", path, events)
+
+
+def reactive_calls(
+    record: RunRecord,
+) -> tuple[dict[str, Any], dict[str, np.ndarray], dict[str, np.ndarray] | None]:
+    """A reactive record's run (its JSON object with its part's record), its filter's kept calls
+    (:data:`LOG_COLUMNS`) and, for a trace, its readings (``arcs``, ``turns``, ``true_arcs``; None for a log)."""
+    if record.events is not None:
+        events = record.events
+        columns = calls_from_events(events)
+        if columns is None:
+            raise RigError(f"run log {record.path} holds no filter calls")
+        result: dict[str, Any] = next((e for e in reversed(events) if e.get("event") == "result"), {})
+        return {**result, "part": events[0].get("part")}, columns, None
+    meta, columns = read_archive(record.path, LOG_COLUMNS)
+    return meta, columns, read_archive(record.path, ("arcs", "turns", "true_arcs"))[1]
