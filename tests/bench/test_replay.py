@@ -1,5 +1,6 @@
 """Replaying one trial's reactive filter with other settings (bench.replay)."""
 
+import math
 from pathlib import Path
 
 import pytest
@@ -118,3 +119,14 @@ def test_a_run_that_ended_on_a_mismatch_says_so_in_every_replay():
     rec = record_trial(ROOT / "bench" / "studies" / "world-tuning.toml", 0, 0)
     assert rec.row["reactive_stopped"] == "mismatch"
     assert replay(rec).mismatch and replay(rec, margin=False).mismatch
+
+
+def test_a_bridge_recorded_without_its_jump_is_kept_with_the_default_one():
+    from bench.replay import log_columns
+    from driver.records import CALLS
+    from localizer import BRIDGE_JUMP
+
+    columns = log_columns([("bridged", (0.1,), {}), ("bridged", (0.2, 3.0), {"jump": 0.7}), ("belief", (), {})])
+    assert list(columns["call"]) == [CALLS.index("bridged")] * 2 + [CALLS.index("belief")]
+    assert columns["value"][0] == BRIDGE_JUMP and columns["value"][1] == 0.7
+    assert columns["jaw"][1] == 3.0 and math.isnan(columns["jaw"][0]) and math.isnan(columns["value"][2])

@@ -122,3 +122,12 @@ def test_a_wheel_trace_reads_back_reading_by_reading(tmp_path):
     assert [m["turn"] for _, m in topics[TOPICS["arm"]]] == pytest.approx(list(turn))
     assert [m["true_arc"] for _, m in topics[TOPICS["truth"]]] == pytest.approx(list(true_arc))
     assert json.loads(meta["rolltouch"]["jaw"]) == "wheel:5"
+
+
+def test_a_malformed_run_log_is_refused_naming_the_event_and_field(tmp_path, capsys):
+    log_file = tmp_path / "bad.jsonl"
+    log = RunLog(log_file, {"part": "cam"})
+    log({"event": "reading", "roll": 0, "step": 0, "dv1": "high", "dv2": 0.5})
+    log.close()
+    assert main(["export", str(log_file), "--mcap", str(tmp_path / "o.mcap")]) == 2
+    assert "event 2 (reading) has dv1='high', not a number" in capsys.readouterr().err
