@@ -9,6 +9,7 @@ mid-localization.
 from __future__ import annotations
 
 import math
+import time
 from typing import TYPE_CHECKING, Any, TypeAlias, cast
 
 import numpy as np
@@ -27,6 +28,10 @@ if TYPE_CHECKING:
     FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 STEP = math.radians(0.2)
+
+#: The wheel's benchmarks before its filter interpolated the start grid's angles (commit 21fce76, this
+#: machine, 2026-12-05, fastest round, ms): the roll in pytest-benchmark, the used reading by perf_counter.
+WHEEL_BEFORE_MS = {"test_wheel_filter_roll": 249.3, "test_wheel_filter_used_reading": 9.8}
 
 
 @pytest.fixture(scope="module")
@@ -137,5 +142,51 @@ def test_wheel_filter_roll(benchmark: BenchmarkFixture) -> None:
 
     b: Belief = benchmark.pedantic(roll, rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(float(part.arc_offset(b.map_arc, start + lengths[-1]))) < 0.3
-    benchmark.extra_info.update({"starts": int(flt.grid.size), "readings": int(lengths.size)})
+    benchmark.extra_info.update(
+        {
+            "starts": int(flt.grid.size),
+            "readings": int(lengths.size),
+            "before_ms": WHEEL_BEFORE_MS["test_wheel_filter_roll"],
+        }
+    )
     per_second(benchmark, "readings_per_second", lengths.size)
+
+
+def test_wheel_filter_used_reading(benchmark: BenchmarkFixture) -> None:
+    """One reading the wheel's likelihood uses (the 20th of a roll on the kidney, its start grid 11724 wide),
+    and in the same run the cost of the model's angles at every start evaluated on the spline itself (what
+    the filter did before it interpolated the start grid's, 19-26 ms a reading)."""
+    from localizer.contact import ShiftedGrid
+
+    part = load_part(PARTS_DIR / "kidney.csv")
+    flt = WheelFilter(part, WheelJaw(5.0))
+    start = 66.0
+    lengths = np.arange(1.0, 20.01, 1.0)
+    theta = part.tangent_angle(part.param_at_arc(start + np.r_[0.0, lengths]))
+    turns = theta[1:] - theta[0]
+
+    def nineteen() -> tuple[tuple[float, float], dict[str, Any]]:
+        flt.reset()
+        for L, om in zip(lengths[:-1], turns[:-1]):
+            flt.update(float(L), float(om))
+        return (float(lengths[-1]), float(turns[-1])), {}
+
+    benchmark.pedantic(flt.update, setup=nineteen, rounds=10, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
+    assert len(flt.L_used) == lengths.size
+    times = {}
+    for name, exact in (("interpolated", False), ("spline", True)):
+        table = ShiftedGrid(part, flt.grid.size, exact=exact)
+        best = math.inf
+        for _ in range(5):
+            t0 = time.perf_counter()
+            table.at(float(lengths[-1]))
+            best = min(best, time.perf_counter() - t0)
+        times[name] = best
+    benchmark.extra_info.update(
+        {
+            "starts": int(flt.grid.size),
+            "before_ms": WHEEL_BEFORE_MS["test_wheel_filter_used_reading"],
+            "angles_interpolated_ms": round(times["interpolated"] * 1e3, 3),
+            "angles_on_the_spline_ms": round(times["spline"] * 1e3, 3),
+        }
+    )

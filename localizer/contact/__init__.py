@@ -7,7 +7,7 @@ from ._reach import DEFAULT_JAW, Reach, StraightJaw, calibration_arc, reach_for
 from ._rolling import arc_from_jaw_positions
 from ._tracks import BRIDGE_EXCESS, PIVOT_KAPPA, ModeTracks, grid_size, tracks_for
 from ._wheel import Finger, WheelJaw, WheelReach, parse_jaw, wheel_reach_for
-from ._wheel_rolling import free_runs, jump_runs, pivot_turn, unwrapped_angle
+from ._wheel_rolling import ShiftedGrid, free_runs, jump_runs, pivot_turn, unwrapped_angle
 
 __all__ = [
     "DEFAULT_JAW",
@@ -26,6 +26,7 @@ __all__ = [
     "WheelReach",
     "parse_jaw",
     "wheel_reach_for",
+    "ShiftedGrid",
     "free_runs",
     "jump_runs",
     "pivot_turn",

@@ -18,7 +18,7 @@ from .._types import FloatArray
 from ..geometry import Boundary, Outline, nearest_corner
 from ._wheel import WheelJaw
 
-__all__ = ["unwrapped_angle", "pivot_turn", "free_runs", "jump_runs"]
+__all__ = ["ShiftedGrid", "unwrapped_angle", "pivot_turn", "free_runs", "jump_runs"]
 
 
 def unwrapped_angle(part: Boundary, sigma: FloatArray) -> FloatArray:
@@ -32,6 +32,56 @@ def unwrapped_angle(part: Boundary, sigma: FloatArray) -> FloatArray:
     t = part.param_at_arc(sigma - laps * part.perimeter)  # type: ignore[attr-defined]
     out: FloatArray = part.tangent_angle(t) + 2 * math.pi * laps  # type: ignore[attr-defined]
     return out
+
+
+class ShiftedGrid:
+    """Θ and κ of a ``part`` at a uniform grid of starts ``k·h`` (``n`` of them round the perimeter), and at
+    that grid shifted by any arc L: what a wheel's filter asks at every reading it uses.
+
+    On a spline part the shifted values come from the grid's own, with one fraction L/h for every start:
+    a cubic Hermite interpolation of Θ (its derivative κ known at every node) and a linear one of κ. At the
+    wheel filter's 0.02 mm grid this is within 2e-8 rad of the spline's own evaluation on the shipped
+    parts and 2.5e-5 rad on the tightest held-out glyph (κ up to 5.8 mm⁻¹), under 6% of one reading's
+    angle error, where the spline's evaluation (arc to parameter by Newton at every start) costs ~15 ms a
+    reading. On a drawing Θ steps at corners and κ at the ends of arcs, which no interpolation crosses:
+    there the drawing's own exact and cheap evaluation is used.
+
+    Parameters
+    ----------
+    part : Part or Outline
+    n : int
+        Starts round the perimeter (the grid step h = P/n, mm).
+    exact : bool
+        Evaluate the part at every shift instead (the reference the interpolation is measured against).
+    """
+
+    def __init__(self, part: Boundary, n: int, *, exact: bool = False) -> None:
+        self.part = part
+        self.h = float(part.perimeter) / n
+        self.grid: FloatArray = np.arange(n, dtype=float) * self.h
+        self.theta: FloatArray = unwrapped_angle(part, self.grid)
+        self.kappa: FloatArray = np.asarray(part.curvature_at_arc(self.grid), dtype=float)
+        self._exact = exact or isinstance(part, Outline)
+
+    def at(self, length: float) -> tuple[FloatArray, FloatArray]:
+        """Θ (rad, unwrapped: Θ(σ + P) = Θ(σ) + 2π) and κ (1/mm) at every start plus ``length`` mm."""
+        x = self.grid + float(length)
+        if self._exact:
+            kappa = np.asarray(self.part.curvature_at_arc(self.part.wrap_arc(x)), dtype=float)
+            return unwrapped_angle(self.part, x), kappa
+        n = self.grid.size
+        q = float(length) / self.h
+        m = math.floor(q)
+        f = q - m
+        i0 = np.arange(m, m + n)
+        j0, j1 = i0 % n, (i0 + 1) % n
+        t0 = self.theta[j0] + 2 * math.pi * (i0 // n)
+        t1 = self.theta[j1] + 2 * math.pi * ((i0 + 1) // n)
+        d0, d1 = self.kappa[j0] * self.h, self.kappa[j1] * self.h
+        f2, f3 = f * f, f * f * f
+        theta = (2 * f3 - 3 * f2 + 1) * t0 + (f3 - 2 * f2 + f) * d0 + (3 * f2 - 2 * f3) * t1 + (f3 - f2) * d1
+        kappa = (1 - f) * self.kappa[j0] + f * self.kappa[j1]
+        return theta, kappa
 
 
 def pivot_turn(

@@ -66,7 +66,7 @@ from scipy.stats import f as f_dist
 from .._defaults import CONFIDENCE, FIT_ALPHA, SUCCESS_RADIUS
 from .._errors import QueryError
 from .._types import BoolArray, FloatArray
-from ..contact import WheelJaw, free_runs, jump_runs, pivot_turn, unwrapped_angle, wheel_reach_for
+from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, wheel_reach_for
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
 from ._belief import Belief, belief_flags, find_modes, flat_top
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
@@ -175,9 +175,10 @@ class WheelFilter:
         P = float(part.perimeter)
         n = max(64, int(math.ceil(P / spacing)))
         check_grid(part, "wheel filter", spacing, n)
-        self.h = P / n
-        self.grid: FloatArray = np.arange(n, dtype=float) * self.h
-        self._theta0 = self._theta(self.grid)
+        self._angles = ShiftedGrid(part, n)
+        self.h = self._angles.h
+        self.grid: FloatArray = self._angles.grid
+        self._theta0 = self._angles.theta
         reach = wheel_reach_for(part, wheel)
         touch = reach.touchable(self.grid)
         self.prior: FloatArray = np.asarray(touch, dtype=float)
@@ -190,11 +191,6 @@ class WheelFilter:
         b = 24.0 * n
         self.max_readings = int((math.sqrt(b * b + 32.0 * MAX_ARRAY_BYTES) - b) / 16.0)
         self.reset()
-
-    # ------------------------------------------------------------ geometry
-    def _theta(self, sigma: FloatArray) -> FloatArray:
-        """Unwrapped tangent angle Θ at unrolled arc positions (rad): :func:`unwrapped_angle`."""
-        return unwrapped_angle(self.part, sigma)
 
     # ------------------------------------------------------------- readings
     def reset(self) -> None:
@@ -281,9 +277,20 @@ class WheelFilter:
         """Each start's model turn (rad) after rolling ``length`` mm, the nearest to the reading ``turn`` (rad)
         the model allows: Θ(s + L) − Θ(s), or, within :meth:`corner_window` of a convex corner, any angle
         between the model's there and across the corner's jump (the wheel pivoting on it)."""
-        x = self.grid + float(length)
-        model = self._theta(x) - self._theta0
-        return pivot_turn(self.part, x, self._theta0, model, float(turn), self.corner_window(length))
+        return self._model_at(length, turn)[0]
+
+    def _model_at(self, length: float, turn: float) -> tuple[FloatArray, FloatArray]:
+        """:meth:`predicted_turn` and each start's curvature (1/mm) at its contact after ``length`` mm."""
+        theta, kappa = self._angles.at(length)
+        model = pivot_turn(
+            self.part,
+            self.grid + float(length),
+            self._theta0,
+            theta - self._theta0,
+            float(turn),
+            self.corner_window(length),
+        )
+        return model, kappa
 
     def update(self, length: float, turn: float) -> None:
         """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
@@ -302,9 +309,9 @@ class WheelFilter:
         c_nn = float(self._cov(np.array([L]), np.array([L]))[0, 0])
         ell = solve_triangular(self._chol, c_new, lower=True) if used.size else np.zeros(0)
         d2 = max(c_nn - float(ell @ ell), 1e-18)
-        kappa = np.asarray(self.part.curvature_at_arc(self.part.wrap_arc(self.grid + L)), dtype=float)
+        model, kappa = self._model_at(L, om)
         extra = kappa**2 * (self.sd_length**2 + (L * self.sd_scale) ** 2)
-        rho = om - self.predicted_turn(L, om)
+        rho = om - model
         var = d2 + extra
         z = (rho - self._z @ ell) / np.sqrt(var)
         self._make_room()
