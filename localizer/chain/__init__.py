@@ -3,10 +3,13 @@ rolls, on splines and on outlines with corners.
 """
 
 from ._disambiguate import RULES, Candidate, Localization, localize
+from ._outline_chain import Forward, chain_forward
 
 __all__ = [
     "RULES",
     "Candidate",
     "Localization",
     "localize",
+    "Forward",
+    "chain_forward",
 ]

@@ -26,18 +26,23 @@ at every start:
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from .._types import FloatArray, IntArray
 from ..geometry import Outline, check_grid, count_text
 from ..solve import Segment
+from ._chain_kernels import UNDERFLOW, add_from_pairs, add_from_runs, sum_from_pairs, sum_from_runs
 
 __all__: list[str] = []
 
 #: The most candidates the likelihood rule reports (a long face the rolls did not resolve would give
 #: one per ``min_separation``).
 MAX_CANDIDATES = 200
+#: A way the sums relative to a roll's largest source leave out weighs less than e^-LOST_BELOW of it: the
+#: smallest positive double is e⁻⁷⁴⁵, a normal one e⁻⁷⁰⁸, and a turn TURN_CUT standard errors off e⁻⁷²².
+LOST_BELOW = 708.0
 
 
 def _interval(outline: Outline, sigma: FloatArray, half: float) -> tuple[FloatArray, FloatArray]:
@@ -87,7 +92,8 @@ def _nodes(outline: Outline, h: float, dpsi: float) -> tuple[FloatArray, FloatAr
 
 
 class _LogSum:
-    """Running log-sum-exp and arg-max over candidate terms, one slot per state."""
+    """Running log-sum-exp (top + log acc) and arg-max over the terms into each state, filled by the
+    kernels of :mod:`localizer.chain._chain_kernels`."""
 
     def __init__(self, n: int) -> None:
         self.top = np.full(n, -np.inf)
@@ -95,25 +101,148 @@ class _LogSum:
         self.best = np.full(n, -np.inf)
         self.best_from = np.zeros(n, dtype=np.int64)
 
-    def add(self, at: IntArray, v: FloatArray, source: IntArray) -> None:
-        """Add the terms ``v`` to the slots ``at`` (distinct), from states ``source``."""
-        top, acc = self.top[at], self.acc[at]
-        better = v > self.best[at]
-        self.best[at] = np.where(better, v, self.best[at])
-        self.best_from[at] = np.where(better, source, self.best_from[at])
-        m = np.maximum(top, v)
-        fin = np.isfinite(m)
-        m0 = np.where(fin, m, 0.0)
-        with np.errstate(invalid="ignore"):
-            old = np.where(np.isfinite(top), np.exp(top - m0), 0.0)
-        self.acc[at] = np.where(fin, acc * old + np.exp(v - m0), 0.0)
-        self.top[at] = m
-
     def total(self) -> FloatArray:
         out: FloatArray = np.full(self.top.size, -np.inf)
         ok = self.acc > 0
         out[ok] = self.top[ok] + np.log(self.acc[ok])
         return out
+
+
+class _Ways(NamedTuple):
+    """The ways into every state by one roll: from the grid's states ``a_lo[j]`` to ``a_hi[j]`` − 1 (over
+    three laps), and from the corners' angles listed as (into, from arc, from angle, from state)."""
+
+    a_lo: IntArray
+    a_hi: IntArray
+    pairs: list[tuple[IntArray, FloatArray, FloatArray, IntArray]]
+
+    @property
+    def most(self) -> int:
+        """The most ways into any one state (at least 1)."""
+        return max(
+            1, int((self.a_hi - self.a_lo).max(initial=0)) + sum(int(np.bincount(p[0]).max()) for p in self.pairs)
+        )
+
+
+def _ways(
+    sig: FloatArray,
+    psi: FloatArray,
+    corner_states: list[IntArray],
+    g_sig: FloatArray,
+    sign: float,
+    L: float,
+    omega: float,
+    P: float,
+    turning: float,
+    sd_length: float,
+    spacing: float,
+    reach: int,
+) -> _Ways:
+    """The sources worth weighing for each state after a roll of travel ``L`` and turn ``omega``: within five
+    standard errors of the travel, and at a corner its ``reach`` angles on each side of the one the turn asks."""
+    wide = max(5.0 * sd_length, 2.0 * spacing)
+    # from the grid: each destination's sources are a contiguous run of it
+    a_lo = np.searchsorted(g_sig, sig - sign * L - wide, side="left")
+    a_hi = np.searchsorted(g_sig, sig - sign * L + wide, side="right")
+    pairs = []
+    # from a corner: only its angles near ψ_destination − Ω (its states are ordered by angle)
+    for c in corner_states:
+        c_psi = psi[c]
+        ascending = c_psi[-1] >= c_psi[0]
+        for lap in (-1, 0, 1):
+            c_sig = float(sig[c[0]]) + lap * P
+            at = np.flatnonzero(np.abs(sign * (sig - c_sig) - L) <= wide)
+            if at.size == 0:
+                continue
+            want = psi[at] - omega - lap * turning
+            near = np.searchsorted(c_psi if ascending else c_psi[::-1], want)
+            if not ascending:
+                near = c.size - near
+            # each destination's angles in the order of their offset from the nearest
+            jx = near[None, :] + np.arange(-reach, reach + 1)[:, None]
+            ok = (jx >= 0) & (jx < c.size)
+            src = c[jx[ok]]
+            pairs.append((np.broadcast_to(at, jx.shape)[ok], np.full(src.size, c_sig), psi[src] + lap * turning, src))
+    return _Ways(a_lo, a_hi, pairs)
+
+
+class Forward(NamedTuple):
+    """The forward recursion over a chain: the states (arc ``sig``, mm; jaw angle ``psi``, rad), each one's
+    log-weight after the last roll (``log_alpha``, unnormalised) and, per roll, the state each one's most
+    probable way came from (``backs``)."""
+
+    sig: FloatArray
+    psi: FloatArray
+    log_alpha: FloatArray
+    backs: list[IntArray]
+
+
+def chain_forward(
+    outline: Outline,
+    chain: tuple[tuple[float, float], ...],
+    sign: float,
+    sd_length: float,
+    sd_turn: float,
+    spacing: float = 0.01,
+    *,
+    exact: bool = False,
+) -> Forward | None:
+    """The likelihood rule's sum over every path (module notes); None when no path has any weight.
+
+    Each roll's sums are taken relative to the largest source (:func:`sum_from_runs`): one exponential a
+    way at most, none for a way whose turn is far off. A way so left out, or lost below what a double
+    holds, weighs under e⁻⁷⁰⁸ of that roll's largest source, so each state's error is under W·e⁻⁷⁰⁸ of it
+    (W ways into a state), and after R rolls under (2W)^R·e⁻⁷⁰⁸ of the largest source any roll had. While the
+    best final state weighs e⁵⁰ more than that, what was left out is below a rounding of the posterior;
+    else (a chain that fits almost nowhere) the whole chain is summed again in logarithms, every way
+    weighed (``exact``: always so)."""
+    P = outline.perimeter
+    turning = float(outline.turning)
+    dpsi = max(sd_turn, 1e-6)
+    sig, psi, corner_states = _nodes(outline, spacing, dpsi)
+    n = sig.size
+    # the grid's states over three laps, so that a window past either end of the lap finds them
+    on_grid = np.ones(n, dtype=bool)
+    for c in corner_states:
+        on_grid[c] = False
+    g = np.flatnonzero(on_grid)
+    g_sig = np.concatenate([sig[g] - P, sig[g], sig[g] + P])
+    g_psi = np.concatenate([psi[g] - turning, psi[g], psi[g] + turning])
+    g_idx = np.concatenate([g, g, g])
+    reach = int(math.ceil(6.0 * sd_turn / dpsi)) + 1  # a corner's states worth weighing per destination
+    log_alpha = np.full(n, -math.log(n))
+    backs: list[IntArray] = []
+    lost = -math.inf  # the log of the most any left-out way could have added to the final states
+    for L, omega in chain:
+        roll = (sign, float(L), float(omega), sd_length, sd_turn)
+        ways = _ways(
+            sig, psi, corner_states, g_sig, sign, float(L), float(omega), P, turning, sd_length, spacing, reach
+        )
+        if exact:
+            into = _LogSum(n)
+            sums = (into.top, into.acc, into.best, into.best_from)
+            add_from_runs(sig, psi, g_sig, g_psi, g_idx, ways.a_lo, ways.a_hi, log_alpha, *roll, *sums)
+            for at, src_sig, src_psi, src in ways.pairs:
+                add_from_pairs(at, src_sig, src_psi, src, sig, psi, log_alpha, *roll, *sums)
+            log_alpha, best_from = into.total(), into.best_from
+        else:
+            top = float(log_alpha.max())
+            weight = np.exp(log_alpha - top)
+            acc, best, best_from = np.zeros(n), np.zeros(n), np.zeros(n, dtype=np.int64)
+            sum_from_runs(sig, psi, g_sig, g_psi, g_idx, ways.a_lo, ways.a_hi, weight, *roll, acc, best, best_from)
+            for at, src_sig, src_psi, src in ways.pairs:
+                sum_from_pairs(at, src_sig, src_psi, src, sig, psi, weight, *roll, acc, best, best_from)
+            with np.errstate(divide="ignore"):
+                log_alpha = top + np.log(acc)
+            lost = max(lost, top - LOST_BELOW) + math.log(2.0 * ways.most)
+        if not np.isfinite(log_alpha).any():
+            break
+        backs.append(best_from)
+    if not exact and not log_alpha.max() >= lost + UNDERFLOW:
+        return chain_forward(outline, chain, sign, sd_length, sd_turn, spacing, exact=True)
+    if not np.isfinite(log_alpha).any():
+        return None
+    return Forward(sig, psi, log_alpha, backs)
 
 
 def chain_likelihood(
@@ -129,64 +258,10 @@ def chain_likelihood(
     first: (probability, the most probable path's unrolled arcs (mm), its turn residuals (rad))."""
     P = outline.perimeter
     turning = float(outline.turning)
-    dpsi = max(sd_turn, 1e-6)
-    sig, psi, corner_states = _nodes(outline, spacing, dpsi)
-    n = sig.size
-    dest = np.arange(n)
-    # the grid's states over three laps, so that a window past either end of the lap finds them
-    on_grid = np.ones(n, dtype=bool)
-    for c in corner_states:
-        on_grid[c] = False
-    g = np.flatnonzero(on_grid)
-    g_sig = np.concatenate([sig[g] - P, sig[g], sig[g] + P])
-    g_psi = np.concatenate([psi[g] - turning, psi[g], psi[g] + turning])
-    g_idx = np.concatenate([g, g, g])
-    reach = int(math.ceil(6.0 * sd_turn / dpsi)) + 1  # a corner's states worth weighing per destination
-    log_alpha = np.full(n, -math.log(n))
-    backs: list[IntArray] = []
-    for L, omega in chain:
-        wide = max(5.0 * sd_length, 2.0 * spacing)
-        into = _LogSum(n)
-
-        def term(
-            src_sig: FloatArray, src_psi: FloatArray, src: IntArray, at: IntArray, prev: FloatArray = log_alpha
-        ) -> FloatArray:
-            """Log-weight of arriving at states ``at`` from ``src`` (at σ ``src_sig``, ψ ``src_psi``)."""
-            travel = sign * (sig[at] - src_sig)
-            v = prev[src] - 0.5 * ((psi[at] - src_psi - omega) / sd_turn) ** 2  # noqa: B023 (called in this roll only)
-            v = v - 0.5 * ((travel - L) / sd_length) ** 2  # noqa: B023
-            out: FloatArray = np.where(travel > 0, v, -np.inf)
-            return out
-
-        # from the grid: each destination's sources are a contiguous run of it
-        a_lo = np.searchsorted(g_sig, sig - sign * L - wide, side="left")
-        a_hi = np.searchsorted(g_sig, sig - sign * L + wide, side="right")
-        for k in range(int((a_hi - a_lo).max(initial=0))):
-            ok = a_lo + k < a_hi
-            a = a_lo[ok] + k
-            into.add(dest[ok], term(g_sig[a], g_psi[a], g_idx[a], dest[ok]), g_idx[a])
-        # from a corner: only its angles near ψ_destination − Ω (its states are ordered by angle)
-        for c in corner_states:
-            c_psi = psi[c]
-            ascending = c_psi[-1] >= c_psi[0]
-            for lap in (-1, 0, 1):
-                c_sig = float(sig[c[0]]) + lap * P
-                at = np.flatnonzero(np.abs(sign * (sig - c_sig) - L) <= wide)
-                if at.size == 0:
-                    continue
-                want = psi[at] - omega - lap * turning
-                near = np.searchsorted(c_psi if ascending else c_psi[::-1], want)
-                if not ascending:
-                    near = c.size - near
-                for dj in range(-reach, reach + 1):
-                    jx = near + dj
-                    ok = (jx >= 0) & (jx < c.size)
-                    src = c[jx[ok]]
-                    into.add(at[ok], term(np.full(src.size, c_sig), psi[src] + lap * turning, src, at[ok]), src)
-        log_alpha = into.total()
-        if not np.isfinite(log_alpha).any():
-            return []
-        backs.append(into.best_from)
+    forward = chain_forward(outline, chain, sign, sd_length, sd_turn, spacing)
+    if forward is None:
+        return []
+    sig, psi, log_alpha, backs = forward
     w = np.exp(log_alpha - log_alpha.max())
     w /= w.sum()
     # the present contact's weight per cell of the σ grid (a corner's angles share its cell)
