@@ -22,7 +22,15 @@ import numpy as np
 import pymunk
 
 from ._errors import SimError
-from .pymunk_world import drive_hand, polygonise, static_chain
+from .pymunk_world import (
+    SETTLE_SPEED,
+    SOLVER_BIAS,
+    Settle,
+    drive_hand,
+    polygonise,
+    solver_space,
+    static_chain,
+)
 from .wheel_world import WheelContact, WheelWorld
 
 __all__ = ["PymunkWheelWorld"]
@@ -46,9 +54,16 @@ class PymunkWheelWorld:
         Coulomb friction between the rim and the part (the disc rolls while the tangential force stays
         within it).
     chord_tolerance : float, mm
+        Polygonisation tolerance of the part: finer than the straight jaw's world, since the disc's contact
+        is read from where its centre settles on the polygon, not refined on the spline (at 1e-3 mm the
+        normal of the contact is 4e-3 rad off the kinematic world's; at 1e-4 mm, 1.4e-3).
     dt : float, s
     linear_speed, angular_speed : float, mm/s and rad/s
     settle_steps : int
+        The most steps run after the hand reaches a commanded pose.
+    settle_speed : float, mm/s
+        Fewer when the disc has come to rest, its rim included (:class:`sim2d.pymunk_world.Settle`); 0:
+        always ``settle_steps``.
     """
 
     def __init__(
@@ -64,6 +79,7 @@ class PymunkWheelWorld:
         linear_speed: float = 20.0,
         angular_speed: float = math.radians(30.0),
         settle_steps: int = 150,
+        settle_speed: float = SETTLE_SPEED,
     ):
         if not (radius > 0 and stiffness > 0 and dt > 0 and friction >= 0):
             raise SimError(
@@ -72,11 +88,8 @@ class PymunkWheelWorld:
         self.geometry = WheelWorld(part, model, radius, stiffness=stiffness)
         self.radius, self.stiffness, self.dt = float(radius), float(stiffness), float(dt)
         self.linear_speed, self.angular_speed = float(linear_speed), float(angular_speed)
-        self.settle_steps = int(settle_steps)
-        space = pymunk.Space()
-        space.gravity = (0.0, 0.0)
-        space.collision_slop = 1e-4
-        space.iterations = 30
+        self.settle_steps, self.settle_speed = int(settle_steps), float(settle_speed)
+        space = solver_space()
         self.space = space
         static_chain(space, polygonise(part, chord_tolerance), friction)
         self.hand_body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
@@ -99,6 +112,8 @@ class PymunkWheelWorld:
         gear = pymunk.GearJoint(self.hand_body, self.carrier, 0.0, 1.0)
         bearing = pymunk.PivotJoint(self.carrier, self.wheel_body, (0.0, 0.0), (0.0, 0.0))
         bearing.collide_bodies = False
+        for joint in (*springs, gear, bearing):
+            joint.error_bias = SOLVER_BIAS
         space.add(self.hand_body, self.carrier, self.wheel_body, disc, *springs, gear, bearing)
         self.hand: tuple[float, float, float] | None = None
 
@@ -115,9 +130,8 @@ class PymunkWheelWorld:
         places everything there directly: the arm's start-up pose must be clear of the part)."""
         if self.hand is None:
             self._place(float(x), float(y), float(phi))
-        drive_hand(
-            self.space, self.hand_body, (x, y, phi), self.dt, self.linear_speed, self.angular_speed, self.settle_steps
-        )
+        settle = Settle(self.settle_steps, self.settle_speed, self.wheel_body, self.radius)
+        drive_hand(self.space, self.hand_body, (x, y, phi), self.dt, self.linear_speed, self.angular_speed, settle)
         self.hand = (float(x), float(y), float(phi))
 
     @property

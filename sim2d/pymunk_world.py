@@ -19,6 +19,7 @@ pose at the speed limits and steps the space until the jaw has settled.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 import pymunk
@@ -30,9 +31,34 @@ from .quasistatic import outline_touch, tangent_point
 from .sampled import SampledPart, polygon_vertices
 from .world import Contact
 
-__all__ = ["PymunkWorld", "polygonise", "static_chain", "drive_hand"]
+__all__ = ["PymunkWorld", "polygonise", "static_chain", "drive_hand", "solver_space", "Settle"]
 
 _MN_PER_N = 1000.0
+#: Steps in a row a body must move slower than the settling speed for it to be at rest, and the fewest
+#: steps a settling takes (three time constants of the wrist's critically damped spring at 1 N/mm).
+QUIET_STEPS = 5
+MIN_SETTLE_STEPS = 20
+#: The jaw is at rest when every point within its half-span moves slower than this, mm/s.
+SETTLE_SPEED = 0.02
+#: Polygonisation of a spline part, mm: its contact is refined on the spline itself (:meth:`PymunkWorld.contact`),
+#: so the chord's sagitta only errs the jaw's depth by up to a micron.
+CHORD_TOLERANCE = 1e-3
+#: The share of an overlap, or of a joint's error, left uncorrected after a second (chipmunk's
+#: ``collision_bias`` and ``error_bias``). chipmunk's default, 10% corrected every 1/60 s, left the jaw
+#: creeping by microns for hundreds of steps after each move, which the settling had to wait out and
+#: which kept the world's L 2 µm off the quasi-static equilibrium's; here both are corrected within steps.
+SOLVER_BIAS = 1e-9
+
+
+def solver_space() -> pymunk.Space:
+    """An empty space set up for the rig's worlds: no gravity, 0.1 µm of allowed overlap, 30 solver
+    iterations, overlaps corrected at :data:`SOLVER_BIAS` (give the same to the joints added)."""
+    space = pymunk.Space()
+    space.gravity = (0.0, 0.0)
+    space.collision_slop = 1e-4
+    space.iterations = 30
+    space.collision_bias = SOLVER_BIAS
+    return space
 
 
 def polygonise(part: Part | SampledPart, chord_tolerance: float) -> np.ndarray:
@@ -153,6 +179,18 @@ def static_chain(space: pymunk.Space, pts: np.ndarray, friction: float) -> None:
     space.add(*segs)
 
 
+class Settle(NamedTuple):
+    """How a world settles after the hand reaches a pose: at most ``steps`` steps, fewer once every point
+    of ``body`` within ``reach`` mm of its centre moves slower than ``speed`` mm/s for
+    :data:`QUIET_STEPS` steps in a row (and :data:`MIN_SETTLE_STEPS` have run); ``speed`` 0 or no body:
+    always ``steps``."""
+
+    steps: int
+    speed: float = 0.0
+    body: pymunk.Body | None = None
+    reach: float = 0.0
+
+
 def drive_hand(
     space: pymunk.Space,
     hand: pymunk.Body,
@@ -160,10 +198,10 @@ def drive_hand(
     dt: float,
     linear_speed: float,
     angular_speed: float,
-    settle_steps: int,
+    settle: Settle,
 ) -> int:
     """Drive the kinematic ``hand`` to ``pose`` (mm, mm, rad) at the speed limits (mm/s, rad/s), stepping
-    ``space`` by ``dt`` s, then ``settle_steps`` more; the number of steps taken."""
+    ``space`` by ``dt`` s, then let it ``settle``; the number of steps taken."""
     x, y, phi = (float(v) for v in pose)
     target = np.array([x, y], float)
     steps = 0
@@ -182,9 +220,23 @@ def drive_hand(
         steps += 1
     hand.velocity, hand.angular_velocity = (0.0, 0.0), 0.0
     hand.position, hand.angle = (x, y), phi
-    for _ in range(settle_steps):
+    body, still = settle.body, settle.speed * dt  # mm a step
+    if body is None or still <= 0:
+        for _ in range(settle.steps):
+            space.step(dt)
+        return steps + settle.steps
+    quiet = 0
+    last = (body.position.x, body.position.y, body.angle)
+    for i in range(settle.steps):
         space.step(dt)
-    return steps + settle_steps
+        # moved, not the velocity: chipmunk resolves overlap by a bias velocity the body's does not show
+        now = (body.position.x, body.position.y, body.angle)
+        moved = math.hypot(now[0] - last[0], now[1] - last[1]) + abs(now[2] - last[2]) * settle.reach
+        last = now
+        quiet = quiet + 1 if moved < still else 0
+        if quiet >= QUIET_STEPS and i + 1 >= MIN_SETTLE_STEPS:
+            return steps + i + 1
+    return steps + settle.steps
 
 
 class PymunkWorld:
@@ -200,9 +252,9 @@ class PymunkWorld:
     half_span : float, mm
         Half the jaw's length.
     chord_tolerance : float, mm
-        Polygonisation tolerance of the part (default 1e-4 mm). pymunk decides
-        whether, how hard and at which polygon vertex the jaw touches; the contact
-        location is then refined on the spline the polygon approximates.
+        Polygonisation tolerance of the part. pymunk decides whether, how hard and at which polygon
+        vertex the jaw touches; the contact location is then refined on the spline the polygon
+        approximates. Each step's cost grows with the segments under the jaw.
     friction : float
         Coulomb friction coefficient between jaw and part.
     dt : float, s
@@ -210,7 +262,9 @@ class PymunkWorld:
     linear_speed, angular_speed : float, mm/s and rad/s
         The hand's speed limits.
     settle_steps : int
-        Steps run after the hand reaches a commanded pose.
+        The most steps run after the hand reaches a commanded pose.
+    settle_speed : float, mm/s
+        Fewer when the jaw has come to rest (:func:`drive_hand`); 0: always ``settle_steps``.
     """
 
     def __init__(
@@ -219,12 +273,13 @@ class PymunkWorld:
         *,
         stiffness: float = 1.0,
         half_span: float = 50.0,
-        chord_tolerance: float = 1e-4,
+        chord_tolerance: float = CHORD_TOLERANCE,
         friction: float = 0.3,
         dt: float = 1e-3,
         linear_speed: float = 20.0,
         angular_speed: float = math.radians(30.0),
         settle_steps: int = 150,
+        settle_speed: float = SETTLE_SPEED,
     ):
         if not (stiffness > 0 and half_span > 0 and dt > 0 and friction >= 0):
             raise SimError(
@@ -238,11 +293,9 @@ class PymunkWorld:
         self.linear_speed = float(linear_speed)
         self.angular_speed = float(angular_speed)
         self.settle_steps = int(settle_steps)
+        self.settle_speed = float(settle_speed)
         self.steps = 0
-        space = pymunk.Space()
-        space.gravity = (0.0, 0.0)
-        space.collision_slop = 1e-4
-        space.iterations = 30
+        space = solver_space()
         self.space = space
         pts, self._poly_t = _polygon(part, chord_tolerance)
         self.polygon = pts
@@ -259,6 +312,8 @@ class PymunkWorld:
         groove = pymunk.GrooveJoint(self.hand_body, self.jaw_body, (0.0, -200.0), (0.0, 200.0), (0.0, 0.0))
         spring = pymunk.DampedSpring(self.hand_body, self.jaw_body, (0.0, -rest), (0.0, 0.0), rest, k, damping)
         gear = pymunk.GearJoint(self.hand_body, self.jaw_body, 0.0, 1.0)
+        for joint in (groove, spring, gear):
+            joint.error_bias = SOLVER_BIAS
         space.add(self.hand_body, self.jaw_body, jaw, groove, spring, gear)
         # not placed yet: the first command puts the arm there directly
         self.hand: tuple[float, float, float] | None = None
@@ -279,8 +334,9 @@ class PymunkWorld:
         """
         if self.hand is None:
             self._place(float(x), float(y), float(phi))
+        settle = Settle(self.settle_steps, self.settle_speed, self.jaw_body, self.half_span)
         self.steps += drive_hand(
-            self.space, self.hand_body, (x, y, phi), self.dt, self.linear_speed, self.angular_speed, self.settle_steps
+            self.space, self.hand_body, (x, y, phi), self.dt, self.linear_speed, self.angular_speed, settle
         )
         self.hand = (float(x), float(y), float(phi))
 
