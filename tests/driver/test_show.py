@@ -69,21 +69,38 @@ def test_what_show_cannot_draw_is_refused_by_name(reactive_trace, tmp_path, caps
     assert "must end in .png" in capsys.readouterr().err
 
 
-def test_the_animation_has_a_frame_a_reading_up_to_its_bound(reactive_trace, tmp_path, capsys):
+def test_the_animation_has_a_frame_a_reading_up_to_its_bound(reactive_trace, tmp_path, capsys, monkeypatch):
+    """The bound lowered to 24 frames (the film draws ~0.2 s a frame; the rolling has hundreds of readings,
+    so the bound is what decides), and the bound's own sampling at its real value below."""
     from PIL import Image
 
-    from driver.records import MAX_FRAMES
+    from driver.records import belief_film
 
+    bound = 24
+    monkeypatch.setattr(belief_film, "MAX_FRAMES", bound)
     out = tmp_path / "b.gif"
     assert (
         main(["show", str(reactive_trace), "--part", str(PARTS / "trefoil.json"), "--out", str(out), "--fps", "5"]) == 0
     )
     _, columns = read_archive(reactive_trace, LOG_COLUMNS)
     readings = int(np.count_nonzero(np.isin(columns["call"], [CALLS.index("update"), CALLS.index("regrasp")])))
+    assert readings > bound
     with Image.open(out) as gif:
-        assert gif.n_frames == min(readings, MAX_FRAMES) >= 20
+        assert gif.n_frames == bound
         assert gif.info["duration"] == 200  # ms a frame at 5 frames per second
-    assert f"{min(readings, MAX_FRAMES)} frames" in capsys.readouterr().out
+    assert f"{bound} frames" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("readings", [1, 20, 160, 161, 997])
+def test_a_film_draws_every_reading_up_to_its_bound_and_the_last_always(readings):
+    from driver.records.belief_film import MAX_FRAMES, _frames
+
+    drawn = _frames(readings)
+    assert drawn.size == min(readings, MAX_FRAMES)
+    assert drawn[0] == 0 and drawn[-1] == readings - 1 and np.all(np.diff(drawn) > 0)
+    if readings > MAX_FRAMES:
+        gaps = np.diff(drawn)
+        assert gaps.max() - gaps.min() <= 1  # evenly spread
 
 
 def test_an_animation_that_cannot_be_written_is_refused_by_name(reactive_trace, tmp_path, capsys):
@@ -96,15 +113,15 @@ def test_an_animation_that_cannot_be_written_is_refused_by_name(reactive_trace, 
         assert "needs ffmpeg" in capsys.readouterr().err
 
 
-def test_a_wheel_rolling_is_shown_and_animated(tmp_path, capsys):
+def test_a_wheel_rolling_is_shown_and_animated(tmp_path, capsys, monkeypatch):
     from PIL import Image
 
-    from driver.records import WheelTrace, replay_wheel_beliefs
+    from driver.records import WheelTrace, belief_film, replay_wheel_beliefs
     from localizer import WheelFilter
 
     trace_file = tmp_path / "w.npz"
     args = ["simulate", str(PARTS / "kidney.csv"), "--jaw", "wheel:5", "--start", "66", "--reactive", "--seed", "2"]
-    # a short rolling (15°, about 75 readings): the animation is drawn a frame a reading
+    # a short rolling (15°, about 75 readings)
     assert main([*args, "--noise", "paper", "--max-rotation", "15", "--out", str(trace_file)]) in (0, 2)
     part = load_part(PARTS / "kidney.csv")
     trace = WheelTrace.load(trace_file)
@@ -113,11 +130,12 @@ def test_a_wheel_rolling_is_shown_and_animated(tmp_path, capsys):
     assert history.final.mass == pytest.approx(final.mass) and history.final.map_arc == pytest.approx(final.map_arc)
     assert history.readings.shape[0] == trace.columns["length"].size
     assert history.true_arc[-1] == pytest.approx(trace.columns["true_arc"][-1])
+    monkeypatch.setattr(belief_film, "MAX_FRAMES", 20)  # the wheel drawn on 20 frames, not 75 (~0.15 s each)
     for name in ("w.png", "w.gif"):
         out = tmp_path / name
         assert main(["show", str(trace_file), "--part", str(PARTS / "kidney.csv"), "--out", str(out)]) == 0
     with Image.open(tmp_path / "w.gif") as gif:
-        assert gif.n_frames == min(trace.columns["length"].size, 160)
+        assert gif.n_frames == min(trace.columns["length"].size, 20) == 20
 
 
 def test_fixed_rolls_are_shown_as_the_reactive_filter_takes_them(tmp_path):
