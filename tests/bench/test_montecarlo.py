@@ -435,7 +435,9 @@ def test_workers_die_with_their_parent():
 
 
 def test_ctrl_c_keeps_the_finished_trials_and_does_not_wait_for_the_queue(tmp_path):
-    f = study_file(tmp_path, trials=150)
+    """Interrupted after two trials of 1500 (the queue alone is minutes of work on two workers): it stops
+    within 45 s however loaded the machine, keeping what finished."""
+    f = study_file(tmp_path, trials=1500)
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "driver.cli", "montecarlo", str(f), "--out", str(out), "--workers", "2"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
@@ -448,7 +450,7 @@ def test_ctrl_c_keeps_the_finished_trials_and_does_not_wait_for_the_queue(tmp_pa
     waited = time.monotonic() - t0
     finished = read_trials(out / "trials.csv")
     assert proc.returncode == 130 and "finished trials are kept; rerun with --resume" in err
-    assert waited < 15 and 2 <= len(finished) < 150
+    assert waited < 45 and 2 <= len(finished) < 1500
     summary = json.loads((out / "summary.json").read_text())
     assert sum(lv["trials"] for lv in summary["levels"]) == len(finished)
 
