@@ -98,19 +98,19 @@ def test_always_garbled_stops_with_a_clear_error(tmp_path):
     outcome, events, elapsed, _, _ = run_with_log(tmp_path, Faults(garble=1.0))
     assert isinstance(outcome, RigError)
     assert "did not answer STATUS after 3 tries" in str(outcome) and "garbled" in str(outcome)
-    assert elapsed < 5
+    assert elapsed < 30  # stopped, not hung: a few timeouts of 0.2-0.5 s, room for a loaded machine
 
 
 def test_dropped_replies_time_out_and_stop(tmp_path):
     outcome, events, elapsed, _, _ = run_with_log(tmp_path, Faults(drop=1.0), timeout=0.2)
     assert isinstance(outcome, RigError) and "no reply within 0.2 s" in str(outcome)
-    assert elapsed < 5
+    assert elapsed < 30  # stopped, not hung: a few timeouts of 0.2-0.5 s, room for a loaded machine
 
 
 def test_slow_device(tmp_path):
     outcome, _, elapsed, _, _ = run_with_log(tmp_path, Faults(delay=0.5), timeout=0.2, retries=1)
     assert isinstance(outcome, RigError) and "no reply" in str(outcome)
-    assert elapsed < 10
+    assert elapsed < 30  # stopped, not hung
 
 
 def test_disconnect_mid_roll_leaves_a_readable_log(tmp_path):
@@ -122,7 +122,7 @@ def test_disconnect_mid_roll_leaves_a_readable_log(tmp_path):
     assert readings and samples  # everything read before the fault is there
     trace = Trace.from_log(tmp_path / "run.jsonl")
     assert len(trace.columns["dv1"]) <= len(readings)
-    assert elapsed < 10
+    assert elapsed < 30  # stopped, not hung
 
 
 def test_saturated_sensor_stops_and_backs_off(tmp_path):
