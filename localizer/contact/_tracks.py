@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .._types import ArrayLike, BoolArray, FloatArray, IntArray
 from ..geometry import Boundary, check_grid, per_part
@@ -470,6 +469,8 @@ def _bitangent(
     change = np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) <= 0)
     if change.size != 1:
         return None
+    from scipy.optimize import brentq  # here: scipy.optimize is 0.3 s of every command's start
+
     k = int(change[0])
     phi = float(brentq(side, phis[k], phis[k + 1], xtol=1e-12)) if g[k] != g[k + 1] else float(phis[k])
     return (phi, *ends(phi))

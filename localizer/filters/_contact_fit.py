@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
-from scipy.stats import f as f_dist
+from scipy.special import fdtrc
 
 from .._defaults import FIT_ALPHA
 from .._types import ArrayLike, FloatArray, IntArray
@@ -147,7 +147,7 @@ class ContactFit(ContactMarginal):
             # a misfit the part's: the stretch's readings at least FIT_RATIO times as far off as the rest,
             # and as the noise it was told (the model's own approximations leave a stretch up to about five
             # times off on clean parts; noise-free readings show them alone)
-            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, 1.0), f_dist.sf(f_stat, kw, kr), 1.0)
+            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, 1.0), fdtrc(kw, kr, f_stat), 1.0)
             better = pv < best_p
             best_p = np.where(better, pv, best_p)
             best_size = np.where(better, stretch, best_size)

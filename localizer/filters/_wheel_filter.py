@@ -60,8 +60,7 @@ import math
 
 import numpy as np
 from scipy.linalg import solve_triangular
-from scipy.stats import chi2
-from scipy.stats import f as f_dist
+from scipy.special import chdtrc, fdtrc
 
 from .._defaults import CONFIDENCE, FIT_ALPHA, SUCCESS_RADIUS
 from .._errors import QueryError
@@ -480,7 +479,7 @@ class WheelFilter:
             # a noise-free pymunk wheel reads 3-5 sigma off the told model over a few readings on a plain
             # convex stretch, which the stated mass takes in and no part's defect needs to be told from
             floor = max(self.noise_scales) ** 2
-            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, floor), f_dist.sf(stretch / rest, kw, k - kw), 1.0)
+            pv = np.where(stretch >= FIT_RATIO * np.maximum(rest, floor), fdtrc(kw, k - kw, stretch / rest), 1.0)
             better = pv < best
             best = np.where(better, pv, best)
             for i in np.flatnonzero(better):
@@ -499,4 +498,4 @@ class WheelFilter:
         if k == 0:
             return True
         best = float(np.min(np.where(self.prior > 0, self._quad, np.inf)))
-        return bool(chi2.sf(best / WHEEL_FIT_SCALE**2, k) >= FIT_ALPHA)
+        return bool(chdtrc(k, best / WHEEL_FIT_SCALE**2) >= FIT_ALPHA)
