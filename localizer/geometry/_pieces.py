@@ -32,11 +32,14 @@ __all__ = ["Line", "CircularArc", "CubicBezier", "Piece", "elliptical_arc"]
 _GL_X, _GL_W = gauss_legendre(16)
 
 
+_PLAIN = (float, int, np.float64)
+
+
 def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
-    if isinstance(p, tuple) and len(p) == 2 and all(type(v) in (float, int, np.float64) for v in p):
-        x, y = float(p[0]), float(p[1])  # the common case, without an array: a drawing has 10⁵ points
-        if math.isfinite(x) and math.isfinite(y):
-            return x, y
+    if type(p) is tuple and len(p) == 2:
+        x, y = p  # the common case, without an array: a drawing has 10⁵ points
+        if type(x) in _PLAIN and type(y) in _PLAIN and math.isfinite(x) and math.isfinite(y):
+            return float(x), float(y)
     a = np.asarray(p, dtype=float)
     if a.shape != (2,) or not np.all(np.isfinite(a)):
         raise PartError(f"{what} must be a finite (x, y) point in mm, got {p!r}")
@@ -109,14 +112,16 @@ class CircularArc:
     @property
     def start(self) -> tuple[float, float]:
         """mm."""
-        p = self.point(0.0)
-        return float(p[0]), float(p[1])
+        return self._at_polar(self.start_angle)
 
     @property
     def end(self) -> tuple[float, float]:
         """mm."""
-        p = self.point(self.length)
-        return float(p[0]), float(p[1])
+        return self._at_polar(self.start_angle + math.copysign(1.0, self.sweep) * self.length / self.radius)
+
+    def _at_polar(self, a: float) -> tuple[float, float]:
+        """The point at polar angle ``a`` (rad), without arrays: a faceted drawing asks it of 10⁵ arcs."""
+        return self.center[0] + self.radius * math.cos(a), self.center[1] + self.radius * math.sin(a)
 
     def _polar(self, s: ArrayLike) -> FloatArray:
         out: FloatArray = self.start_angle + math.copysign(1.0, self.sweep) * np.asarray(s, dtype=float) / self.radius
