@@ -25,7 +25,7 @@ import numpy as np
 from localizer import Part
 
 from ._errors import SimError
-from .sampled import SampledPart
+from .sampled import BLOCK, SampledPart
 from .world import Contact
 
 __all__ = ["QuasiStaticWorld", "tangent_point", "outline_touch", "FLUSH"]
@@ -133,7 +133,18 @@ def outline_touch(
     """
     e = np.array([np.cos(phi), np.sin(phi)])
     m = np.array([-np.sin(phi), np.cos(phi)])
-    rel = outline.xy - origin
+    # only the runs of points that may hold the deepest point under the edge or one flush with it: a run
+    # lies within its radius r of its middle point, so none of it is deeper than that point's depth plus r,
+    # and the deepest point under the edge is at least as deep as any middle point under it
+    middle, r = outline.blocks
+    rel_m = outline.xy[middle] - origin
+    u_m, d_m = rel_m @ e, -(rel_m @ m)
+    under = np.abs(u_m) <= half_span
+    floor = float(d_m[under].max()) - FLUSH if under.any() else -np.inf
+    runs = np.flatnonzero((np.abs(u_m) - r <= half_span) & (d_m + r >= floor))
+    idx = (runs[:, None] * BLOCK + np.arange(BLOCK)).ravel()
+    idx = idx[idx < outline.xy.shape[0]]
+    rel = outline.xy[idx] - origin
     u = rel @ e
     depth = -(rel @ m)
     inside = np.abs(u) <= half_span
@@ -142,9 +153,10 @@ def outline_touch(
     k = int(np.argmax(np.where(inside, depth, -np.inf)))
     flush = inside & (depth >= depth[k] - FLUSH)
     P = outline.perimeter
+    arcs = outline.arcs[idx]
     # arcs relative to the deepest point's, so that a face across the first point stays whole
-    rel_arc = (outline.arcs[flush] - outline.arcs[k] + P / 2) % P - P / 2
-    arc = float((outline.arcs[k] + rel_arc.mean()) % P)
+    rel_arc = (arcs[flush] - arcs[k] + P / 2) % P - P / 2
+    arc = float((arcs[k] + rel_arc.mean()) % P)
     # the deepest point the last one under the jaw, not a line: the jaw's end is what touches
     line = float(np.ptp(u[flush])) > EDGE
     at_edge = not line and abs(float(u[k])) >= half_span - EDGE

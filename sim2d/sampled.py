@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -19,6 +20,8 @@ from localizer import Outline, Part, check_grid
 
 __all__ = ["SampledPart", "SAMPLE_SPACING", "model_sample", "polygon_vertices"]
 
+#: Points in a run of :attr:`SampledPart.blocks`.
+BLOCK = 64
 #: Arc between the points of a sampled part, mm: the kinematic world takes the deepest of them as the
 #: contact, so this bounds the contact's place error (a quarter of a µm of depth on a 10 mm radius).
 SAMPLE_SPACING = 0.005
@@ -57,6 +60,19 @@ class SampledPart:
     def perimeter(self) -> float:
         """The model's perimeter, mm: the arcs' period."""
         return float(self.model.perimeter)
+
+    @cached_property
+    def blocks(self) -> tuple[np.ndarray, np.ndarray]:
+        """The points in runs of :data:`BLOCK` in order: each run's middle point's index, and the farthest any
+        point of the run lies from it (mm). What lies under a jaw is sought run by run
+        (:func:`sim2d.quasistatic.outline_touch`)."""
+        n = self.xy.shape[0]
+        starts = np.arange(0, n, BLOCK)
+        middle = np.minimum(starts + BLOCK // 2, n - 1)
+        run = np.repeat(np.arange(starts.size), np.diff(np.append(starts, n)))
+        far = np.hypot(*(self.xy - self.xy[middle[run]]).T)
+        radius = np.maximum.reduceat(far, starts)
+        return middle, radius
 
 
 def model_sample(model: Part | Outline, spacing: float = SAMPLE_SPACING) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -173,3 +173,42 @@ def test_calibration_on_a_drawing_is_not_where_the_jaw_lies_flush_on_a_face():
         assert near.any() and v[near].min() >= 0.5, (side, v[near].min())
     for seed in range(4):
         calibrate_simulated(plate, load_noise("paper"), seed=seed, engine="kinematic")
+
+
+def _every_point_touch(outline, origin, phi, half_span):
+    """outline_touch's rule over every point of the sample (the reference its run-by-run search must equal)."""
+    from sim2d.quasistatic import EDGE, FLUSH
+
+    e, m = np.array([np.cos(phi), np.sin(phi)]), np.array([-np.sin(phi), np.cos(phi)])
+    rel = outline.xy - origin
+    u, depth = rel @ e, -(rel @ m)
+    inside = np.abs(u) <= half_span
+    if not inside.any():
+        return False, 0.0, float("nan"), 0.0, False
+    k = int(np.argmax(np.where(inside, depth, -np.inf)))
+    flush = inside & (depth >= depth[k] - FLUSH)
+    P = outline.perimeter
+    arc = float((outline.arcs[k] + ((outline.arcs[flush] - outline.arcs[k] + P / 2) % P - P / 2).mean()) % P)
+    at_edge = not float(np.ptp(u[flush])) > EDGE and abs(float(u[k])) >= half_span - EDGE
+    return True, float(u[flush].mean()), arc, float(depth[k]), at_edge
+
+
+@pytest.mark.parametrize("name", ["bracket.dxf", "profile.svg"])
+def test_the_touch_sought_run_by_run_is_the_touch_over_every_point(name):
+    """On the machined sample of each shipped drawing, jaws laid at random places, along the tangent and
+    tilted, pressed in and held clear, flush on faces and off the ends: the same contact, to the bit."""
+    from sim2d.quasistatic import outline_touch
+
+    rig = SimRig(load_outline(PARTS / name), noise="paper", seed=1)
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        x, y, phi = rig.approach_pose(
+            rng.uniform(0, rig.part.perimeter),
+            jaw_position=rng.uniform(-60, 60),
+            standoff=rng.uniform(-1.0, 0.5),
+            tilt=float(rng.choice([0.0, rng.normal(0, 0.05)])),
+        )
+        got = outline_touch(rig.part, (x, y), phi, 50.0)
+        want = _every_point_touch(rig.part, (x, y), phi, 50.0)
+        assert got == want or (not got[0] and not want[0])
+    assert outline_touch(rig.part, (1e4, 1e4), 0.0, 50.0)[0] is False  # nothing under a jaw far away
