@@ -36,7 +36,7 @@ _PLAIN = (float, int, np.float64)
 
 
 def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
-    if type(p) is tuple and len(p) == 2:
+    if isinstance(p, tuple) and len(p) == 2:
         x, y = p  # the common case, without an array: a drawing has 10⁵ points
         if type(x) in _PLAIN and type(y) in _PLAIN and math.isfinite(x) and math.isfinite(y):
             return float(x), float(y)
