@@ -155,11 +155,16 @@ def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_t
     assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3
 
 
-def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_connecting_and_reading_back(tmp_path):
+def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_connecting_and_reading_back(tmp_path, capsys):
+    """The emulator a process of its own on TCP, the commands run in this one (each a process would pay a
+    second of start-up nine times; the console script is main() under sys.exit, tested elsewhere)."""
     import json
     import os
     import subprocess
     import sys
+    from types import SimpleNamespace
+
+    from driver.cli import main
 
     port = 49000 + os.getpid() % 1000
     env = dict(os.environ, PYTHONUNBUFFERED="1")
@@ -174,7 +179,13 @@ def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_connect
     )
 
     def cli(*args):
-        return subprocess.run(exe + list(args), capture_output=True, text=True, timeout=120, env=env)
+        capsys.readouterr()
+        try:
+            rc = main(list(args))
+        except SystemExit as exc:  # argparse's refusals
+            rc = exc.code
+        out = capsys.readouterr()
+        return SimpleNamespace(returncode=rc, stdout=out.out, stderr=out.err)
 
     try:
         assert emu.stdout.readline().startswith("arm socket://127.0.0.1:")
