@@ -25,6 +25,7 @@ import numpy as np
 
 from .._errors import PartError
 from .._types import ArrayLike, FloatArray
+from ._bezier_kernels import arc_to_param
 from ._numerics import gauss_legendre, wrap_angle
 
 __all__ = ["Line", "CircularArc", "CubicBezier", "Piece", "elliptical_arc"]
@@ -167,6 +168,7 @@ class CubicBezier:
     _theta: FloatArray = field(init=False, repr=False, compare=False)  # unwrapped θ at 65 u, rad
     _rational: bool = field(init=False, repr=False, compare=False)  # weights not all equal
     _coef: FloatArray = field(init=False, repr=False, compare=False)  # power basis of (wx, wy, w), (4, 3)
+    _diff: FloatArray = field(init=False, repr=False, compare=False)  # p1 - p0, p2 - p1, p3 - p2, (3, 2)
 
     def __post_init__(self) -> None:
         for name in ("p0", "p1", "p2", "p3"):
@@ -179,6 +181,8 @@ class CubicBezier:
         h = np.c_[np.array([self.p0, self.p1, self.p2, self.p3]) * w[:, None], w]
         coef = np.array([h[0], 3 * (h[1] - h[0]), 3 * (h[2] - 2 * h[1] + h[0]), h[3] - 3 * h[2] + 3 * h[1] - h[0]])
         object.__setattr__(self, "_coef", coef)
+        p = np.array([self.p0, self.p1, self.p2, self.p3])
+        object.__setattr__(self, "_diff", np.diff(p, axis=0))
         u = np.linspace(0.0, 1.0, 257)
         if np.hypot(*self._d1(u).T).min() <= 1e-9 * max(1.0, self._size()):
             raise PartError(f"Bézier {self.p0}…{self.p3} stops (zero speed, a cusp): split it there")
@@ -288,17 +292,7 @@ class CubicBezier:
         k = np.clip(np.searchsorted(self._cum, arc, side="right") - 1, 0, len(self._breaks) - 2)
         lo, hi = self._breaks[k], self._breaks[k + 1]
         u: FloatArray = lo + (hi - lo) * (arc - self._cum[k]) / np.maximum(self._cum[k + 1] - self._cum[k], 1e-300)
-        # Newton on the points not yet within 1e-12 mm (each step costs a 16-point rule per point)
-        live = np.ones(u.shape, dtype=bool)
-        for _ in range(50):
-            ul, lol, hil, kl = u[live], lo[live], hi[live], k[live]
-            f = self._cum[kl] + self._gauss_to(lol, ul) - arc[live]
-            done = np.abs(f) <= 1e-12
-            step = f / np.maximum(self._speed(ul), 1e-300)
-            u[live] = np.where(done, ul, np.clip(ul - step, lol, hil))
-            live[live] = ~done
-            if not live.any():
-                break
+        arc_to_param(self._coef, self._diff, self._rational, _GL_X, _GL_W, self._cum, k, lo, hi, arc, u)
         return u.reshape(shape)
 
     def _gauss_to(self, a: FloatArray, b: FloatArray) -> FloatArray:
