@@ -61,7 +61,7 @@ def _gauss_to(
     r5 += _speed(coef, diff, rational, a + d * gl_x[13]) * gl_w[13]
     r6 += _speed(coef, diff, rational, a + d * gl_x[14]) * gl_w[14]
     r7 += _speed(coef, diff, rational, a + d * gl_x[15]) * gl_w[15]
-    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    total: float = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
     return total * (b - a)
 
 
