@@ -29,6 +29,34 @@ max_rotation_deg = 60.0
     return f, record_trial(f, 0, 0)
 
 
+@pytest.fixture
+def recorded_once(recorded, monkeypatch):
+    """The command line given the fixture's recording of level 0, trial 0 instead of running the trial again
+    for each command (a trial is deterministic: ``test_a_trial_records_the_same_calls_twice``)."""
+    import bench.replay
+
+    f, rec = recorded
+    record = bench.replay.record_trial
+
+    def once(study, level, trial):
+        return rec if (Path(study), level, trial) == (f, 0, 0) else record(study, level, trial)
+
+    monkeypatch.setattr(bench.replay, "record_trial", once)
+    return recorded
+
+
+def test_a_trial_records_the_same_calls_twice(recorded):
+    f, rec = recorded
+    import pickle
+
+    again = record_trial(f, 0, 0)
+    # byte for byte (NaN, which the calls and the row hold, is not equal to itself); all but the time it took
+    assert pickle.dumps(again.calls) == pickle.dumps(rec.calls)
+    assert [(k, pickle.dumps(v)) for k, v in again.row.items() if k != "time_s"] == [
+        (k, pickle.dumps(v)) for k, v in rec.row.items() if k != "time_s"
+    ]
+
+
 def test_the_recorded_calls_give_back_the_run_belief(recorded):
     _, rec = recorded
     names = {c[0] for c in rec.calls}
@@ -39,8 +67,8 @@ def test_the_recorded_calls_give_back_the_run_belief(recorded):
     assert as_run.margin > 0  # it localized: the true start leads
 
 
-def test_the_recorded_calls_as_a_kept_log_give_back_the_run_belief(recorded, tmp_path, capsys):
-    f, rec = recorded
+def test_the_recorded_calls_as_a_kept_log_give_back_the_run_belief(recorded_once, tmp_path, capsys):
+    f, rec = recorded_once
     b = replay_log(ContactFilter(rec.part, **rec.settings), log_columns(rec.calls))
     assert b.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
     out = tmp_path / "t.png"
@@ -56,8 +84,8 @@ def test_a_variant_changes_only_the_filter(recorded):
     assert told_ten_times.settings == {"sd_position": 0.4, "noise_scales": (1.0,)}
 
 
-def test_the_command_line(recorded, capsys):
-    f, _ = recorded
+def test_the_command_line(recorded_once, capsys):
+    f, _ = recorded_once
     assert main([str(f), "--level", "0", "--trial", "0", "--set", "temper=1", "--set", "nonsense=2"]) == 0
     out, err = capsys.readouterr()
     assert "as run" in out and "{'temper': 1}" in out
@@ -82,8 +110,8 @@ def test_the_belief_part_way_is_that_of_the_calls_made_before_that_turn(recorded
     assert alone.settings == {"defect_window": 0.0, "slope_envelope": (), "lookalike_slope": 0.0}
 
 
-def test_a_variant_of_several_settings_on_the_command_line(recorded, capsys):
-    f, _ = recorded
+def test_a_variant_of_several_settings_on_the_command_line(recorded_once, capsys):
+    f, _ = recorded_once
     assert main([str(f), "--level", "0", "--trial", "0", "--at", "20", "--set", "temper=1 defect_window=0"]) == 0
     assert main([str(f), "--level", "0", "--trial", "0", "--set", "corner_ends=false"]) == 0
     out, _ = capsys.readouterr()
