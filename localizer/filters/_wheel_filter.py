@@ -281,15 +281,8 @@ class WheelFilter:
     def _model_at(self, length: float, turn: float) -> tuple[FloatArray, FloatArray]:
         """:meth:`predicted_turn` and each start's curvature (1/mm) at its contact after ``length`` mm."""
         theta, kappa = self._angles.at(length)
-        model = pivot_turn(
-            self.part,
-            self.grid + float(length),
-            self._theta0,
-            theta - self._theta0,
-            float(turn),
-            self.corner_window(length),
-        )
-        return model, kappa
+        x, window = self.grid + float(length), self.corner_window(length)
+        return pivot_turn(self.part, x, self._theta0, theta - self._theta0, float(turn), window), kappa
 
     def update(self, length: float, turn: float) -> None:
         """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
