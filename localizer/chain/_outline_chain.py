@@ -120,7 +120,9 @@ class _Ways(NamedTuple):
     def most(self) -> int:
         """The most ways into any one state (at least 1)."""
         return max(
-            1, int((self.a_hi - self.a_lo).max(initial=0)) + sum(int(np.bincount(p[0]).max()) for p in self.pairs)
+            1,
+            int((self.a_hi - self.a_lo).max(initial=0))
+            + sum(int(np.bincount(p[0]).max(initial=0)) for p in self.pairs),
         )
 
 
