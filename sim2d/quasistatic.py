@@ -135,8 +135,10 @@ def outline_touch(
     m = np.array([-np.sin(phi), np.cos(phi)])
     # only the runs of points that may hold the deepest point under the edge or one flush with it: a run
     # lies within its radius r of its middle point, so none of it is deeper than that point's depth plus r,
-    # and the deepest point under the edge is at least as deep as any middle point under it
+    # and the deepest point under the edge is at least as deep as any middle point under it (the radii
+    # widened by 1e-9 mm, far above the rounding of coordinates of a few hundred mm)
     middle, r = outline.blocks
+    r = r + 1e-9
     rel_m = outline.xy[middle] - origin
     u_m, d_m = rel_m @ e, -(rel_m @ m)
     under = np.abs(u_m) <= half_span

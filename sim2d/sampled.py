@@ -18,7 +18,7 @@ import numpy as np
 
 from localizer import Outline, Part, check_grid
 
-__all__ = ["SampledPart", "SAMPLE_SPACING", "model_sample", "polygon_vertices"]
+__all__ = ["SampledPart", "SAMPLE_SPACING", "BLOCK", "model_sample", "polygon_vertices"]
 
 #: Points in a run of :attr:`SampledPart.blocks`.
 BLOCK = 64

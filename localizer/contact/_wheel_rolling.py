@@ -42,8 +42,8 @@ class ShiftedGrid:
     a cubic Hermite interpolation of Θ (its derivative κ known at every node) and a linear one of κ. At the
     wheel filter's 0.02 mm grid this is within 2e-8 rad of the spline's own evaluation on the shipped
     parts and 2.5e-5 rad on the tightest held-out glyph (κ up to 5.8 mm⁻¹), under 6% of one reading's
-    angle error, where the spline's evaluation (arc to parameter by Newton at every start) costs ~15 ms a
-    reading. On a drawing Θ steps at corners and κ at the ends of arcs, which no interpolation crosses:
+    angle error, where the spline's evaluation (arc to parameter by Newton at every start) costs ~10 ms a
+    reading on the kidney. On a drawing Θ steps at corners and κ at the ends of arcs, which no interpolation crosses:
     there the drawing's own exact and cheap evaluation is used.
 
     Parameters
