@@ -1,5 +1,5 @@
-"""A decision of the reactive policy that seeks information (issue 32's bound: ≤ 20 ms on the benchmark
-part): the expected gain each way over the 64 most probable starts, and whether each way is clear.
+"""A decision of the reactive policy that seeks information (bound: ≤ 20 ms on the benchmark part): the
+expected gain each way over the 64 most probable starts, and whether each way is clear.
 
 Run: ``pytest bench/benchmarks/test_policy.py --benchmark-only``. The filter is first fed a 10° noise-free
 roll from 20 mm on the trefoil (50 readings, a belief every 5 as the reactive procedure checks), where
