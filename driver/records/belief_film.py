@@ -41,17 +41,15 @@ def _frames(n: int) -> NDArray[np.intp]:
 
 def _places(mass: NDArray[np.float64], edges: NDArray[np.float64], k: int = 3) -> list[tuple[float, float]]:
     """The ``k`` leading places of a belief histogram: (arc mm, share), each the peak of a run of bins
-    separated by empty ones, its share the run's mass."""
+    separated by empty ones (at most 1e-6 of the fullest), its share the run's mass."""
+    full = np.r_[False, mass > 1e-6 * mass.max(), False]
+    starts = np.flatnonzero(full[1:] & ~full[:-1])
+    stops = np.flatnonzero(full[:-1] & ~full[1:])
     runs: list[tuple[float, float]] = []
-    start = None
-    for i, m in enumerate(np.append(mass, 0.0)):
-        if m > 1e-6 * mass.max() and start is None:
-            start = i
-        elif m <= 1e-6 * mass.max() and start is not None:
-            seg = mass[start:i]
-            peak = start + int(np.argmax(seg))
-            runs.append((0.5 * float(edges[peak] + edges[peak + 1]), float(seg.sum())))
-            start = None
+    for a, b in zip(starts, stops):
+        seg = mass[a:b]
+        peak = int(a) + int(np.argmax(seg))
+        runs.append((0.5 * float(edges[peak] + edges[peak + 1]), float(seg.sum())))
     return sorted(runs, key=lambda r: -r[1])[:k]
 
 
@@ -117,6 +115,8 @@ def write_film(
     (grown,) = ax_p.plot([], [], "-", color="tab:red", lw=1.6)
     stated_axes(ax_p, history, max(float(deg[-1]), 1.0))
 
+    placed: dict[int, list[tuple[float, float]]] = {}  # frames between two checks show the same places
+
     def draw(k: int) -> list[Artist]:
         rotation, jaw, true_arc, check = readings[k]
         c = int(check)
@@ -128,7 +128,7 @@ def write_film(
             jaw_line.set_data(outline[:, 0], outline[:, 1])
             p = part.point_at_arc(where)
             contact.set_data([p[0]], [p[1]])
-        places = _places(mass, history.edges) if c >= 0 else []
+        places = placed.setdefault(c, _places(mass, history.edges) if c >= 0 else [])
         for label, (arc, share) in zip(labels, places):
             xy = part.point_at_arc(arc)
             label.set_position((float(xy[0]), float(xy[1])))
