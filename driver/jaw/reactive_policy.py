@@ -215,8 +215,7 @@ def information_by_direction(
     if top.size < 2:
         return (0.0, 0.0)
     wt = w[top] / w[top].sum()
-    mean, _ = flt.shift()
-    present = flt.part.wrap_arc(flt.current[top] + mean[top])
+    present = flt.present()[top]
     same = np.abs(flt.part.arc_offset(present[:, None], present[None, :])) <= flt.radius
     now = float(wt @ (same @ wt))
     variance = 2.0 * (flt.sd_position * flt.noise_scale()) ** 2

@@ -155,10 +155,16 @@ def replay_beliefs(
     def observe(name: str, arc: float, turn: float, jaw: float, value: float, belief: Belief | None) -> None:
         nonlocal found, now_true
         if name in ("update", "regrasp"):
-            match = np.flatnonzero((np.abs(rows_turn[found:] - turn) < 1e-12) & (np.abs(rows_arc[found:] - arc) < 1e-9))
-            if match.size:
-                found += int(match[0]) + 1
-                now_true = float(rows_true[found - 1])
+            # the first of the readings not yet found that is this one: near the last found, so looked for
+            # there first (a rolling has thousands of readings), then among the rest
+            for lo, hi in ((found, found + 64), (found + 64, rows_turn.size)):
+                match = np.flatnonzero(
+                    (np.abs(rows_turn[lo:hi] - turn) < 1e-12) & (np.abs(rows_arc[lo:hi] - arc) < 1e-9)
+                )
+                if match.size:
+                    found = lo + int(match[0]) + 1
+                    now_true = float(rows_true[found - 1])
+                    break
             keep.reading(turn, jaw, now_true)  # jaw: NaN where not given
             if name == "regrasp":
                 keep.event("regrasp")
@@ -167,8 +173,7 @@ def replay_beliefs(
         elif name == "bridged":
             keep.event("bridge")
         elif belief is not None:
-            mean, _ = flt.shift()
-            keep.check(belief, flt.part.wrap_arc(flt.current + mean), flt.posterior(), now_true)
+            keep.check(belief, flt.present(), flt.posterior(), now_true)
 
     return keep.history(replay_log(flt, columns, observe))
 

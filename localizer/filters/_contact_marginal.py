@@ -146,6 +146,11 @@ class ContactMarginal(ContactState):
         """
         return self._shift(1.0)
 
+    def present(self) -> FloatArray:
+        """Each start's present contact, mm: the nominal one moved by its :meth:`shift`."""
+        out: FloatArray = self.part.wrap_arc(self.current + self.shift()[0])
+        return out
+
     def _shift(self, factor: float) -> tuple[FloatArray, FloatArray]:
         """:meth:`shift` with the slope prior's standard deviations times ``factor``."""
         return self._shift_of(self._solved(factor))

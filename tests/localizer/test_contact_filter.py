@@ -55,6 +55,22 @@ def test_noise_free_posterior_concentrates_at_the_truth(cam):
     assert len(b.modes) >= 1 and abs(cam.arc_offset(b.modes[0].start_arc, 57.3)) < 0.03
 
 
+def test_each_start_s_present_contact_is_where_its_own_rolling_ends(cam):
+    """Noise-free, without the slope term (no shift): every start still weighed has its present contact where
+    the filter's tracks take that start by the rolled turns, and the true start's is the true contact."""
+    flt = ContactFilter(cam, sd_position=0.005, sd_scale=0.0, sd_slope=0.0)
+    turns = STEP * np.arange(1, 51)
+    z, arcs = readings(flt, 57.3, turns)
+    feed(flt, z, turns)
+    present = flt.present()
+    i = int(round(57.3 / flt.tracks.h)) % flt.grid.size
+    assert abs(cam.arc_offset(present[i], arcs[-1])) < 1e-9
+    idx = np.flatnonzero(flt.posterior() > 0)
+    assert idx.size > 10
+    ends, ok = flt.tracks.advance(idx, float(turns[-1]))
+    assert np.abs(cam.arc_offset(present[idx[ok]], ends[ok])).max() < 1e-6
+
+
 def test_noisy_posterior_covers_the_truth_and_sharpens_with_rotation(cam):
     rng = np.random.default_rng(4)
     flt = ContactFilter(cam, sd_position=0.035, sd_scale=0.0, sd_slope=0.0)
