@@ -21,12 +21,13 @@ RECORD_KINDS = ("fixed", "reactive", "wheel")
 
 
 class RunRecord(NamedTuple):
-    """A run's record: its kind (one of :data:`RECORD_KINDS`), its path, and a run log's events (None for a
-    trace)."""
+    """A run's record: its kind (one of :data:`RECORD_KINDS`), its path, a run log's events (None for a
+    trace) and a reactive run log's filter calls (:data:`LOG_COLUMNS`; None otherwise)."""
 
     kind: str
     path: str
     events: list[dict[str, Any]] | None
+    calls: dict[str, np.ndarray] | None = None
 
     def fixed(self) -> Trace:
         """The fixed rolls' trace (a run log made into one)."""
@@ -53,8 +54,9 @@ def open_record(path: str | os.PathLike[str]) -> RunRecord:
     events = read_log(path)
     if str(events[0].get("jaw", "straight")).startswith("wheel"):
         return RunRecord("wheel", path, events)
-    if calls_from_events(events) is not None:
-        return RunRecord("reactive", path, events)
+    calls = calls_from_events(events)
+    if calls is not None:
+        return RunRecord("reactive", path, events, calls)
     if any(e.get("event") == "belief" for e in events):
         raise RigError(
             f"run log {path} is of a reactive run whose filter calls it does not hold (the run ended before its "
@@ -69,11 +71,10 @@ def reactive_calls(
     """A reactive record's run (its JSON object with its part's record), its filter's kept calls
     (:data:`LOG_COLUMNS`) and, for a trace, its readings (``arcs``, ``turns``, ``true_arcs``; None for a log)."""
     if record.events is not None:
-        events = record.events
-        columns = calls_from_events(events)
-        if columns is None:
+        if record.calls is None:
             raise RigError(f"run log {record.path} holds no filter calls")
+        events = record.events
         result: dict[str, Any] = next((e for e in reversed(events) if e.get("event") == "result"), {})
-        return {**result, "part": events[0].get("part")}, columns, None
+        return {**result, "part": events[0].get("part")}, record.calls, None
     meta, columns = read_archive(record.path, LOG_COLUMNS)
     return meta, columns, read_archive(record.path, ("arcs", "turns", "true_arcs"))[1]
