@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from localizer import SUCCESS_RADIUS, Outline, Part, QueryError, WheelJaw, wheel_reach_for
 
-from ..records import check_same_part, part_record
+from ..records import check_finger, check_same_part, part_record
 from ..rig import Rig, RigError
 from ..wheel import wheel_calibration_arc
 from ._options import UsageError, pressing
@@ -224,8 +224,7 @@ def locate_wheel(args: argparse.Namespace, record: RunRecord) -> int:
 
     path = record.path
     trace = record.wheel()
-    if args.jaw is not None and str(args.jaw) != trace.metadata["jaw"]:
-        raise RigError(f"trace {path} is of a {trace.metadata['jaw']} finger, not of {args.jaw}")
+    check_finger(path, trace.metadata["jaw"], args.jaw)
     part = load_part(args.part)
     check_same_part(trace.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
     b = trace.relocalize(part)

@@ -29,6 +29,7 @@ from localizer import (
 from ..records import (
     CALLS,
     SAME_PART_FLAG,
+    check_finger,
     check_same_part,
     open_record,
     reactive_calls,
@@ -211,8 +212,7 @@ def locate_command(args: argparse.Namespace) -> int:
         meta, columns, readings = reactive_calls(record)
         truth = readings["true_arcs"] if readings is not None else np.array([], dtype=float)
         return locate_reactive(args, args.trace, meta, columns, truth)
-    if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
-        raise RigError(f"trace {args.trace} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
+    check_finger(args.trace, DEFAULT_JAW, args.jaw)
     part = load_part(args.part)
     trace = record.fixed()
     check_same_part(trace.metadata.get("part"), part, args.part, f"trace {args.trace}", same=args.same_part)
@@ -238,8 +238,7 @@ def locate_reactive(
 
     Where the part seemed to differ from its model is the filter's finding, or else the run's own
     (a jump the jaw left, or one no place explains: what the hand did, which the calls do not hold)."""
-    if args.jaw is not None and str(args.jaw) != str(DEFAULT_JAW):
-        raise RigError(f"trace {path} is of the {DEFAULT_JAW} jaw, not of {args.jaw}")
+    check_finger(path, DEFAULT_JAW, args.jaw)
     if args.plot:
         raise UsageError(
             f"--plot {args.plot}: a reactive trace's plot is drawn by the run itself ('simulate --reactive --plot'); "

@@ -51,6 +51,7 @@ def show_command(args: argparse.Namespace) -> int:
 
     from ..records import (
         FILM_SUFFIXES,
+        check_finger,
         check_same_part,
         open_record,
         plot_belief_history,
@@ -67,9 +68,7 @@ def show_command(args: argparse.Namespace) -> int:
     path = str(args.trace)
     record = open_record(path)
     wheel = record.wheel() if record.kind == "wheel" else None
-    finger = wheel.metadata["jaw"] if wheel is not None else str(DEFAULT_JAW)
-    if args.jaw is not None and str(args.jaw) != finger:
-        raise RigError(f"trace {path} is of the {finger} finger, not of --jaw {args.jaw}")
+    check_finger(path, wheel.metadata["jaw"] if wheel is not None else DEFAULT_JAW, args.jaw)
     radius: float | None = None
     if wheel is not None:
         part = load_part(args.part)

@@ -27,7 +27,7 @@ from .filter_log import (
 from .mcap_export import READING_PERIOD, SCHEMAS, TOPICS, Message, export_mcap, run_messages, write_mcap
 from .part_match import SAME_PART_FLAG, PartMismatch, check_same_part, part_record
 from .plotting import draw_part, plot_localization, plot_reactive, plot_run
-from .run_record import RECORD_KINDS, RunRecord, open_record, reactive_calls
+from .run_record import RECORD_KINDS, RunRecord, check_finger, open_record, reactive_calls
 from .runlog import LOG_FORMAT, RunLog, read_log
 from .trace import COLUMNS, FORMAT, Trace, read_archive, trace_format
 from .wheel_trace import WHEEL_COLUMNS, WHEEL_FORMAT, WheelTrace
@@ -70,6 +70,7 @@ __all__ = [
     "RECORD_KINDS",
     "RunRecord",
     "open_record",
+    "check_finger",
     "reactive_calls",
     "LOG_FORMAT",
     "RunLog",

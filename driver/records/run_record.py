@@ -14,7 +14,7 @@ from .runlog import read_log
 from .trace import Trace, read_archive, trace_format
 from .wheel_trace import WHEEL_FORMAT, WheelTrace
 
-__all__ = ["RunRecord", "open_record", "reactive_calls", "RECORD_KINDS"]
+__all__ = ["RunRecord", "open_record", "reactive_calls", "check_finger", "RECORD_KINDS"]
 
 #: The kinds of run a record can hold.
 RECORD_KINDS = ("fixed", "reactive", "wheel")
@@ -78,3 +78,10 @@ def reactive_calls(
         return {**result, "part": events[0].get("part")}, record.calls, None
     meta, columns = read_archive(record.path, LOG_COLUMNS)
     return meta, columns, read_archive(record.path, ("arcs", "turns", "true_arcs"))[1]
+
+
+def check_finger(path: str | os.PathLike[str], finger: object, jaw: object | None) -> None:
+    """Refuse a ``--jaw`` given (``jaw``; None: not given) that is not the ``finger`` the record at ``path`` was
+    made with (both as their text, e.g. ``wheel:5``)."""
+    if jaw is not None and str(jaw) != str(finger):
+        raise RigError(f"trace {path} is of the {finger} finger, not of --jaw {jaw}")

@@ -218,7 +218,7 @@ def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_connect
     assert loc.returncode == 0, loc.stderr
     assert json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"], abs=1e-6)
     other = cli("locate", str(tmp_path / "r.jsonl"), "--part", kidney, "--jaw", "wheel:3")
-    assert other.returncode == 2 and "not of wheel:3" in other.stderr
+    assert other.returncode == 2 and "of the wheel:5 finger, not of --jaw wheel:3" in other.stderr
     # ... and on another part: refused by name, not scored
     elsewhere = cli("locate", str(tmp_path / "r.jsonl"), "--part", "parts/trefoil.json")
     assert elsewhere.returncode == 2 and "was made on part 'kidney'" in elsewhere.stderr, elsewhere.stderr
