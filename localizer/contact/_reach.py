@@ -40,6 +40,7 @@ from scipy.spatial import ConvexHull
 from .._errors import QueryError
 from .._types import ArrayLike, BoolArray, FloatArray, IntArray
 from ..geometry import MAX_PAIRWISE_POINTS, Boundary, Outline, check_grid, per_part
+from ._reach_kernels import reach_intervals
 
 __all__ = ["StraightJaw", "DEFAULT_JAW", "Reach", "reach_for", "calibration_arc", "grid_neighbours"]
 
@@ -143,7 +144,7 @@ class Reach:
             depth = np.maximum(depth, (e[:, :2] @ pts.T + e[:, 2:3]).max(axis=0))
         self.hull_depth: FloatArray = np.maximum(-depth, 0.0)
         tiny = 1e-9 * max(1.0, float(np.ptp(pts)))  # rounding of the depth
-        self._pts = pts
+        self._pts = np.ascontiguousarray(pts, dtype=float)
         lo, hi, lo_sure, hi_sure = self._intervals(np.arange(n), tan, tiny)
         self.lo, self.hi = lo, hi
         self.lo_sure, self.hi_sure = np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
@@ -157,32 +158,16 @@ class Reach:
         """(lo, hi, lo_sure, hi_sure) for the jaw along unit ``tangents`` touching the grid points ``points``
         (or the points ``origins``, mm, near them), the sure interval not yet intersected with the
         generous one."""
-        pts, n, half, c = self._pts, self.sigma.size, self.jaw.half, self.clearance
-        m = points.size
-        lo, hi = np.full(m, -np.inf), np.full(m, np.inf)
-        lo_sure, hi_sure = np.full(m, -np.inf), np.full(m, np.inf)
-        k = np.arange(n)
-        for start in range(0, m, 128):
-            rows = np.arange(start, min(start + 128, m))
-            i = points[rows]
-            # the boundary in arc order from each P: column k is the point k grid steps ahead of P
-            here = pts[i] if origins is None else origins[rows]
-            q = pts[(i[:, None] + k[None, :]) % n] - here[:, None, :]  # (b, n, 2): Q − P
-            e = tangents[rows, None, :]
-            w = np.einsum("bnk,bnk->bn", q, e)  # along the tangent
-            dep = q[..., 0] * e[..., 1] - q[..., 1] * e[..., 0]  # −(Q−P)·m, m the inner normal
-            # generous: blocked by a point deeper than the clearance
-            block = dep > c
-            lo[rows], hi[rows] = self._interval(w, block, half)
-            # sure: also by a point within the clearance of the edge, except P's own cap (the
-            # stretch around P that stays within it below the edge, which is the contact itself)
-            clear_of = dep < -c
-            ahead = np.where(clear_of[:, 1:].any(axis=1), np.argmax(clear_of[:, 1:], axis=1) + 1, n)
-            behind = np.where(clear_of[:, :0:-1].any(axis=1), np.argmax(clear_of[:, :0:-1], axis=1) + 1, n)
-            cap = (k[None, :] < ahead[:, None]) | (k[None, :] > n - behind[:, None])
-            cap &= dep <= tiny  # rising above the edge blocks
-            lo_sure[rows], hi_sure[rows] = self._interval(w, (dep > -c) & ~cap, half)
-        return lo, hi, lo_sure, hi_sure
+        here = self._pts[points] if origins is None else origins
+        return reach_intervals(
+            self._pts,
+            np.ascontiguousarray(points, dtype=np.int64),
+            np.ascontiguousarray(tangents, dtype=float),
+            np.ascontiguousarray(here, dtype=float),
+            self.clearance,
+            self.jaw.half,
+            tiny,
+        )
 
     def at_angle(self, arc: ArrayLike, angle: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """(lo, hi, lo_sure, hi_sure), mm: where on the jaw it touches the boundary at ``arc`` (mm) when the
@@ -195,14 +180,6 @@ class Reach:
         origins = np.asarray(self.part.point_at_arc(a), dtype=float).reshape(-1, 2)
         lo, hi, lo_sure, hi_sure = self._intervals(i, tan, self._tiny, origins)
         return lo, hi, np.maximum(lo, lo_sure), np.minimum(hi, hi_sure)
-
-    @staticmethod
-    def _interval(w: FloatArray, block: BoolArray, half: float) -> tuple[FloatArray, FloatArray]:
-        """(lo, hi) per row from the blocking points' places ``w`` along the tangent (module notes)."""
-        w_plus = np.where(block & (w > 0), w, np.inf).min(axis=1)
-        w_minus = np.where(block & (w < 0), w, -np.inf).max(axis=1)
-        here = (block & (w == 0)).any(axis=1)
-        return np.where(here, np.inf, half - w_plus), np.where(here, -np.inf, -half - w_minus)
 
     def interval(self, arc: ArrayLike, sure: bool = False) -> tuple[FloatArray, FloatArray]:
         """(lo, hi) jaw positions, mm, at which the jaw can touch at arc position(s) ``arc`` (mm).

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from localizer import QueryError, Reach, StraightJaw, calibration_arc, load_part, part_from_points
+from localizer import QueryError, Reach, StraightJaw, calibration_arc, load_outline, load_part, part_from_points
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -21,6 +21,66 @@ def brute_touchable(part, arc, d, half=50.0, clearance=0.1, per_piece=64):
     depth = q[:, 0] * e[1] - q[:, 1] * e[0]
     inside = (w >= -half - d) & (w <= half - d)
     return not np.any(inside & (depth > clearance))
+
+
+def numpy_intervals(pts, points, tangents, clearance, half, tiny, origins=None):
+    """The reach's intervals as numpy computes them, in blocks of rows of every pair of points: the
+    reference the compiled loop must equal to the bit."""
+    n, m = len(pts), points.size
+    lo, hi = np.full(m, -np.inf), np.full(m, np.inf)
+    lo_sure, hi_sure = np.full(m, -np.inf), np.full(m, np.inf)
+    k = np.arange(n)
+
+    def interval(w, block):
+        w_plus = np.where(block & (w > 0), w, np.inf).min(axis=1)
+        w_minus = np.where(block & (w < 0), w, -np.inf).max(axis=1)
+        here = (block & (w == 0)).any(axis=1)
+        return np.where(here, np.inf, half - w_plus), np.where(here, -np.inf, -half - w_minus)
+
+    for start in range(0, m, 128):
+        rows = np.arange(start, min(start + 128, m))
+        i = points[rows]
+        here = pts[i] if origins is None else origins[rows]
+        q = pts[(i[:, None] + k[None, :]) % n] - here[:, None, :]
+        e = tangents[rows, None, :]
+        w = np.einsum("bnk,bnk->bn", q, e)
+        dep = q[..., 0] * e[..., 1] - q[..., 1] * e[..., 0]
+        lo[rows], hi[rows] = interval(w, dep > clearance)
+        clear_of = dep < -clearance
+        ahead = np.where(clear_of[:, 1:].any(axis=1), np.argmax(clear_of[:, 1:], axis=1) + 1, n)
+        behind = np.where(clear_of[:, :0:-1].any(axis=1), np.argmax(clear_of[:, :0:-1], axis=1) + 1, n)
+        cap = ((k[None, :] < ahead[:, None]) | (k[None, :] > n - behind[:, None])) & (dep <= tiny)
+        lo_sure[rows], hi_sure[rows] = interval(w, (dep > -clearance) & ~cap)
+    return lo, hi, lo_sure, hi_sure
+
+
+@pytest.mark.parametrize("name", ["trefoil.json", "kidney.csv", "bracket.dxf", "star"])
+def test_the_compiled_intervals_are_numpys_to_the_bit(name, star):
+    part = star if name == "star" else (load_outline if name.endswith(".dxf") else load_part)(ROOT / "parts" / name)
+    for clearance in (0.0, 0.1):
+        r = Reach(part, clearance=clearance)
+        pts = np.asarray(part.point_at_arc(r.sigma))
+        tiny = 1e-9 * max(1.0, float(np.ptp(pts)))  # as the reach rounds a depth
+        theta = np.asarray(part.tangent_angle_at_arc(r.sigma))
+        tan = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+        ref = numpy_intervals(pts, np.arange(r.sigma.size), tan, clearance, r.jaw.half, tiny)
+        lo, hi = ref[0], ref[1]
+        for got, want in zip(
+            (r.lo, r.hi, r.lo_sure, r.hi_sure), (lo, hi, np.maximum(lo, ref[2]), np.minimum(hi, ref[3]))
+        ):
+            assert np.array_equal(got, want)
+        # every part has points the jaw reaches whole, in part, and not at all: each branch is taken
+        assert (r.lo <= -r.jaw.half).any() and (r.lo > -r.jaw.half).any() and (r.lo >= r.hi).any()
+        # off the grid and off the tangent, as on a convex corner
+        rng = np.random.default_rng(1)
+        arc, angle = rng.uniform(0, part.perimeter, 300), rng.uniform(-np.pi, np.pi, 300)
+        i = np.mod(np.rint(arc / r.h).astype(np.int64), r.sigma.size)
+        tan = np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+        origins = np.asarray(part.point_at_arc(arc), dtype=float)
+        lo, hi, lo_sure, hi_sure = numpy_intervals(pts, i, tan, clearance, r.jaw.half, tiny, origins)
+        got = r.at_angle(arc, angle)
+        for a, b in zip(got, (lo, hi, np.maximum(lo, lo_sure), np.minimum(hi, hi_sure))):
+            assert np.array_equal(a, b)
 
 
 @pytest.fixture(scope="module")
