@@ -16,6 +16,7 @@ import math
 import os
 import signal
 import tempfile
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -285,9 +286,15 @@ class SerialRig:
         self.move(x + d * math.sin(phi), y - d * math.cos(phi), phi)
 
     def close(self) -> None:
-        for port in self.ports.values():
-            with contextlib.suppress(OSError, serial.SerialException):
-                port.close()
+        # pyserial waits 0.3 s after closing a socket:// port (room for a quick reconnect): the arm's
+        # and the DAQ's ports close side by side, not one after the other
+        others = [threading.Thread(target=_close_quietly, args=(port,)) for port in list(self.ports.values())[1:]]
+        for thread in others:
+            thread.start()
+        for port in list(self.ports.values())[:1]:
+            _close_quietly(port)
+        for thread in others:
+            thread.join()
         for lock in self._locks:
             with contextlib.suppress(OSError):
                 lock.close()
@@ -305,6 +312,11 @@ class SerialRig:
                 exc.add_note(outcome)  # the CLI prints it after the error: what the host really did
         self.close()
         return False
+
+
+def _close_quietly(port: Any) -> None:
+    with contextlib.suppress(OSError, serial.SerialException):
+        port.close()
 
 
 def _open_problem(url: str, exc: Exception) -> str:
