@@ -49,21 +49,22 @@ class _Stack(NamedTuple):
 
 
 def _sums(stack: _Stack, stretches: Sequence[IntArray]) -> _Sums:
-    """The sums of each stretch of readings (their positions in ``stack``), along a leading axis."""
-    mask = np.zeros((len(stretches), stack.z.size))
-    for n, at in enumerate(stretches):
-        mask[n, at] = 1.0
-    masked = np.swapaxes(mask[:, :, None] * stack.a, 1, 2)  # (stretches, c, k)
-    return _Sums(
-        cols=stack.cols,
-        uu=masked @ stack.a,
-        uz=masked @ stack.z,
-        szz=mask @ stack.z**2,
-        up=masked @ stack.p,
-        spp=mask @ stack.p**2,
-        szp=mask @ (stack.z[:, None] * stack.p),
-        readings=mask.sum(axis=1),
-    )
+    """The sums of each stretch of readings (their positions in ``stack``, each counted once), along a
+    leading axis."""
+    m, c, n = len(stretches), stack.cols.size, stack.p.shape[1]
+    uu, uz, szz = np.empty((m, c, c)), np.empty((m, c)), np.empty(m)
+    up, spp, szp = np.empty((m, c, n)), np.empty((m, n)), np.empty((m, n))
+    readings = np.empty(m)
+    # each stretch from its own rows: a stretch is a few dozen of the hundreds of readings, and a product
+    # over all of them with the others masked out cost the hypotheses' count times every reading
+    for k, at in enumerate(stretches):
+        rows = np.unique(np.asarray(at, dtype=np.int64))
+        a, z, p = stack.a[rows], stack.z[rows], stack.p[rows]
+        at_ = a.T
+        uu[k], uz[k], szz[k] = at_ @ a, at_ @ z, z @ z
+        up[k], spp[k], szp[k] = at_ @ p, np.einsum("ij,ij->j", p, p), z @ p
+        readings[k] = rows.size
+    return _Sums(cols=stack.cols, uu=uu, uz=uz, szz=szz, up=up, spp=spp, szp=szp, readings=readings)
 
 
 class _Reading(NamedTuple):
