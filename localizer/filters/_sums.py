@@ -52,19 +52,32 @@ def _sums(stack: _Stack, stretches: Sequence[IntArray]) -> _Sums:
     """The sums of each stretch of readings (their positions in ``stack``, each counted once), along a
     leading axis."""
     m, c, n = len(stretches), stack.cols.size, stack.p.shape[1]
-    uu, uz, szz = np.empty((m, c, c)), np.empty((m, c)), np.empty(m)
-    up, spp, szp = np.empty((m, c, n)), np.empty((m, n)), np.empty((m, n))
-    readings = np.empty(m)
-    # each stretch from its own rows: a stretch is a few dozen of the hundreds of readings, and a product
-    # over all of them with the others masked out cost the hypotheses' count times every reading
+    member = np.zeros((stack.z.size, m), dtype=bool)
     for k, at in enumerate(stretches):
-        rows = np.unique(np.asarray(at, dtype=np.int64))
-        a, z, p = stack.a[rows], stack.z[rows], stack.p[rows]
-        at_ = a.T
-        uu[k], uz[k], szz[k] = at_ @ a, at_ @ z, z @ z
-        up[k], spp[k], szp[k] = at_ @ p, np.einsum("ij,ij->j", p, p), z @ p
-        readings[k] = rows.size
-    return _Sums(cols=stack.cols, uu=uu, uz=uz, szz=szz, up=up, spp=spp, szp=szp, readings=readings)
+        member[at, k] = True
+    rows = np.flatnonzero(member.any(axis=1))
+    # the stretches overlap (by three quarters, most of them): each reading is summed once, in the piece
+    # of the readings that the same stretches hold, and each stretch adds up its pieces
+    pieces, piece_of = np.unique(member[rows], axis=0, return_inverse=True)
+    piece_of = piece_of.ravel()
+    uu, uz, szz = np.empty((len(pieces), c, c)), np.empty((len(pieces), c)), np.empty(len(pieces))
+    up, spp, szp = np.empty((len(pieces), c, n)), np.empty((len(pieces), n)), np.empty((len(pieces), n))
+    for k in range(len(pieces)):
+        at = rows[piece_of == k]
+        a, z, p = stack.a[at], stack.z[at], stack.p[at]
+        uu[k], uz[k], szz[k] = a.T @ a, a.T @ z, z @ z
+        up[k], spp[k], szp[k] = a.T @ p, np.einsum("ij,ij->j", p, p), z @ p
+    held = pieces.T.astype(float)  # (stretches, pieces)
+    return _Sums(
+        cols=stack.cols,
+        uu=np.tensordot(held, uu, axes=1),
+        uz=held @ uz,
+        szz=held @ szz,
+        up=np.tensordot(held, up, axes=1),
+        spp=held @ spp,
+        szp=held @ szp,
+        readings=member.sum(axis=0).astype(float),
+    )
 
 
 class _Reading(NamedTuple):
