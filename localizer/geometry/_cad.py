@@ -71,8 +71,7 @@ def load_outline(
         ignored.append(f"{rest} other closed loop(s) (holes or other outlines)")
     if facets is not None:
         chosen = read_facets(chosen, facets)
-    outline = outline_from_pieces(chosen, name=path.stem)
-    return Outline(outline.pieces, outline.name, ignored=tuple(ignored))
+    return outline_from_pieces(chosen, name=path.stem, ignored=tuple(ignored))
 
 
 # ------------------------------------------------------------------ DXF

@@ -312,7 +312,9 @@ def nearest_corner(arcs: FloatArray, period: float, x: FloatArray) -> tuple[np.n
     return (j - 1) % arcs.size, offset, np.where(j == 0, -1, np.where(j == near.size - 1, 1, 0))
 
 
-def outline_from_pieces(pieces: list[Piece] | tuple[Piece, ...], *, name: str = "outline") -> Outline:
+def outline_from_pieces(
+    pieces: list[Piece] | tuple[Piece, ...], *, name: str = "outline", ignored: tuple[str, ...] = ()
+) -> Outline:
     """The closed outline of ``pieces`` chained in order, made counter-clockwise.
 
     Parameters
@@ -322,6 +324,8 @@ def outline_from_pieces(pieces: list[Piece] | tuple[Piece, ...], *, name: str = 
         end where the first starts.
     name : str
         For messages and plots.
+    ignored : tuple of str
+        What the file the pieces were read from held besides them (:attr:`Outline.ignored`).
 
     Raises
     ------
@@ -358,7 +362,7 @@ def outline_from_pieces(pieces: list[Piece] | tuple[Piece, ...], *, name: str = 
                 f"outline {name!r}: piece {i} ends at {piece.end} but piece {(i + 1) % len(pieces)} starts at "
                 f"{nxt.start}, {gap:.3g} mm away (more than {JOIN_TOL} mm): the outline is not closed there"
             )
-    outline = Outline(pieces, name)
+    outline = Outline(pieces, name, ignored)
     poly = outline.sample(max(outline.perimeter / 4000.0, 1e-3))
     crossing = _segments_cross(poly)
     if crossing is not None:
@@ -381,5 +385,5 @@ def outline_from_pieces(pieces: list[Piece] | tuple[Piece, ...], *, name: str = 
     if abs(abs(turning) - 2.0 * math.pi) > 1e-6:
         raise PartError(f"outline {name!r} turns by {turning:.6f} rad, not one full turn: not a simple closed outline")
     if turning < 0:  # clockwise: travel it the other way, from the same first point
-        outline = Outline(tuple(p.reversed() for p in reversed(pieces)), name)
+        outline = Outline(tuple(p.reversed() for p in reversed(pieces)), name, ignored)
     return outline
