@@ -7,6 +7,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
+from driver import one_blas_thread
+
 from .columns import trial_row
 from .methods import score_trial
 from .straight_trial import roll_straight
@@ -24,7 +26,8 @@ def run_trial(spec: TrialSpec) -> dict[str, Any]:
     rolls can run; with a wheel (:func:`bench.wheel_trial.roll_wheel`) over the whole boundary instead.
     """
     t0 = time.perf_counter()
-    ctx = draw_trial(spec)
-    rolled = roll_wheel(ctx) if ctx.jaw.startswith("wheel") else roll_straight(ctx)
-    scored = score_trial(ctx, rolled)
+    with one_blas_thread():  # in whichever process runs it: a pool's or a Dask worker
+        ctx = draw_trial(spec)
+        rolled = roll_wheel(ctx) if ctx.jaw.startswith("wheel") else roll_straight(ctx)
+        scored = score_trial(ctx, rolled)
     return trial_row(ctx.head, rolled, scored, time.perf_counter() - t0, world=ctx.world is not None)

@@ -1,6 +1,7 @@
 """The rig protocol every rig keeps, and its rooms: the straight jaw (``jaw``), the wheel finger
 (``wheel``), the serial rig (``link``), what a run leaves (``records``) and the command line (``cli``)."""
 
+from .blas import one_blas_thread
 from .records import PartMismatch, check_same_part, part_record
 from .rig import (
     Clocked,
@@ -33,4 +34,5 @@ __all__ = [
     "PartMismatch",
     "part_record",
     "check_same_part",
+    "one_blas_thread",
 ]

@@ -23,6 +23,7 @@ from typing import Any
 
 from localizer import RolltouchError
 
+from ..blas import one_blas_thread
 from ..link import handling
 from ._options import UsageError, add_command
 
@@ -102,7 +103,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with handling(("SIGTERM", "SIGHUP"), _terminate):  # handled as Ctrl-C is
+        with handling(("SIGTERM", "SIGHUP"), _terminate), one_blas_thread():  # SIGTERM handled as Ctrl-C is
             return int(args.run(args))
     except UsageError as exc:
         args.parser.error(str(exc))  # exits with status 2
