@@ -171,6 +171,7 @@ class ModeTracks:
         self._span = span
         run_of_cell = np.repeat(np.arange(a.size), b - a)
         self._run = run_of_cell[np.arange(n) + n]
+        self._entry = self._first[self._run] + (np.arange(n) + n - a[self._run])  # each grid point's own
         # where the jaw reaches, from its geometry (localizer.contact._reach): no fixed tolerance below the hull
         self.reach = reach_for(part, jaw)
         self.lo, self.hi = (np.array(v) for v in self.reach.interval(sigma))
@@ -205,6 +206,7 @@ class ModeTracks:
             self._first,
             self._last,
             self._run,
+            self._entry,
         ):
             arr.setflags(write=False)
 
@@ -286,6 +288,7 @@ class ModeTracks:
             self.convex,
             self._s,
             self._node,
+            self._entry,
         )
         arc, node, ok = arc.reshape(shape), node.reshape(shape), ok.reshape(shape)
         j, target, idx = j.reshape(shape), target.reshape(shape), idx.reshape(shape)

@@ -18,6 +18,48 @@ __all__ = ["step_along"]
 
 
 @numba.njit(cache=True)
+def _leftmost(banded: FloatArray, target: float, lo: int, hi: int, hint: int) -> int:
+    """The first entry of ``banded[lo:hi + 1]`` (sorted) at or above ``target`` (``banded[hi]`` is), found by
+    galloping from ``hint`` and halving the bracket: the entry ``np.searchsorted(..., side="left")`` gives."""
+    h = min(max(hint, lo), hi)
+    step = 1
+    if banded[h] >= target:  # at or before h: gallop back to an entry below the target
+        right = h
+        left = h
+        while True:
+            left = right - step
+            if left <= lo:
+                left = lo
+                break
+            if banded[left] < target:
+                break
+            right = left
+            step *= 2
+        if banded[left] >= target:  # only at lo: nothing before it is searched
+            return left
+    else:  # after h: gallop on to an entry at or above it
+        left = h
+        right = h
+        while True:
+            right = left + step
+            if right >= hi:
+                right = hi
+                break
+            if banded[right] >= target:
+                break
+            left = right
+            step *= 2
+    # banded[left] < target <= banded[right]
+    while right - left > 1:
+        mid = (left + right) // 2
+        if banded[mid] >= target:
+            right = mid
+        else:
+            left = mid
+    return right
+
+
+@numba.njit(cache=True)
 def step_along(
     idx: IntArray,
     turn: FloatArray,
@@ -31,6 +73,7 @@ def step_along(
     convex: BoolArray,
     s: FloatArray,
     node_of: IntArray,
+    entry: IntArray,
 ) -> tuple[FloatArray, IntArray, BoolArray, IntArray, FloatArray]:
     """The raw step of :meth:`localizer.Tracks.step` (before a face's centre of pressure and the
     no-turn and out-of-stretch masks).
@@ -43,9 +86,12 @@ def step_along(
         Net rotation, one for all or one per point.
     turn_margin : float, rad
         How far past its stretch's end a rotation may go and still keep the point.
-    theta, run_of, span, first_of, last_of, banded, convex, s, node_of
+    theta, run_of, span, first_of, last_of, banded, convex, s, node_of, entry
         The tracks' tables: each grid point's angle and run, the runs' angle offset, each run's
-        first and last entry in the banded table, the banded angles, convexity, arcs and nodes.
+        first and last entry in the banded table, the banded angles, convexity, arcs and nodes, and
+        each grid point's own entry (where the search for its landing starts: a roll moves the
+        contact a few entries, and a search from there is a few steps where one over the whole
+        table was many, each to a far-off place in memory).
 
     Returns
     -------
@@ -68,7 +114,7 @@ def step_along(
         lo_b, hi_b = banded[first], banded[last]
         ok[k] = convex[i] and (target >= lo_b - turn_margin) and (target <= hi_b + turn_margin)
         target = min(max(target, lo_b), hi_b)
-        j = min(max(np.searchsorted(banded, target, side="left"), first + 1), last)
+        j = max(_leftmost(banded, target, first, last, entry[i]), first + 1)
         b0, b1 = banded[j - 1], banded[j]
         w = (target - b0) / (b1 - b0 if b1 > b0 else 1.0)
         arc[k] = s[j - 1] + w * (s[j] - s[j - 1])

@@ -58,3 +58,25 @@ def test_the_jaw_is_carried_across_shallow_dips_and_stopped_by_deeper_ones(push)
             # a deeper concavity ends the stretch (the rig reports the jump as a bridge): the contact
             # is never carried across it
             assert not ok_after[0] or after[0] % part.perimeter < 0.5 * (sa + sb)
+
+
+def test_a_roll_on_a_convex_part_lands_where_the_tangent_has_turned_by_it():
+    """Every start of a convex cam turned by up to a lap either way: the landing is where the grid's own
+    tangent angle (unwrapped over three laps) reaches the start's plus the turn, interpolated linearly
+    between grid points, as numpy's interp finds it on the whole table (the reference for the step's
+    search, which starts from each start's own entry)."""
+    a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    cam = part_from_points(np.c_[40 * np.cos(a) + 3 * np.cos(2 * a), 30 * np.sin(a)], name="cam")
+    tracks = ModeTracks(cam, 0.2)
+    assert tracks.convex.all()
+    n, p = tracks.sigma.size, cam.perimeter
+    theta = np.unwrap(tracks.theta)
+    arcs = np.concatenate([tracks.sigma - p, tracks.sigma, tracks.sigma + p])
+    angles = np.concatenate([theta - 2 * np.pi, theta, theta + 2 * np.pi])
+    rng = np.random.default_rng(4)
+    idx = rng.integers(0, n, 5000)
+    for turn in (rng.uniform(-2 * np.pi, 2 * np.pi, idx.size), 1e-3, -0.4):
+        arc, node, ok = tracks.step(idx, turn)
+        want = np.interp(theta[idx] + turn, angles, arcs)
+        assert ok.all() and np.abs(arc - want).max() < 1e-9
+        assert np.array_equal(node, tracks.node_at(arc))
