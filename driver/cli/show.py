@@ -51,6 +51,7 @@ def show_command(args: argparse.Namespace) -> int:
 
     from ..records import (
         FILM_SUFFIXES,
+        check_film,
         check_finger,
         check_same_part,
         open_record,
@@ -65,6 +66,8 @@ def show_command(args: argparse.Namespace) -> int:
     writable_file(args.out, "--out", (".png", *FILM_SUFFIXES))
     if not 1 <= args.fps <= 60:
         raise UsageError(f"--fps {args.fps} must be from 1 to 60")
+    if not str(args.out).lower().endswith(".png"):
+        check_film(args.out, args.fps)  # before the replay: an MP4 without ffmpeg is refused at once
     path = str(args.trace)
     record = open_record(path)
     wheel = record.wheel() if record.kind == "wheel" else None

@@ -3,7 +3,7 @@ and their replay, plots, the part's record that keeps a trace from being scored 
 any of them as an MCAP file.
 """
 
-from .belief_film import FILM_SUFFIXES, MAX_FRAMES, write_film
+from .belief_film import FILM_SUFFIXES, MAX_FRAMES, check_film, write_film
 from .belief_history import (
     ARC_BINS,
     BeliefHistory,
@@ -36,6 +36,7 @@ __all__ = [
     "FILM_SUFFIXES",
     "MAX_FRAMES",
     "write_film",
+    "check_film",
     "ARC_BINS",
     "BeliefHistory",
     "plot_belief_history",

@@ -24,7 +24,7 @@ from localizer import DEFAULT_JAW, Outline, Part
 from ..rig import RigError
 from .belief_history import BeliefHistory, finger_outline, stated_axes
 
-__all__ = ["write_film", "MAX_FRAMES", "FILM_SUFFIXES"]
+__all__ = ["write_film", "check_film", "MAX_FRAMES", "FILM_SUFFIXES"]
 
 #: The most frames drawn: a longer rolling is sampled evenly (one frame a reading up to it).
 MAX_FRAMES = 160
@@ -53,6 +53,25 @@ def _places(mass: NDArray[np.float64], edges: NDArray[np.float64], k: int = 3) -
     return sorted(runs, key=lambda r: -r[1])[:k]
 
 
+def check_film(path: str | os.PathLike[str], fps: int = 10) -> str:
+    """The suffix of a film :func:`write_film` can write to ``path`` at ``fps``; checked before the rolling is
+    replayed for it, so that a film that cannot be written is refused at once.
+
+    Raises
+    ------
+    RigError
+        An output that is neither .gif nor .mp4, .mp4 without ffmpeg, ``fps`` not from 1 to 60.
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix not in FILM_SUFFIXES:
+        raise RigError(f"{path}: an animation is written as {' or '.join(FILM_SUFFIXES)}")
+    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
+        raise RigError(f"{path}: an MP4 needs ffmpeg, which is not installed; write a .gif instead")
+    if not (isinstance(fps, int) and 1 <= fps <= 60):
+        raise RigError(f"fps={fps!r} must be a whole number of frames per second from 1 to 60")
+    return suffix
+
+
 def write_film(
     part: Part | Outline,
     history: BeliefHistory,
@@ -74,18 +93,12 @@ def write_film(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
+    from matplotlib.animation import FFMpegWriter, PillowWriter
     from matplotlib.artist import Artist
 
     from .plotting import draw_part
 
-    suffix = Path(path).suffix.lower()
-    if suffix not in FILM_SUFFIXES:
-        raise RigError(f"{path}: an animation is written as {' or '.join(FILM_SUFFIXES)}")
-    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
-        raise RigError(f"{path}: an MP4 needs ffmpeg, which is not installed; write a .gif instead")
-    if not (isinstance(fps, int) and 1 <= fps <= 60):
-        raise RigError(f"fps={fps!r} must be a whole number of frames per second from 1 to 60")
+    suffix = check_film(path, fps)
     readings = history.readings
     if not readings.shape[0] or not history.rotation.size:
         raise RigError("a rolling without readings or checks has nothing to animate")
@@ -140,10 +153,17 @@ def write_film(
         grown.set_data(deg[: c + 1], history.stated[: c + 1])
         return [band, jaw_line, contact, grown, title, *labels]
 
-    film = FuncAnimation(fig, draw, frames=[int(k) for k in frames], blit=False)
+    # laid out once, on the first frame (its title in place), and kept: each frame is then drawn once, where
+    # an animation drew it three times (once to show it, twice to lay it out and save it)
+    draw(int(frames[0]))
+    fig.canvas.draw()
+    fig.set_layout_engine("none")
     writer = PillowWriter(fps=fps) if suffix == ".gif" else FFMpegWriter(fps=fps)
     try:
-        film.save(str(path), writer=writer, dpi=80)
+        with writer.saving(fig, str(path), dpi=80):
+            for k in frames:
+                draw(int(k))
+                writer.grab_frame()
     except OSError as exc:
         raise RigError(f"cannot write {path}: {exc.strerror or exc}") from None
     finally:
