@@ -29,19 +29,39 @@ max_rotation_deg = 60.0
     return f, record_trial(f, 0, 0)
 
 
+@pytest.fixture(scope="module")
+def as_run_replay(recorded):
+    """``replay`` of the fixture's recording with the settings it ran with, to the end (None) or part-way
+    (degrees), each made once for the module: a replay is deterministic, and its result is only read."""
+    _, rec = recorded
+    done = {}
+
+    def replayed(at_deg=None):
+        if at_deg not in done:
+            done[at_deg] = replay(rec, at_deg)
+        return done[at_deg]
+
+    return replayed
+
+
 @pytest.fixture
-def recorded_once(recorded, monkeypatch):
+def recorded_once(recorded, as_run_replay, monkeypatch):
     """The command line given the fixture's recording of level 0, trial 0 instead of running the trial again
-    for each command (a trial is deterministic: ``test_a_trial_records_the_same_calls_twice``)."""
+    for each command (a trial is deterministic: ``test_a_trial_records_the_same_calls_twice``), and that
+    recording's replays as run from ``as_run_replay`` (the same call; variants are replayed anew)."""
     import bench.replay
 
     f, rec = recorded
-    record = bench.replay.record_trial
+    record, replay_one = bench.replay.record_trial, bench.replay.replay
 
     def once(study, level, trial):
         return rec if (Path(study), level, trial) == (f, 0, 0) else record(study, level, trial)
 
+    def replayed(r, at_deg=None, **changes):
+        return as_run_replay(at_deg) if r is rec and not changes else replay_one(r, at_deg, **changes)
+
     monkeypatch.setattr(bench.replay, "record_trial", once)
+    monkeypatch.setattr(bench.replay, "replay", replayed)
     return recorded
 
 
@@ -57,11 +77,11 @@ def test_a_trial_records_the_same_calls_twice(recorded):
     ]
 
 
-def test_the_recorded_calls_give_back_the_run_belief(recorded):
+def test_the_recorded_calls_give_back_the_run_belief(recorded, as_run_replay):
     _, rec = recorded
     names = {c[0] for c in rec.calls}
     assert {"touch", "update", "belief"} <= names and len(rec.calls) > 20
-    as_run = replay(rec)
+    as_run = as_run_replay()
     assert as_run.mass == pytest.approx(float(rec.row["reactive_mass"]), abs=1e-6)
     assert as_run.error_mm == pytest.approx(float(rec.row["reactive_error_mm"]), abs=0.06)
     assert as_run.margin > 0  # it localized: the true start leads
@@ -76,10 +96,10 @@ def test_the_recorded_calls_as_a_kept_log_give_back_the_run_belief(recorded_once
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and "drawn to" in capsys.readouterr().out
 
 
-def test_a_variant_changes_only_the_filter(recorded):
+def test_a_variant_changes_only_the_filter(recorded, as_run_replay):
     _, rec = recorded
     told_ten_times = replay(rec, sd_position=0.4, noise_scales=(1.0,))
-    as_run = replay(rec)
+    as_run = as_run_replay()
     assert told_ten_times.mass < as_run.mass
     assert told_ten_times.settings == {"sd_position": 0.4, "noise_scales": (1.0,)}
 
@@ -119,11 +139,11 @@ def test_a_variant_of_several_settings_on_the_command_line(recorded_once, capsys
     assert "{'corner_ends': False}" in out
 
 
-def test_without_the_margin_the_belief_is_the_same(recorded):
+def test_without_the_margin_the_belief_is_the_same(recorded, as_run_replay):
     import math
 
     _, rec = recorded
-    quick, whole = replay(rec, 20.0, margin=False), replay(rec, 20.0)
+    quick, whole = replay(rec, 20.0, margin=False), as_run_replay(20.0)
     assert quick.mass == whole.mass and quick.error_mm == pytest.approx(whole.error_mm)
     assert quick.mismatch == whole.mismatch
     assert math.isnan(quick.margin) and math.isnan(quick.noise_scale)
