@@ -38,21 +38,44 @@ def trefoil():
     return part, calibration(part)
 
 
-@pytest.mark.parametrize("seek", [False, True])
-def test_it_stops_when_sure_and_is_right(trefoil, seek):
+@pytest.fixture(scope="module")
+def until_sure(trefoil):
+    """``until_sure(seek)``: the noise-free rolling from 300 mm with a tight filter until 95% sure, checked
+    every 5 steps, and where its contact ended; each rolled once for the module (read only)."""
     part, cal = trefoil
-    rig = SimRig(part, noise="none", seed=1)
-    flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
-    run = localize_reactively(
-        rig,
-        part,
-        calibration=cal,
-        filter=flt,
-        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
-        policy=ReactivePolicy(confidence=0.95, seek=seek),
-    )
+    runs = {}
+
+    def get(seek):
+        if seek not in runs:
+            rig = SimRig(part, noise="none", seed=1)
+            flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
+            run = localize_reactively(
+                rig,
+                part,
+                calibration=cal,
+                filter=flt,
+                approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+                policy=ReactivePolicy(confidence=0.95, seek=seek),
+            )
+            runs[seek] = run, rig.truth()["contact_arc"]
+        return runs[seek]
+
+    return get
+
+
+@pytest.fixture(scope="module")
+def ellipse():
+    """The ellipse, loaded once: its tables (the filter's tracks, the jaw's reach) are built once and kept
+    with it, read-only, for the tests on it."""
+    return load_part(PARTS / "ellipse.json")
+
+
+@pytest.mark.parametrize("seek", [False, True])
+def test_it_stops_when_sure_and_is_right(trefoil, until_sure, seek):
+    part, _ = trefoil
+    run, truth = until_sure(seek)
     assert run.stopped == "confident" and run.belief.mass >= 0.95
-    assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
+    assert abs(part.arc_offset(run.estimate_arc, truth)) < 0.3
     assert run.rotation < math.radians(120)
     assert len(run.arcs) == len(run.turns) == len(run.true_arcs) == len(run.segments) == run.steps + 1
 
@@ -97,35 +120,28 @@ def test_the_rotation_budget_stops_it(trefoil):
     assert run.steps == 10
 
 
-def test_a_budget_that_runs_out_between_checks_judges_the_last_readings(trefoil):
+def test_a_budget_that_runs_out_between_checks_judges_the_last_readings(trefoil, until_sure):
     # the same rolling checked every 5 steps, and never until the budget ends a little after that stop:
     # the readings since the last check are judged as a check would, and a sure belief there is sure
     part, cal = trefoil
-    runs = []
-    for policy in (
-        ReactivePolicy(confidence=0.95),
-        ReactivePolicy(confidence=0.95, check_every=100_000, max_rotation=math.radians(60.0)),
-    ):
-        rig = SimRig(part, noise="none", seed=1)
-        runs.append(
-            localize_reactively(
-                rig,
-                part,
-                calibration=cal,
-                filter=ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005),
-                approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
-                policy=policy,
-            )
-        )
-    checked, unchecked = runs
+    checked, _ = until_sure(False)  # ReactivePolicy(confidence=0.95): seek is off by default
+    rig = SimRig(part, noise="none", seed=1)
+    unchecked = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005),
+        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+        policy=ReactivePolicy(confidence=0.95, check_every=100_000, max_rotation=math.radians(60.0)),
+    )
     assert checked.stopped == "confident" and checked.rotation < math.radians(60.0) and checked.reversals == 0
     assert unchecked.rotation == pytest.approx(math.radians(60.0), abs=1e-9) and len(unchecked.history) == 1
     assert unchecked.stopped == "confident" and unchecked.belief.mass >= 0.95
     assert abs(part.arc_offset(unchecked.estimate_arc, unchecked.true_arcs[-1])) < 0.3
 
 
-def test_on_an_ellipse_it_stays_ambiguous_and_says_so():
-    part = load_part(PARTS / "ellipse.json")
+def test_on_an_ellipse_it_stays_ambiguous_and_says_so(ellipse):
+    part = ellipse
     cal = calibration(part)
     rig = SimRig(part, noise="none", seed=2)
     flt = ContactFilter(part, sd_position=0.02, sd_scale=0.0, sd_slope=0.0)
@@ -143,8 +159,8 @@ def test_on_an_ellipse_it_stays_ambiguous_and_says_so():
     assert abs(part.arc_offset(m1.arc, m2.arc)) == pytest.approx(part.perimeter / 2, abs=0.5)
 
 
-def test_direction_helpers_on_a_symmetric_belief():
-    part = load_part(PARTS / "ellipse.json")
+def test_direction_helpers_on_a_symmetric_belief(ellipse):
+    part = ellipse
     flt = ContactFilter(part)
     a = part.perimeter / 4
     ccw, cw = spread_by_direction(flt, math.radians(15), starts=[a, a + part.perimeter / 2])
@@ -166,10 +182,10 @@ def rolled(part, start_arc, steps, **settings):
     return flt, float(turns[-1])
 
 
-def test_seeking_gains_nothing_between_twin_places():
+def test_seeking_gains_nothing_between_twin_places(ellipse):
     # an ellipse's two halves are alike: rolled from a quarter, the belief is split between twin places
     # half a perimeter apart, which no rolling either way can tell apart
-    part = load_part(PARTS / "ellipse.json")
+    part = ellipse
     flt, turned = rolled(part, part.perimeter / 4 + 5.0, 75, sd_position=0.01)
     places = [m for m in flt.belief().modes if m.mass > 0.1]
     assert len(places) == 2
@@ -293,13 +309,13 @@ def test_cli_simulate_and_run_reactive(tmp_path, capsys):
     assert any(e.get("event") == "belief" for e in events) and events[-1]["event"] == "result"
 
 
-def test_the_two_turning_rules_do_not_rock_the_jaw():
+def test_the_two_turning_rules_do_not_rock_the_jaw(trefoil):
     # Trial 66 of bench/studies/reactive.toml: three look-alike lobes, the leading modes separate
     # only clockwise, where most of the belief also expects a concavity. The concavity rule turned
     # the jaw counter-clockwise and the direction rule straight back, every 1°: 110 reversals and
     # 168° of rolling in place before a wrong lobe won. Each rule now turns only towards a way
     # that is clear beyond what has been rolled there.
-    part = load_part(PARTS / "trefoil.json")
+    part, _ = trefoil
     cal = calibration_with(part, "paper", seed=2140531231)
     rig = SimRig(part, noise="paper", seed=568606712)
     # the filter of that study (the slope prior alone), so that only the turning rules are under test

@@ -267,91 +267,51 @@ def test_cli_emulate_and_run(tmp_path):
     assert loc.returncode == 0 and json.loads(loc.stdout)["estimate_arc"] == pytest.approx(doc["estimate_arc"])
 
 
-def test_cli_emulate_run_reactively_and_locate_its_log(tmp_path):
-    # the log of 'run --reactive' holds the filter's calls: locate has the run's belief again from it
-    port = 46000 + os.getpid() % 1000
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
-    exe = [sys.executable, "-m", "driver.cli"]
+def test_cli_emulate_run_reactively_and_locate_its_log(tmp_path, capsys):
+    # the log of 'run --reactive' holds the filter's calls: locate has the run's belief again from it.
+    # What is checked is the log, not the processes: the emulator 'emulate PART --tcp PORT --start 120
+    # --seed 3' serves is served here, and both commands run in this process (test_cli_emulate_and_run runs
+    # each as a command line of its own)
+    from driver.cli import main
+
     trefoil = str(ROOT / "parts" / "trefoil.json")
-    emu = subprocess.Popen(
-        exe + ["emulate", trefoil, "--tcp", str(port), "--start", "120", "--seed", "3"],
-        stdout=subprocess.PIPE,
-        text=True,
-        env=env,
-    )
-    rig = ["--arm", f"socket://127.0.0.1:{port}", "--daq", f"socket://127.0.0.1:{port + 1}"]
+    rig = SimRig(PART, noise="paper", seed=3)
+    emu = Emulator(rig, start_pose=rig.approach_pose(START, jaw_position=0.0, standoff=1.0), seed=3)
+    arm, daq = emu.serve_tcp(0)
     try:
-        assert emu.stdout.readline().startswith("arm socket://127.0.0.1:")
-        emu.stdout.readline()
-        args = [
-            "run",
-            trefoil,
-            *rig,
-            "--reactive",
-            "--max-rotation",
-            "30",
-            "--json",
-            "--log",
-            str(tmp_path / "r.jsonl"),
-        ]
-        out = subprocess.run(exe + args, capture_output=True, text=True, timeout=180, env=env)
+        capsys.readouterr()
+        args = ["run", trefoil, "--arm", arm, "--daq", daq, "--reactive", "--max-rotation", "30"]
+        rc = main([*args, "--json", "--log", str(tmp_path / "r.jsonl")])
+        out = capsys.readouterr()
     finally:
-        emu.terminate()
-        emu.wait(10)
-    assert out.returncode in (0, 2), out.stderr
-    doc = json.loads(out.stdout)
-    loc = subprocess.run(
-        exe + ["locate", str(tmp_path / "r.jsonl"), "--part", trefoil, "--json"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        env=env,
-    )
-    again = json.loads(loc.stdout)
-    assert loc.returncode == out.returncode, loc.stderr
+        emu.close()
+    assert rc in (0, 2), out.err
+    doc = json.loads(out.out)
+    loc_rc = main(["locate", str(tmp_path / "r.jsonl"), "--part", trefoil, "--json"])
+    loc = capsys.readouterr()
+    again = json.loads(loc.out)
+    assert loc_rc == rc, loc.err
     assert again["estimate_arc"] == doc["estimate_arc"] and again["mass"] == doc["mass"]
 
 
 def test_cli_run_fails_with_one_line_on_disconnect(tmp_path):
-    port = 48000 + os.getpid() % 1000
-    exe = [sys.executable, "-m", "driver.cli"]
-    emu = subprocess.Popen(
-        exe
-        + [
-            "emulate",
-            str(ROOT / "parts" / "trefoil.json"),
-            "--tcp",
-            str(port),
-            "--start",
-            "120",
-            "--fault",
-            "disconnect-after=50",
-        ],
-        stdout=subprocess.PIPE,
-        text=True,
+    # the command line's stderr is what is checked, so 'run' is a process of its own; the emulator is the
+    # one 'emulate PART --tcp PORT --start 120 --fault disconnect-after=50' serves (seed 0), served here
+    rig = SimRig(PART, noise="paper", seed=0)
+    emu = Emulator(
+        rig, start_pose=rig.approach_pose(START, jaw_position=0.0, standoff=1.0), faults=Faults(disconnect_after=50)
     )
+    arm, daq = emu.serve_tcp(0)
     try:
-        emu.stdout.readline()
-        emu.stdout.readline()
         out = subprocess.run(
-            exe
-            + [
-                "run",
-                str(ROOT / "parts" / "trefoil.json"),
-                "--arm",
-                f"socket://127.0.0.1:{port}",
-                "--daq",
-                f"socket://127.0.0.1:{port + 1}",
-                "--timeout",
-                "0.5",
-            ],
+            [sys.executable, "-m", "driver.cli", "run", str(ROOT / "parts" / "trefoil.json")]
+            + ["--arm", arm, "--daq", daq, "--timeout", "0.5"],
             capture_output=True,
             text=True,
             timeout=60,
         )
     finally:
-        emu.terminate()
-        emu.wait(10)
+        emu.close()
     assert out.returncode != 0
     last = [line for line in out.stderr.splitlines() if line.startswith("rolltouch:")]
     assert len(last) == 1 and "error" in last[0]

@@ -9,12 +9,33 @@ import pytest
 
 from driver.rig import RigError
 from driver.wheel import WheelCalibration, WheelPolicy, WheelSlip, localize_with_wheel
-from localizer import WheelJaw, WheelReach, load_part, part_from_points
+from localizer import WheelJaw, load_part, part_from_points, wheel_reach_for
 from sim2d import SimRig, WheelRig
 
 
+def lobed():
+    """A generated part, no symmetry, whose concave radius (4.3 mm at the least) exceeds the wheel's."""
+    a = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+    rho = 40 + 4 * np.cos(a) + 9 * np.cos(3 * a + 0.5) + 3 * np.cos(5 * a + 1.0)
+    return part_from_points(np.c_[rho * np.cos(a), rho * np.sin(a)], name="lobed")
+
+
+@pytest.fixture(scope="module")
+def parts():
+    """The parts, each loaded once for the module: the tables built from a part (the wheel's reach, the
+    filter's) are read-only and kept with it, so the tests on one part share them as any users of it do."""
+    loaded = {}
+
+    def get(name):
+        if name not in loaded:
+            loaded[name] = lobed() if name == "lobed" else load_part(name)
+        return loaded[name]
+
+    return get
+
+
 def concave_starts(part, wheel, n, seed=0):
-    reach = WheelReach(part, wheel)
+    reach = wheel_reach_for(part, wheel)
     ok = reach.sure & (np.asarray(part.curvature_at_arc(reach.sigma)) < 0)
     return np.random.default_rng(seed).choice(reach.sigma[ok], n, replace=False)
 
@@ -35,13 +56,11 @@ def localize(part, wheel, start, **rig_options):
         ("lobed", 3.0, "pymunk"),
     ],
 )
-def test_noise_free_rolls_from_concave_starts_localize_within_the_success_radius(part_name, radius, engine):
+def test_noise_free_rolls_from_concave_starts_localize_within_the_success_radius(part_name, radius, engine, parts):
     if part_name == "kidney":
-        part = load_part("parts/kidney.csv")
-    else:  # a generated part, no symmetry, whose concave radius (4.3 mm at the least) exceeds the wheel's
-        a = np.linspace(0, 2 * np.pi, 120, endpoint=False)
-        rho = 40 + 4 * np.cos(a) + 9 * np.cos(3 * a + 0.5) + 3 * np.cos(5 * a + 1.0)
-        part = part_from_points(np.c_[rho * np.cos(a), rho * np.sin(a)], name="lobed")
+        part = parts("parts/kidney.csv")
+    else:
+        part = parts("lobed")
         kappa = part.curvature_at_arc(np.linspace(0, part.perimeter, 5000))
         assert -1 / radius < kappa.min() < -0.2
     wheel = WheelJaw(radius)
@@ -54,8 +73,8 @@ def test_noise_free_rolls_from_concave_starts_localize_within_the_success_radius
         assert abs(run.slip) < 0.01 + 0.002 * run.arc
 
 
-def test_a_jump_over_a_pocket_is_undone_and_the_wheel_rolls_the_other_way():
-    part = load_part("bench/parts/tuning/star-04.json")
+def test_a_jump_over_a_pocket_is_undone_and_the_wheel_rolls_the_other_way(parts):
+    part = parts("bench/parts/tuning/star-04.json")
     wheel = WheelJaw(5.0)
     run, err = localize(part, wheel, 161.3)  # 5 mm before a pocket the 5 mm wheel cannot enter
     assert run.jumps >= 1 and run.reversals >= 1
@@ -66,15 +85,15 @@ def test_a_jump_over_a_pocket_is_undone_and_the_wheel_rolls_the_other_way():
     assert steps.max() < 1.0
 
 
-def test_a_slipping_rim_stops_the_rolling_with_the_slip_named():
-    part = load_part("parts/kidney.csv")
+def test_a_slipping_rim_stops_the_rolling_with_the_slip_named(parts):
+    part = parts("parts/kidney.csv")
     wheel = WheelJaw(5.0)
     with pytest.raises(WheelSlip, match=r"slipped [+-]\d"):
         localize(part, wheel, 60.0, slip=0.05)
 
 
-def test_a_calibration_for_another_finger_and_a_rig_without_an_axle_encoder_are_refused():
-    part = load_part("parts/kidney.csv")
+def test_a_calibration_for_another_finger_and_a_rig_without_an_axle_encoder_are_refused(parts):
+    part = parts("parts/kidney.csv")
     rig = WheelRig(part, WheelJaw(5.0))
     with pytest.raises(RigError, match="calibration is for wheel:3"):
         localize_with_wheel(
@@ -91,8 +110,8 @@ def test_a_calibration_for_another_finger_and_a_rig_without_an_axle_encoder_are_
         WheelPolicy(step=-1.0)
 
 
-def test_a_mounting_rotation_is_taken_out_by_the_calibration():
-    part = load_part("parts/kidney.csv")
+def test_a_mounting_rotation_is_taken_out_by_the_calibration(parts):
+    part = parts("parts/kidney.csv")
     wheel = WheelJaw(5.0)
     rig = WheelRig(part, wheel, direction_zero=math.radians(2.0))
     cal = WheelCalibration(jaw="wheel:5", radius=5.0, direction_zero=math.radians(2.0))
@@ -100,11 +119,11 @@ def test_a_mounting_rotation_is_taken_out_by_the_calibration():
     assert abs(float(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"]))) < 0.3
 
 
-def test_the_same_wheel_localization_over_the_serial_protocol_and_a_straight_hand_refusing_the_axle():
+def test_the_same_wheel_localization_over_the_serial_protocol_and_a_straight_hand_refusing_the_axle(parts):
     from driver.link import Emulator, SerialRig
     from driver.rig import ProtocolError
 
-    part = load_part("parts/kidney.csv")
+    part = parts("parts/kidney.csv")
     wheel = WheelJaw(5.0)
     start = 65.0
     direct = WheelRig(part, wheel, noise="paper", seed=3)
@@ -129,11 +148,11 @@ def test_the_same_wheel_localization_over_the_serial_protocol_and_a_straight_han
         emu.close()
 
 
-def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_the_part_itself(tmp_path):
+def test_the_calibration_finds_the_wheels_true_radius_and_mounting_rotation_on_the_part_itself(tmp_path, parts):
     from driver.jaw import Calibration
     from driver.wheel import calibrate_wheel, load_calibration
 
-    part = load_part("parts/kidney.csv")
+    part = parts("parts/kidney.csv")
     wheel = WheelJaw(5.0)
     rig = WheelRig(part, wheel, noise="paper", seed=2, true_radius=5.03, direction_zero=math.radians(1.5))
     cal = calibrate_wheel(rig, wheel, rig.approach_pose(20.0), part=part, length=40.0)
@@ -224,13 +243,13 @@ def test_cli_emulate_calibrate_and_run_a_wheel_and_the_finger_checked_on_connect
     assert elsewhere.returncode == 2 and "was made on part 'kidney'" in elsewhere.stderr, elsewhere.stderr
 
 
-def test_the_calibration_stretch_lies_within_the_longest_the_wheel_surely_reaches():
+def test_the_calibration_stretch_lies_within_the_longest_the_wheel_surely_reaches(parts):
     from driver.wheel import CALIBRATION_LENGTH, wheel_calibration_arc
 
     for name in ("glyph-06", "star-04"):
-        part = load_part(f"bench/parts/tuning/{name}.json")
+        part = parts(f"bench/parts/tuning/{name}.json")
         wheel = WheelJaw(5.0)
-        reach = WheelReach(part, wheel)
+        reach = wheel_reach_for(part, wheel)
         start = wheel_calibration_arc(part, wheel)
         # brute force: the runs of sure points, walked from a point it does not reach
         first = int(np.argmin(reach.sure))
@@ -247,10 +266,10 @@ def test_the_calibration_stretch_lies_within_the_longest_the_wheel_surely_reache
         wheel_calibration_arc(part, wheel, length=1000.0)
 
 
-def test_a_budget_that_runs_out_between_checks_judges_the_last_readings():
+def test_a_budget_that_runs_out_between_checks_judges_the_last_readings(parts):
     # the same noise-free wheel rolling checked every 4 steps, and not until a budget a little beyond that
     # stop: the readings since the last check decide as a check would
-    part, wheel = load_part("parts/kidney.csv"), WheelJaw(5.0)
+    part, wheel = parts("parts/kidney.csv"), WheelJaw(5.0)
     runs = []
     for policy in (WheelPolicy(), WheelPolicy(check_every=100_000, max_rotation=math.radians(200.0))):
         rig = WheelRig(part, wheel)
@@ -261,10 +280,10 @@ def test_a_budget_that_runs_out_between_checks_judges_the_last_readings():
     assert abs(part.arc_offset(unchecked.estimate_arc, unchecked.true_arcs[-1])) < 0.3
 
 
-def test_on_a_drawing_the_wheel_pivots_on_a_convex_corner_and_is_found():
+def test_on_a_drawing_the_wheel_pivots_on_a_convex_corner_and_is_found(parts):
     """The bracket's corner at the seam (0 mm, 90°): the hand turns through it while L stands still, no step
     of it taken for a jump; then sure and right."""
-    part = load_part("parts/bracket.dxf")
+    part = parts("parts/bracket.dxf")
     run, err = localize(part, WheelJaw(5.0), 240.0)
     rolled, turn = np.asarray(run.lengths), np.asarray(run.turns)
     at = part.perimeter - 240.0  # L at the corner
@@ -274,12 +293,12 @@ def test_on_a_drawing_the_wheel_pivots_on_a_convex_corner_and_is_found():
     assert run.jumps == 0 and run.stopped == "confident" and abs(err) < 0.3
 
 
-def test_from_inside_a_drawings_notch_the_wheel_stops_enclosed_and_is_found_between_the_jumps():
+def test_from_inside_a_drawings_notch_the_wheel_stops_enclosed_and_is_found_between_the_jumps(parts):
     """The bracket's notch (20 mm wide, 10 deep) holds a 5 mm wheel between two walls it cannot climb: it
     jumps at each, turns round, and stops when it comes back to where it jumped the same way before. The
     floor's readings place the contact anywhere between where the jumps allow, alike: the estimate is
     the middle of that flat top (its first point was 0.27 mm off, at 56%)."""
-    part = load_part("parts/bracket.dxf")
+    part = parts("parts/bracket.dxf")
     run, err = localize(part, WheelJaw(5.0), 163.0)
     assert run.jumps == 3 and run.arc < 30.0  # enclosed: stopped at the third jump
     assert 153.13 < run.estimate_arc < 173.13  # on the notch's floor
@@ -299,12 +318,12 @@ def test_cli_simulates_a_wheel_on_a_drawing_and_locates_its_trace_again(tmp_path
     assert abs(again["estimate_arc"] - doc["estimate_arc"]) < 1e-6 and again["error_mm"] < 0.3
 
 
-def test_after_a_jam_the_wheel_starts_afresh_away_from_the_jump_that_followed_it():
+def test_after_a_jam_the_wheel_starts_afresh_away_from_the_jump_that_followed_it(parts):
     """On the bracket's notch wall, 4 mm above where a 5 mm wheel wedges against the floor: the step into the
     wedge reads as rolling on a concave arc, the next jumps and is undone, the wheel turns round, and nothing
     fits. Starting afresh the way it had turned to (not away from where it was going) rolled it back into the
     wedge twice, and the run ended "mismatch" (recorded at `paper` noise, seed 1)."""
-    part = load_part("parts/bracket.dxf")
+    part = parts("parts/bracket.dxf")
     run, err = localize(part, WheelJaw(5.0), 144.414, noise="paper", seed=1)
     assert run.jumps >= 1 and max(run.segments) >= 1  # it wedged, and started afresh
     segments, lengths = np.asarray(run.segments), np.asarray(run.lengths)
@@ -313,13 +332,13 @@ def test_after_a_jam_the_wheel_starts_afresh_away_from_the_jump_that_followed_it
     assert run.stopped == "confident" and abs(err) < 0.3
 
 
-def test_a_calibration_across_a_drawings_convex_corner_finds_the_radius_and_rotation():
+def test_a_calibration_across_a_drawings_convex_corner_finds_the_radius_and_rotation(parts):
     """The sums of the calibration hold through a pivot (path + δ·ΔΩ = r·(Δψ_e + Δφ)): 40 mm on the bracket
     from its notch's floor up the wall the disc wedges against would jump, so from the left face over the
     corner at the seam onto the bottom face, at `paper` noise."""
     from driver.wheel import calibrate_wheel
 
-    part = load_part("parts/bracket.dxf")
+    part = parts("parts/bracket.dxf")
     wheel = WheelJaw(5.0)
     rig = WheelRig(part, wheel, noise="paper", seed=2, true_radius=5.03, direction_zero=math.radians(1.5))
     cal = calibrate_wheel(rig, wheel, rig.approach_pose(part.perimeter - 15.0), part=part, length=40.0)
