@@ -268,12 +268,15 @@ class ContactState:
         constant part look measured (it is the segments' offsets' to absorb)."""
         if self.sd_slope <= 0 or self._ref is None or not self._hist:
             return
+        before = self._slope_var.copy()
         if self._ref != self._prior_ref:  # a new reference: its radii along the whole path
             self._prior_ref, self._prior_upto = self._ref, 0
             self._slope_var[self._segments : self._jaw0] = 0.0
         new = np.array(self._hist[self._prior_upto :])
         self._prior_upto = len(self._hist)
         if new.size == 0:
+            if not np.array_equal(before, self._slope_var):
+                self._version += 1
             return
         z, turn = new.T
         arc, ok = self.tracks.advance(np.full(z.size, self._ref), turn, turn_margin=TURN_MARGIN)
@@ -284,7 +287,9 @@ class ContactState:
         first = np.floor(z / self.shape_spacing).astype(np.int64) + self._segments + self._k0
         for k in range(4):
             np.maximum.at(self._slope_var, first + k, (rho * self.sd_slope) ** 2)
-        self._version += 1
+        # a refresh that changes no prior keeps the solves made since the last reading
+        if not np.array_equal(before, self._slope_var):
+            self._version += 1
 
     def _add_row(
         self, z: float, p: FloatArray, idx: IntArray | None = None, jaw: float | None = None, turn: float = 0.0
