@@ -38,26 +38,31 @@ def trefoil():
     return part, calibration(part)
 
 
+def from_300(trefoil, policy):
+    """The noise-free rolling of the trefoil from 300 mm with a tight filter under ``policy``: the run and
+    where its contact ended (mm)."""
+    part, cal = trefoil
+    rig = SimRig(part, noise="none", seed=1)
+    run = localize_reactively(
+        rig,
+        part,
+        calibration=cal,
+        filter=ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005),
+        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
+        policy=policy,
+    )
+    return run, rig.truth()["contact_arc"]
+
+
 @pytest.fixture(scope="module")
 def until_sure(trefoil):
-    """``until_sure(seek)``: the noise-free rolling from 300 mm with a tight filter until 95% sure, checked
-    every 5 steps, and where its contact ended; each rolled once for the module (read only)."""
-    part, cal = trefoil
+    """``until_sure(seek)``: :func:`from_300` until 95% sure, checked every 5 steps; each rolled once for the
+    module (read only)."""
     runs = {}
 
     def get(seek):
         if seek not in runs:
-            rig = SimRig(part, noise="none", seed=1)
-            flt = ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005)
-            run = localize_reactively(
-                rig,
-                part,
-                calibration=cal,
-                filter=flt,
-                approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
-                policy=ReactivePolicy(confidence=0.95, seek=seek),
-            )
-            runs[seek] = run, rig.truth()["contact_arc"]
+            runs[seek] = from_300(trefoil, ReactivePolicy(confidence=0.95, seek=seek))
         return runs[seek]
 
     return get
@@ -123,17 +128,10 @@ def test_the_rotation_budget_stops_it(trefoil):
 def test_a_budget_that_runs_out_between_checks_judges_the_last_readings(trefoil, until_sure):
     # the same rolling checked every 5 steps, and never until the budget ends a little after that stop:
     # the readings since the last check are judged as a check would, and a sure belief there is sure
-    part, cal = trefoil
+    part, _ = trefoil
     checked, _ = until_sure(False)  # ReactivePolicy(confidence=0.95): seek is off by default
-    rig = SimRig(part, noise="none", seed=1)
-    unchecked = localize_reactively(
-        rig,
-        part,
-        calibration=cal,
-        filter=ContactFilter(part, sd_position=0.01, sd_scale=0.001, sd_slope=0.0005),
-        approach_pose=rig.approach_pose(300.0, jaw_position=-40.0, standoff=1.0),
-        policy=ReactivePolicy(confidence=0.95, check_every=100_000, max_rotation=math.radians(60.0)),
-    )
+    never = ReactivePolicy(confidence=0.95, check_every=100_000, max_rotation=math.radians(60.0))
+    unchecked, _ = from_300(trefoil, never)
     assert checked.stopped == "confident" and checked.rotation < math.radians(60.0) and checked.reversals == 0
     assert unchecked.rotation == pytest.approx(math.radians(60.0), abs=1e-9) and len(unchecked.history) == 1
     assert unchecked.stopped == "confident" and unchecked.belief.mass >= 0.95
