@@ -288,10 +288,11 @@ class SerialRig:
     def close(self) -> None:
         # pyserial waits 0.3 s after closing a socket:// port (room for a quick reconnect): the arm's
         # and the DAQ's ports close side by side, not one after the other
-        others = [threading.Thread(target=_close_quietly, args=(port,)) for port in list(self.ports.values())[1:]]
+        ports = list(self.ports.values())
+        others = [threading.Thread(target=_close_quietly, args=(port,)) for port in ports[1:]]
         for thread in others:
             thread.start()
-        for port in list(self.ports.values())[:1]:
+        for port in ports[:1]:
             _close_quietly(port)
         for thread in others:
             thread.join()
