@@ -19,6 +19,28 @@ __all__ = ["reach_intervals"]
 
 
 @numba.njit(cache=True)
+def _blocked_by(wk: float, nearest: tuple[float, float, bool]) -> tuple[float, float, bool]:
+    """The nearest blocking points ahead and behind along the tangent (mm), and whether one is at the
+    contact itself, with a blocking point ``wk`` mm along it added."""
+    ahead, behind, here = nearest
+    if wk > 0:
+        return min(ahead, wk), behind, here
+    if wk < 0:
+        return ahead, max(behind, wk), here
+    return ahead, behind, True
+
+
+@numba.njit(cache=True)
+def _interval(nearest: tuple[float, float, bool], half: float) -> tuple[float, float]:
+    """(lo, hi) jaw positions, mm, from the nearest blocking points (:func:`_blocked_by`); empty where one
+    is at the contact."""
+    ahead, behind, here = nearest
+    if here:
+        return np.inf, -np.inf
+    return half - ahead, -half - behind
+
+
+@numba.njit(cache=True)
 def reach_intervals(
     pts: FloatArray,
     points: IntArray,
@@ -74,27 +96,15 @@ def reach_intervals(
             if dep[k] < -clearance:
                 behind = n - k
                 break
-        g_plus, g_minus, g_here = np.inf, -np.inf, False
-        s_plus, s_minus, s_here = np.inf, -np.inf, False
+        generous = (np.inf, -np.inf, False)
+        sure = (np.inf, -np.inf, False)
         for k in range(n):
             wk, dk = w[k], dep[k]
             if dk > clearance:  # generous: blocked by a point deeper than the clearance
-                if wk > 0:
-                    g_plus = min(g_plus, wk)
-                elif wk < 0:
-                    g_minus = max(g_minus, wk)
-                else:
-                    g_here = True
+                generous = _blocked_by(wk, generous)
             cap = (k < ahead or k > n - behind) and dk <= tiny  # rising above the edge blocks
             if dk > -clearance and not cap:  # sure: also within the clearance of the edge
-                if wk > 0:
-                    s_plus = min(s_plus, wk)
-                elif wk < 0:
-                    s_minus = max(s_minus, wk)
-                else:
-                    s_here = True
-        lo[r] = np.inf if g_here else half - g_plus
-        hi[r] = -np.inf if g_here else -half - g_minus
-        lo_sure[r] = np.inf if s_here else half - s_plus
-        hi_sure[r] = -np.inf if s_here else -half - s_minus
+                sure = _blocked_by(wk, sure)
+        lo[r], hi[r] = _interval(generous, half)
+        lo_sure[r], hi_sure[r] = _interval(sure, half)
     return lo, hi, lo_sure, hi_sure
