@@ -104,26 +104,21 @@ def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray
     if live.all():
         labels = np.zeros(nb, dtype=int)
     else:
-        # label runs of live bins around the circle
+        # label runs of live bins around the circle, counted from a dead bin so that none wraps
         start = int(np.flatnonzero(~live)[0])
         order = (np.arange(nb) + start) % nb
+        run = live[order]
+        first = run & ~np.r_[False, run[:-1]]
         labels = np.full(nb, -1)
-        label = -1
-        prev = False
-        for k in order:
-            if live[k] and not prev:
-                label += 1
-            if live[k]:
-                labels[k] = label
-            prev = live[k]
+        labels[order] = np.where(run, np.cumsum(first) - 1, -1)
+    held = labels[b]  # each hypothesis' mode
     out: list[Mode] = []
     for lab in range(int(labels.max()) + 1):
-        bins = labels == lab
-        sel = bins[b]
+        sel = held == lab
         if not sel.any():
             continue
         top = int(np.argmax(np.where(sel, w, -1.0)))
-        out.append(Mode(arc=float(present[top]), mass=float(mass[bins].sum()), start_arc=float(starts[top])))
+        out.append(Mode(arc=float(present[top]), mass=float(mass[labels == lab].sum()), start_arc=float(starts[top])))
     out.sort(key=lambda m: -m.mass)
     return out
 

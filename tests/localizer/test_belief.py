@@ -1,10 +1,13 @@
-"""The estimate of a belief: the most probable point, or the middle of a flat top."""
+"""The estimate of a belief: the most probable point, or the middle of a flat top; its modes."""
+
+import math
+from types import SimpleNamespace
 
 import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from localizer.filters._belief import FLAT_TOP, flat_top
+from localizer.filters._belief import FLAT_TOP, find_modes, flat_top
 
 
 @given(st.integers(8, 400), st.integers(0, 399), st.integers(1, 60), st.integers(0, 2**32 - 1))
@@ -40,3 +43,52 @@ def test_weights_without_a_positive_top_give_the_argmax():
     w = np.zeros(10)
     w[3] = np.nan
     assert flat_top(w) == 3
+
+
+def modes_by_walking(perimeter, w, present, radius):
+    """The modes as sets of bins: walk round the circle from each live bin, joining its live neighbours
+    (mass above 1e-4 of the largest bin's)."""
+    nb = max(8, int(perimeter / radius))
+    b = np.minimum((present / perimeter * nb).astype(int), nb - 1)
+    mass = np.zeros(nb)
+    for k, wk in zip(b, w):
+        mass[k] += wk
+    live = {k for k in range(nb) if mass[k] > 1e-4 * mass.max()}
+    groups, seen = [], set()
+    for k in sorted(live):
+        if k in seen:
+            continue
+        group, todo = set(), [k]
+        while todo:
+            j = todo.pop()
+            if j in live and j not in group:
+                group.add(j)
+                todo += [(j - 1) % nb, (j + 1) % nb]
+        seen |= group
+        groups.append(group)
+    out = []
+    for group in groups:
+        held = [h for h in range(len(w)) if b[h] in group]
+        top = max(held, key=lambda h: (w[h], -h))  # the first of the most probable
+        out.append((float(present[top]), sum(mass[k] for k in group), top))
+    return sorted(out, key=lambda m: -m[1])
+
+
+@given(st.integers(1, 300), st.floats(0.5, 20.0), st.integers(0, 2**32 - 1), st.floats(0.0, 0.9))
+def test_the_modes_are_the_runs_of_live_bins_round_the_circle(n, radius, seed, dead):
+    """Against a walk over the bins' neighbours: the same groups (one across the seam too), each with its
+    mass and its most probable hypothesis."""
+    perimeter = 200.0
+    rng = np.random.default_rng(seed)
+    present = rng.uniform(0.0, perimeter, n)
+    w = rng.exponential(1.0, n) * (rng.uniform(size=n) >= dead)
+    if w.sum() <= 0:
+        return
+    w /= w.sum()
+    starts = rng.uniform(0.0, perimeter, n)
+    got = find_modes(SimpleNamespace(perimeter=perimeter, name="ring"), w, present, starts, radius)
+    want = modes_by_walking(perimeter, w, present, radius)
+    assert len(got) == len(want)
+    for mode, (arc, mass, top) in zip(got, want):
+        assert mode.arc == arc and mode.start_arc == starts[top]
+        assert math.isclose(mode.mass, mass, rel_tol=1e-12, abs_tol=1e-15)
