@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from .._types import ArrayLike, BoolArray, FloatArray, IntArray
-from ..geometry import Boundary, check_grid, per_part
+from ..geometry import Boundary, check_grid, mod_period, per_part
 from ._reach import DEFAULT_JAW, StraightJaw, reach_for
 from ._tracks_kernels import step_along
 
@@ -217,7 +217,7 @@ class ModeTracks:
             uniform: IntArray = np.mod(np.rint(a / self.h).astype(np.int64), self.sigma.size)
             return uniform
         p = self.part.perimeter
-        w = np.mod(a, p)
+        w = mod_period(a, p)
         j = np.clip(np.searchsorted(self.sigma, w), 1, self.sigma.size - 1)
         nearer_left = (w - self.sigma[j - 1]) <= (self.sigma[j] - w)
         node: IntArray = np.where(nearer_left, j - 1, j)

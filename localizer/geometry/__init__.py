@@ -21,7 +21,7 @@ from ._limits import (
     count_text,
     read_toml,
 )
-from ._numerics import TWO_PI, curvature, gauss_legendre, wrap_angle
+from ._numerics import TWO_PI, curvature, gauss_legendre, mod_period, wrap_angle
 from ._outline import Corner, Outline, nearest_corner, outline_from_pieces
 from ._part import UNITS_TO_MM, Part, part_from_points, polygon_crossing
 from ._pieces import CircularArc, CubicBezier, Line, elliptical_arc
@@ -51,6 +51,7 @@ __all__ = [
     "TWO_PI",
     "curvature",
     "gauss_legendre",
+    "mod_period",
     "wrap_angle",
     "Corner",
     "Outline",

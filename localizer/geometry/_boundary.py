@@ -15,6 +15,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from .._types import ArrayLike, FloatArray
+from ._numerics import mod_period
 
 __all__ = ["Boundary", "ArcPositions"]
 
@@ -77,7 +78,7 @@ class ArcPositions:
 
     def wrap_arc(self, sigma: ArrayLike) -> FloatArray:
         """Arc positions ``sigma`` (mm) reduced to ``[0, perimeter)``."""
-        w = np.mod(np.asarray(sigma, dtype=float), self.perimeter)
+        w = mod_period(np.asarray(sigma, dtype=float), self.perimeter)
         wrapped: FloatArray = np.where(w >= self.perimeter, 0.0, w)
         return wrapped
 
@@ -89,7 +90,7 @@ class ArcPositions:
         """
         half = 0.5 * self.perimeter
         offset: FloatArray = (
-            np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
+            mod_period(np.asarray(a, dtype=float) - np.asarray(b, dtype=float) + half, self.perimeter) - half
         )
         return offset
 

@@ -11,7 +11,7 @@ from .._types import FloatArray
 
 _Angle = TypeVar("_Angle", float, FloatArray)
 
-__all__ = ["TWO_PI", "wrap_angle", "curvature", "gauss_legendre"]
+__all__ = ["TWO_PI", "wrap_angle", "mod_period", "curvature", "gauss_legendre"]
 
 #: One full turn, rad.
 TWO_PI = 2.0 * np.pi
@@ -21,6 +21,24 @@ def wrap_angle(angle: _Angle) -> _Angle:
     """Angles mapped to [−π, π), rad (arrays or scalars)."""
     wrapped: _Angle = (angle + np.pi) % TWO_PI - np.pi
     return wrapped
+
+
+def mod_period(x: FloatArray, period: float) -> FloatArray:
+    """``np.mod(x, period)`` to the bit, for ``period`` > 0, in a third of its time where every ``x`` is
+    within a period of [0, period), as the filters' arc positions are.
+
+    There numpy's remainder (``fmod``, then the period added to a negative remainder, and −0 made +0) is
+    the value itself, the value less the period (exact: the two are within a factor of two) or the value
+    plus the period; elsewhere, and for short arrays, NaN or infinities, ``np.mod`` is asked."""
+    a = np.asarray(x, dtype=float)
+    if a.size < 64:
+        out: FloatArray = np.mod(a, period)
+        return out
+    if not (-period <= a.min() and a.max() < 2.0 * period):  # also false for NaN
+        out = np.mod(a, period)
+        return out
+    out = np.where(a < 0.0, a + period, np.where(a >= period, a - period, a)) + 0.0
+    return out
 
 
 def curvature(dx: FloatArray, dy: FloatArray, ddx: FloatArray, ddy: FloatArray) -> FloatArray:
