@@ -20,6 +20,7 @@ __all__ = [
     "wilson",
     "json_safe",
     "cell_number",
+    "quantile",
     "summarize",
     "method_detail",
     "error_over_bound",
@@ -70,6 +71,16 @@ def json_safe(value: object) -> object:
     return value
 
 
+def quantile(values: FloatArray, q: float) -> float:
+    """The ``q`` quantile of ``values`` (numpy's linear interpolation), infinite where it falls between two
+    infinite values (failed trials' errors), where numpy's interpolation would say NaN."""
+    with np.errstate(invalid="ignore"):
+        out = float(np.quantile(values, q))
+    if math.isnan(out) and not np.isnan(values).any():
+        return math.inf
+    return out
+
+
 def cell_number(text: Any) -> float:
     """A trials.csv cell as a float (empty: nan)."""
     try:
@@ -96,7 +107,7 @@ def summarize(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
                 "success_rate": ok / n if n else None,
                 "ci95": list(wilson(ok, n)),
                 "error_median_mm": float(np.median(err)) if n else None,
-                "error_p90_mm": float(np.quantile(err, 0.9)) if n else None,
+                "error_p90_mm": quantile(err, 0.9) if n else None,
                 "ambiguous": sum(int(r["ambiguous"]) for r in sel),
                 "broken": sum(bool(r["failure"]) for r in sel),
                 "mean_time_s": float(np.mean([float(r["time_s"]) for r in sel])) if n else None,

@@ -1,11 +1,12 @@
 """The calibration of a method's stated probability: the binned gap between what it states and how
 often it is right, against sums written out by hand."""
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bench.summary import FULL_BIN, RELIABILITY_BINS, calibration
+from bench.summary import FULL_BIN, RELIABILITY_BINS, calibration, quantile
 
 
 def rows(*groups):
@@ -121,3 +122,12 @@ def test_sure_against_rotation_counts_each_trial_from_the_mark_it_is_sure_at():
     assert by["5"] == {"sure": pytest.approx(1 / 3), "sure_wrong": pytest.approx(1 / 3)}
     assert by["10"] == by["240"] == {"sure": pytest.approx(2 / 3), "sure_wrong": pytest.approx(1 / 3)}
     assert sure_by_rotation(study, "reactive", rows[2:]) is None
+
+
+def test_a_quantile_among_failed_trials_is_infinite_not_nan():
+    """Two of ten trials failed (infinite error): the 90% quantile lies between them."""
+    err = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, np.inf, np.inf])
+    assert quantile(err, 0.9) == np.inf
+    assert quantile(err[:8], 0.5) == pytest.approx(np.quantile(err[:8], 0.5))
+    assert quantile(np.array([0.1, np.inf]), 0.5) == np.inf
+    assert np.isnan(quantile(np.array([0.1, np.nan]), 0.5))  # an unknown error stays unknown
