@@ -33,6 +33,12 @@ from .signals import handling
 
 __all__ = ["SerialRig", "Workspace"]
 
+#: Each URL's port still closing in this process. pyserial sleeps 0.3 s after it has closed a socket://
+#: port, room for the server to take the next connection: a rig opening that URL again waits for the
+#: sleep to end, the rig closing it only until the port is shut.
+_closing: dict[str, threading.Thread] = {}
+_closing_lock = threading.Lock()
+
 
 @dataclass(frozen=True)
 class Workspace:
@@ -96,10 +102,15 @@ class SerialRig:
         self._seq = 0
         self._commanded: tuple[float, float, float] | None = None
         self.ports: dict[str, Any] = {}
+        self._urls = {"arm": arm_url, "daq": daq_url}
         self._locks: list[IO[str]] = []
         try:
             for name, url in (("arm", arm_url), ("daq", daq_url)):
                 self._locks.append(_device_lock(name, url))
+                with _closing_lock:
+                    closing = _closing.pop(url, None)
+                if closing is not None:
+                    closing.join()
                 # a local device is also locked by the OS (pyserial's flock), against other programs
                 local = "://" not in url
                 self.ports[name] = serial.serial_for_url(
@@ -286,16 +297,21 @@ class SerialRig:
         self.move(x + d * math.sin(phi), y - d * math.cos(phi), phi)
 
     def close(self) -> None:
-        # pyserial waits 0.3 s after closing a socket:// port (room for a quick reconnect): the arm's
-        # and the DAQ's ports close side by side, not one after the other
-        ports = list(self.ports.values())
-        others = [threading.Thread(target=_close_quietly, args=(port,)) for port in ports[1:]]
-        for thread in others:
+        # each port closes on a thread of its own, waited for until the port is shut (pyserial marks it
+        # closed once its socket or descriptor is), not through pyserial's sleep after a socket:// port
+        # (see _closing); a port that does not say whether it is open is waited for to the end
+        closers = []
+        for name, port in self.ports.items():
+            if not getattr(port, "is_open", True):
+                continue  # closed before: its sleep, if any, is already waited for where it matters
+            thread = threading.Thread(target=_close_quietly, args=(port,), name=f"close {name}", daemon=True)
             thread.start()
-        for port in ports[:1]:
-            _close_quietly(port)
-        for thread in others:
-            thread.join()
+            with _closing_lock:
+                _closing[self._urls[name]] = thread
+            closers.append((port, thread))
+        for port, thread in closers:
+            while thread.is_alive() and getattr(port, "is_open", True):
+                thread.join(0.002)
         for lock in self._locks:
             with contextlib.suppress(OSError):
                 lock.close()

@@ -215,6 +215,48 @@ def test_the_serial_rig_is_a_rig_without_the_simulators_extras():
         emu.close()
 
 
+def test_a_closed_rig_does_not_wait_out_pyserials_grace_but_a_rig_reopening_its_port_does(monkeypatch):
+    """pyserial sleeps 0.3 s after closing a socket:// port, room for the server to take the next
+    connection (here the sleep lasts until the test ends it): the rig's close returns once its ports are
+    shut; a rig opening the same URL waits for the grace to end."""
+    import threading
+    from types import SimpleNamespace
+
+    import serial.urlhandler.protocol_socket as protocol_socket
+
+    grace = threading.Event()
+    asleep = threading.Semaphore(0)
+
+    def sleep(seconds):
+        asleep.release()
+        grace.wait()
+
+    monkeypatch.setattr(protocol_socket, "time", SimpleNamespace(sleep=sleep))
+    emu = emulator()
+    arm, daq = emu.serve_tcp(0)
+    try:
+        rig = SerialRig(arm, daq)
+        ports = list(rig.ports.values())
+        closing = threading.Thread(target=rig.close, daemon=True)
+        closing.start()
+        closing.join(30)
+        assert not closing.is_alive()  # returned while pyserial sleeps
+        assert not any(port.is_open for port in ports) and not grace.is_set()
+        reopened = []
+        opener = threading.Thread(target=lambda: reopened.append(SerialRig(arm, daq)), daemon=True)
+        opener.start()
+        opener.join(0.5)
+        assert opener.is_alive() and not reopened  # waiting for the grace, however long it takes
+        assert asleep.acquire(timeout=30) and asleep.acquire(timeout=30)  # both ports in it
+        grace.set()
+        opener.join(30)
+        assert reopened and reopened[0].pose() is not None
+        reopened[0].close()
+    finally:
+        grace.set()
+        emu.close()
+
+
 def test_requests_round_trip():
     seq, cmd, args = parse_request(encode_request(12, "MOVE", 1.5, -2.25, 30.0), ARM_COMMANDS)
     assert (seq, cmd, args) == (12, "MOVE", [1.5, -2.25, 30.0])
