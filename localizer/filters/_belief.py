@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from .._types import FloatArray
+from .._types import FloatArray, IntArray
 from ..geometry import check_grid
 
-__all__ = ["Belief", "Mode", "find_modes", "belief_flags", "flat_top", "FLAT_TOP"]
+__all__ = ["Belief", "Mode", "find_modes", "belief_flags", "flat_top", "most_probable", "FLAT_TOP"]
 
 
 @dataclass(frozen=True)
@@ -120,6 +120,21 @@ def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray
         top = int(np.argmax(np.where(sel, w, -1.0)))
         out.append(Mode(arc=float(present[top]), mass=float(mass[labels == lab].sum()), start_arc=float(starts[top])))
     out.sort(key=lambda m: -m.mass)
+    return out
+
+
+def most_probable(w: FloatArray, k: int) -> IntArray:
+    """The indices of the ``k`` largest weights ``w`` (all of them if fewer), largest first, equal weights
+    by index: the same on every machine (numpy's argsort orders equal values as the CPU's sort does),
+    and a partition of the grid rather than a sort of it."""
+    n = int(w.size)
+    k = min(int(k), n)
+    if k <= 0:
+        return np.zeros(0, dtype=np.int64)
+    kth = np.partition(w, n - k)[n - k]
+    above = np.flatnonzero(w > kth)
+    chosen = np.concatenate([above, np.flatnonzero(w == kth)[: k - above.size]])
+    out: IntArray = chosen[np.lexsort((chosen, -w[chosen]))]
     return out
 
 

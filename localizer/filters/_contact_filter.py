@@ -21,7 +21,7 @@ import numpy as np
 
 from .._defaults import BRIDGE_JUMP
 from .._errors import QueryError
-from ._belief import Belief, belief_flags
+from ._belief import Belief, belief_flags, most_probable
 from ._contact_fit import ContactFit
 from ._contact_settings import (
     BRIDGE_MISS,
@@ -377,7 +377,7 @@ class ContactFilter(ContactFit):
             self._fit_version = self._version
             # the most probable starts, and each strong mode's best: all of them must misfit
             strong = [m for m in modes if m.mass >= self.mode_floor][:3]
-            top = np.argsort(w)[::-1][:FIT_STARTS]
+            top = most_probable(w, FIT_STARTS)
             reps = [i] + [int(self.tracks.node_at(m.start_arc)) for m in strong[1:]]
             reps += [int(h) for h in top if w[h] > 0 and int(h) not in reps]
             found = self.fit_test(reps)

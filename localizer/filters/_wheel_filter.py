@@ -67,7 +67,7 @@ from .._errors import QueryError
 from .._types import BoolArray, FloatArray
 from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, wheel_reach_for
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
-from ._belief import Belief, belief_flags, find_modes, flat_top
+from ._belief import Belief, belief_flags, find_modes, flat_top, most_probable
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 
@@ -389,7 +389,7 @@ class WheelFilter:
             and (mass >= self.confidence or used >= self._fit_at + WHEEL_FIT_EVERY)
         ):
             self._fit_at = used
-            top = [int(h) for h in np.argsort(w)[::-1][:FIT_STARTS] if w[h] > 0]
+            top = [int(h) for h in most_probable(w, FIT_STARTS) if w[h] > 0]
             self._misfit = self.fit_test(top)
         mismatch = self._misfit[0] if self._misfit is not None else None
         # sure only if sure without any one short stretch of the rolled arc (the straight jaw's rule,

@@ -7,7 +7,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from localizer.filters._belief import FLAT_TOP, find_modes, flat_top
+from localizer.filters._belief import FLAT_TOP, find_modes, flat_top, most_probable
 
 
 @given(st.integers(8, 400), st.integers(0, 399), st.integers(1, 60), st.integers(0, 2**32 - 1))
@@ -92,3 +92,14 @@ def test_the_modes_are_the_runs_of_live_bins_round_the_circle(n, radius, seed, d
     for mode, (arc, mass, top) in zip(got, want):
         assert mode.arc == arc and mode.start_arc == starts[top]
         assert math.isclose(mode.mass, mass, rel_tol=1e-12, abs_tol=1e-15)
+
+
+@given(
+    st.lists(st.sampled_from([0.0, 0.1, 0.25, 0.5, 1.0]) | st.floats(0.0, 1.0), min_size=1, max_size=200),
+    st.integers(0, 12),
+)
+def test_the_most_probable_are_the_largest_first_equal_ones_by_index(weights, k):
+    """Against a sort by (−weight, index): the same indices in the same order, ties and all."""
+    w = np.asarray(weights)
+    want = sorted(range(w.size), key=lambda i: (-w[i], i))[:k]
+    assert most_probable(w, k).tolist() == want
