@@ -226,6 +226,11 @@ class ModeTracks:
         result: IntArray = np.where(wrap, 0, node)
         return result
 
+    def landing_hints(self) -> IntArray:
+        """A fresh :meth:`step` ``hint``: each grid point's own entry in the angle table."""
+        out: IntArray = self._entry.copy()
+        return out
+
     def advance(
         self, index: IntArray, turn: FloatArray | float, *, turn_margin: float = 0.0
     ) -> tuple[FloatArray, BoolArray]:
@@ -242,6 +247,7 @@ class ModeTracks:
         turn_margin: float = 0.0,
         jaw: float | None = None,
         at: ArrayLike | None = None,
+        hint: IntArray | None = None,
     ) -> tuple[FloatArray, IntArray, BoolArray]:
         """Arc positions after a net rotation ``turn`` (rad) of the grid points ``index``, along their
         convex stretches (no check of where the jaw reaches: :meth:`touches`, :meth:`roll`).
@@ -261,6 +267,11 @@ class ModeTracks:
             lays the jaw flush on a face (within :data:`FLUSH_TURN` of its angle) puts the contact
             at the middle of the face's stretch under the jaw, the centre of pressure of a line
             contact (without them, at the face's start).
+        hint : ndarray of int over the grid, optional
+            Where the search for each point's landing in the angle table starts (from
+            :meth:`landing_hints`), updated in place with the landings found: a caller stepping the
+            same points by a growing turn searches a few entries from the last landing instead of
+            from the start. The landings do not depend on it.
 
         Returns
         -------
@@ -288,8 +299,10 @@ class ModeTracks:
             self.convex,
             self._s,
             self._node,
-            self._entry,
+            self._entry if hint is None else hint,
         )
+        if hint is not None:
+            hint[idx] = j
         arc, node, ok = arc.reshape(shape), node.reshape(shape), ok.reshape(shape)
         j, target, idx = j.reshape(shape), target.reshape(shape), idx.reshape(shape)
         # no turn, no move: on a flat face the angle alone does not say where along it the contact is

@@ -165,6 +165,7 @@ class ContactFilter(ContactFit):
             turn_margin=TURN_MARGIN,
             jaw=self.jaw_position if flush else None,
             at=self.current[idx] if flush else None,
+            hint=self._hints,
         )
         if not ok.all():
             out = idx[~ok]

@@ -174,6 +174,7 @@ class ContactState:
         n = self.grid.size
         self.current = self.grid.copy()  # present contact of each hypothesis, mm (unwrapped)
         self.node = np.arange(n)  # ... and its grid point (on a pivot, the jaw's angle too)
+        self._hints = self.tracks.landing_hints()  # ... and its entry in the tracks' angle table
         self.feasible = self.tracks.convex.copy()
         m = self._m
         self._up = np.zeros((m, n))  # Uᵀp per hypothesis (row 0: Σp)

@@ -80,3 +80,24 @@ def test_a_roll_on_a_convex_part_lands_where_the_tangent_has_turned_by_it():
         want = np.interp(theta[idx] + turn, angles, arcs)
         assert ok.all() and np.abs(arc - want).max() < 1e-9
         assert np.array_equal(node, tracks.node_at(arc))
+
+
+@pytest.mark.parametrize("shape", ["cam", "kidney"])
+def test_a_search_started_from_the_last_landings_finds_the_same_landings(shape):
+    """Rolled by a growing turn with the landings kept as the next search's start, and by random turns
+    from wherever the last search ended: every landing, node and verdict is the one found from each
+    start's own entry (on a part with concave stretches and faces too)."""
+    a = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    r = 35 + (8 * np.cos(2 * a) if shape == "kidney" else 3 * np.cos(3 * a))
+    part = part_from_points(np.c_[r * np.cos(a), 0.8 * r * np.sin(a)], name=shape)
+    tracks = ModeTracks(part, 0.2)
+    idx = np.flatnonzero(tracks.convex)
+    hints = tracks.landing_hints()
+    rng = np.random.default_rng(7)
+    turns = np.r_[np.cumsum(np.full(120, 0.01)), rng.uniform(-np.pi, np.pi, 30)]
+    for turn in turns:
+        for margin in (0.0, 0.02):
+            want = tracks.step(idx, float(turn), turn_margin=margin)
+            got = tracks.step(idx, float(turn), turn_margin=margin, hint=hints)
+            for g, w in zip(got, want):
+                assert np.array_equal(g, w, equal_nan=g.dtype.kind == "f")
