@@ -124,14 +124,16 @@ def find_modes(part: Any, w: FloatArray, present: FloatArray, starts: FloatArray
 
 
 def most_probable(w: FloatArray, k: int) -> IntArray:
-    """The indices of the ``k`` largest weights ``w`` (all of them if fewer), largest first, equal weights
-    by index: the same on every machine (numpy's argsort orders equal values as the CPU's sort does),
-    and a partition of the grid rather than a sort of it."""
+    """The indices of the ``k`` largest of the non-negative weights ``w`` (all of them if fewer), largest
+    first, equal weights by index: the same on every machine (numpy's argsort orders equal values as the
+    CPU's sort does). A partition of the positive weights finds the k-th: numpy's partition of a grid
+    mostly of zeros (the pruned starts) takes as long as a sort."""
     n = int(w.size)
     k = min(int(k), n)
     if k <= 0:
         return np.zeros(0, dtype=np.int64)
-    kth = np.partition(w, n - k)[n - k]
+    positive = w[w > 0]
+    kth = np.partition(positive, positive.size - k)[positive.size - k] if positive.size >= k else 0.0
     above = np.flatnonzero(w > kth)
     chosen = np.concatenate([above, np.flatnonzero(w == kth)[: k - above.size]])
     out: IntArray = chosen[np.lexsort((chosen, -w[chosen]))]
