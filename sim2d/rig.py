@@ -109,10 +109,11 @@ class SimRig(SimulatedArm):
         """Average of ``n`` raw samples of (v1, v2), V; logged with the truth."""
         c = self.world.contact()
         times = self.time + self.sample_period * np.arange(1, n + 1)
-        v1, v2 = self.wrist.voltages(np.full(n, c.force), np.full(n, c.jaw_position), times, self.noise, self.rng)
+        # the force and place hold over the n samples: the same voltages as arrays of them, elementwise
+        v1, v2 = self.wrist.voltages(c.force, c.jaw_position, times, self.noise, self.rng)
         self.time = float(times[-1])
         spike = self.spikes()  # on the twist channel: the contact's place
-        out = (float(np.mean(v1)), float(np.mean(v2)) + spike)
+        out = (float(v1.sum()) / n, float(v2.sum()) / n + spike)  # np.mean's sum and division
         x, y, phi = self.world.hand or (0.0, 0.0, 0.0)
         self.samples.append(
             {
