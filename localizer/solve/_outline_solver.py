@@ -166,9 +166,8 @@ def _solve_ccw(outline: Outline, L: float, omega: float, spacing: float) -> list
         else:
             out.append((float(root[i]), "simple", 0.0, float(residual[i])))
     # corners: a start at corner c, or an end at a corner, fits a range of rotations
-    for b in breaks:
-        if outline.corner_at(b) < 0 and outline.corner_at(b + L) < 0:
-            continue
+    at_corner = (outline.corner_at(breaks) >= 0) | (outline.corner_at(breaks + L) >= 0)
+    for b in breaks[at_corner]:
         lo_end, hi_end = sorted((_theta(outline, b + L, "before"), _theta(outline, b + L, "after")))
         lo_start, hi_start = sorted((_theta(outline, b, "before"), _theta(outline, b, "after")))
         lo_turn, hi_turn = lo_end - hi_start, hi_end - lo_start
