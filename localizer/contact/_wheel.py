@@ -17,6 +17,7 @@ docs/wheel.md has the physics.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -152,10 +153,16 @@ class WheelReach:
         around the contact (False where not reached)."""
         out = np.zeros(n, dtype=bool)
         todo = np.flatnonzero(self.reached)
-        for i, near in zip(todo, tree.query_ball_point(self.axle[todo], within)):
-            off = np.sort((np.asarray(near, dtype=np.int64) - i + n // 2) % n - n // 2)
-            # one run of consecutive samples that holds the contact (offset 0)
-            out[i] = off.size > 0 and off[0] <= 0 <= off[-1] and bool(np.all(np.diff(off) == 1))
+        near = tree.query_ball_point(self.axle[todo], within)
+        sizes = np.fromiter((len(x) for x in near), dtype=np.int64, count=len(near))
+        flat = np.fromiter(itertools.chain.from_iterable(near), dtype=np.int64, count=int(sizes.sum()))
+        off = (flat - np.repeat(todo, sizes) + n // 2) % n - n // 2
+        # one run of consecutive samples that holds the contact (offset 0): the samples are distinct, so
+        # they are a run when their span is their count
+        held = sizes > 0
+        first = (np.cumsum(sizes) - sizes)[held]
+        lo, hi = np.minimum.reduceat(off, first), np.maximum.reduceat(off, first)
+        out[todo[held]] = (lo <= 0) & (hi >= 0) & (hi - lo + 1 == sizes[held])
         return out
 
     def touchable(self, arc: ArrayLike) -> BoolArray:
