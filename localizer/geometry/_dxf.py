@@ -11,7 +11,7 @@ import numpy as np
 
 from .._errors import PartError
 from ._cad_loops import chain_loops, check_pieces
-from ._pieces import CircularArc, CubicBezier, Line, Piece, elliptical_arc
+from ._pieces import CircularArc, CubicBezier, Line, Piece, elliptical_arc, trusted_lines
 
 __all__ = ["DXF_UNITS", "DXF_NOTES", "read_dxf"]
 
@@ -150,12 +150,29 @@ def _closed(e: Any, kind: str) -> bool:
 
 def _polyline(e: Any, kind: str, k: float, where: str) -> list[Piece]:
     if kind == "LWPOLYLINE":
-        verts = [(float(x) * k, float(y) * k, float(b)) for x, y, b in e.get_points("xyb")]
+        # ezdxf keeps the vertices packed, a row (x, y, start width, end width, bulge) each (its
+        # LWPolylinePoints, VERTEX_SIZE 5): read as one array, not as a tuple a vertex
+        packed = e.lwpoints
+        if getattr(packed, "VERTEX_SIZE", None) == 5 and hasattr(packed, "values"):
+            rows = np.asarray(packed.values, dtype=float).reshape(-1, 5)
+            xy, bulge = rows[:, :2] * k, rows[:, 4]
+        else:  # another ezdxf's layout: its public reading
+            xyb = np.array(e.get_points("xyb"), dtype=float).reshape(-1, 3)
+            xy, bulge = xyb[:, :2] * k, xyb[:, 2]
     else:
-        verts = [(float(v.dxf.location[0]) * k, float(v.dxf.location[1]) * k, float(v.dxf.bulge)) for v in e.vertices]
-    n = len(verts)
+        xy = np.array([(float(v.dxf.location[0]), float(v.dxf.location[1])) for v in e.vertices]).reshape(-1, 2) * k
+        bulge = np.array([float(v.dxf.bulge) for v in e.vertices])
+    n = len(xy)
     last = n if _closed(e, kind) else n - 1
-    return [_bulge(verts[i][:2], verts[(i + 1) % n][:2], verts[i][2], f"{where}, vertex {i}") for i in range(last)]
+    if last <= 0:
+        return []
+    verts = list(zip(xy[:, 0].tolist(), xy[:, 1].tolist(), strict=True))
+    ends = verts[1:] + verts[:1]
+    straight = bool(np.all(np.abs(bulge[:last]) <= 1e-15))
+    if straight and np.isfinite(xy).all() and min(map(math.dist, verts[:last], ends[:last])) > 1e-12:
+        return list(trusted_lines(verts[:last], ends[:last]))  # what _line makes of each, its checks passed
+    bulges = bulge.tolist()
+    return [_bulge(verts[i], ends[i], bulges[i], f"{where}, vertex {i}") for i in range(last)]
 
 
 def _spline(e: Any, k: float, where: str) -> list[Piece]:

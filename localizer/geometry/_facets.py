@@ -27,7 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._errors import PartError
-from ._pieces import CircularArc, Line, Piece
+from .._types import FloatArray
+from ._pieces import CircularArc, Line, Piece, arcs_are_valid, lines_are_valid, trusted_arcs, trusted_lines
 
 __all__ = ["FacetRule", "FACETS", "read_facets"]
 
@@ -134,14 +135,24 @@ def read_facets(pieces: list[Piece] | tuple[Piece, ...], rule: FacetRule = FACET
     s0, s1 = cut, length - np.roll(cut, -1)
     a, b = start + s0[:, None] * direction, start + s1[:, None] * direction
 
-    out: list[Piece] = []
-    for j, piece in enumerate(pieces):
-        if smooth[j]:
-            out.append(CircularArc((centre[j, 0], centre[j, 1]), radius[j], a0[j], turn[j]))
-        if not (line[j] and trimmed[j]):
-            out.append(piece)
-        elif s1[j] - s0[j] >= MIN_SEGMENT:
-            out.append(Line((a[j, 0], a[j, 1]), (b[j, 0], b[j, 1])))
+    # each vertex's fillet, then its piece or what the fillets leave of it, in the chain's order
+    arcs = np.flatnonzero(smooth)
+    cuts = np.flatnonzero(line & trimmed & (s1 - s0 >= MIN_SEGMENT))
+    kept = np.flatnonzero(~(line & trimmed))
+    slots = np.empty(2 * n, dtype=object)
+    if arcs_are_valid(centre[arcs], radius[arcs], a0[arcs], turn[arcs]) and lines_are_valid(a[cuts], b[cuts]):
+        slots[2 * arcs] = trusted_arcs(_points(centre[arcs]), radius[arcs], a0[arcs], turn[arcs])
+        slots[2 * cuts + 1] = trusted_lines(_points(a[cuts]), _points(b[cuts]))
+    else:  # the constructors say what is wrong, at the first piece it is wrong in
+        for i in np.sort(np.r_[2 * arcs, 2 * cuts + 1]):
+            j = i // 2
+            slots[i] = (
+                Line((a[j, 0], a[j, 1]), (b[j, 0], b[j, 1]))
+                if i % 2
+                else CircularArc((centre[j, 0], centre[j, 1]), radius[j], a0[j], turn[j])
+            )
+    slots[2 * kept + 1] = [pieces[j] for j in kept]
+    out: list[Piece] = [p for p in slots.tolist() if p is not None]
     if smooth[0]:  # the first vertex's fillet: its second half first, its first half last
         arc = out[0]
         assert isinstance(arc, CircularArc)
@@ -149,3 +160,8 @@ def read_facets(pieces: list[Piece] | tuple[Piece, ...], rule: FacetRule = FACET
         out[0] = CircularArc(arc.center, arc.radius, mid, 0.5 * arc.sweep)
         out.append(CircularArc(arc.center, arc.radius, arc.start_angle, 0.5 * arc.sweep))
     return out
+
+
+def _points(xy: FloatArray) -> list[tuple[float, float]]:
+    """Points (n, 2) as the (x, y) tuples of floats the pieces hold."""
+    return list(zip(xy[:, 0].tolist(), xy[:, 1].tolist(), strict=True))

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Hashable
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -96,23 +96,35 @@ class Outline(ArcPositions):
     _tables: dict[tuple[str, Hashable], Any] = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
-        n = len(self.pieces)
-        lengths = np.array([p.length for p in self.pieces])
+        pieces = self.pieces
+        n = len(pieces)
+        # lines and arcs are evaluated for all their arc positions at once, from these arrays, by the
+        # same arithmetic as the pieces' own; Béziers one piece at a time
+        kind = np.array(
+            [_LINE if isinstance(p, Line) else _ARC if isinstance(p, CircularArc) else _BEZIER for p in pieces],
+            dtype=np.int8,
+        )
+        at_line, at_arc, at_bezier = (np.flatnonzero(kind == k) for k in (_LINE, _ARC, _BEZIER))
+        lines = cast(list[Line], [pieces[i] for i in at_line.tolist()])
+        arcs = cast(list[CircularArc], [pieces[i] for i in at_arc.tolist()])
+        origin, delta = np.zeros((n, 2)), np.zeros((n, 2))  # a line's start and end − start
+        polar0, sense, radius = np.zeros(n), np.zeros(n), np.ones(n)  # an arc's, origin its centre
+        lengths = np.empty(n)
+        if lines:
+            origin[at_line] = [p.start for p in lines]
+            delta[at_line] = np.array([p.end for p in lines]) - origin[at_line]
+            lengths[at_line] = list(map(math.hypot, delta[at_line, 0].tolist(), delta[at_line, 1].tolist()))
+        if arcs:
+            origin[at_arc] = [p.center for p in arcs]
+            radius[at_arc] = [p.radius for p in arcs]
+            polar0[at_arc] = [p.start_angle for p in arcs]
+            sweep = np.array([p.sweep for p in arcs], dtype=float)
+            sense[at_arc] = np.copysign(1.0, sweep)
+            lengths[at_arc] = radius[at_arc] * np.abs(sweep)
+        lengths[at_bezier] = [pieces[i].length for i in at_bezier.tolist()]
         starts = np.concatenate([[0.0], np.cumsum(lengths)])
         object.__setattr__(self, "starts", starts)
         object.__setattr__(self, "perimeter", float(starts[-1]))
-        # lines and arcs are evaluated for all their arc positions at once, from these arrays, by the
-        # same arithmetic as the pieces' own; Béziers one piece at a time
-        kind = np.full(n, _BEZIER, dtype=np.int8)
-        origin, delta = np.zeros((n, 2)), np.zeros((n, 2))  # a line's start and end − start
-        polar0, sense, radius = np.zeros(n), np.zeros(n), np.ones(n)  # an arc's, origin its centre
-        for i, piece in enumerate(self.pieces):
-            if isinstance(piece, Line):
-                kind[i], origin[i] = _LINE, piece.start
-                delta[i] = (piece.end[0] - piece.start[0], piece.end[1] - piece.start[1])
-            elif isinstance(piece, CircularArc):
-                kind[i], origin[i], radius[i] = _ARC, piece.center, piece.radius
-                polar0[i], sense[i] = piece.start_angle, math.copysign(1.0, piece.sweep)
         heading = np.arctan2(delta[:, 1], delta[:, 0])
         quarter = sense * (0.5 * math.pi)
         first = np.where(kind == _LINE, heading, polar0 + quarter)
@@ -120,22 +132,23 @@ class Outline(ArcPositions):
         for b in np.flatnonzero(kind == _BEZIER):
             piece = self.pieces[int(b)]
             first[b], last[b] = float(piece.tangent_angle(0.0)), float(piece.tangent_angle(piece.length))
-        theta0 = np.empty(n)
+        angles0, angles1, arcs_at = first.tolist(), last.tolist(), starts.tolist()
+        theta0: list[float] = []
         corners = []
-        theta = float(first[0])
+        theta = angles0[0]
         for i in range(n):
-            local0 = float(first[i])
+            local0 = angles0[i]
             if i > 0:
-                jump = float(wrap_angle(local0 - theta))
+                jump = wrap_angle(local0 - theta)
                 if abs(jump) > SMOOTH_TOL:
-                    corners.append(Corner(float(starts[i]), jump))
+                    corners.append(Corner(arcs_at[i], jump))
                 theta += jump
-            theta0[i] = theta
-            theta += float(last[i]) - local0
-        jump = float(wrap_angle(float(first[0]) - theta))
+            theta0.append(theta)
+            theta += angles1[i] - local0
+        jump = wrap_angle(angles0[0] - theta)
         if abs(jump) > SMOOTH_TOL:
             corners.insert(0, Corner(0.0, jump))
-        object.__setattr__(self, "_theta0", theta0)
+        object.__setattr__(self, "_theta0", np.array(theta0, dtype=float))
         object.__setattr__(self, "corners", tuple(corners))
         object.__setattr__(self, "_corner_arcs", np.array([c.arc for c in corners], dtype=float))
         object.__setattr__(self, "_corner_angles", np.array([c.angle for c in corners], dtype=float))
@@ -312,6 +325,30 @@ def nearest_corner(arcs: FloatArray, period: float, x: FloatArray) -> tuple[np.n
     return (j - 1) % arcs.size, offset, np.where(j == 0, -1, np.where(j == near.size - 1, 1, 0))
 
 
+def _ends(pieces: tuple[Piece, ...]) -> tuple[FloatArray, FloatArray]:
+    """Each piece's start and end, shape (n, 2), mm, to the bit as its ``start`` and ``end``: a circular
+    arc's by the same arithmetic on arrays, with :mod:`math`'s cosines and sines (numpy's may differ in
+    the last bit)."""
+    n = len(pieces)
+    start, end = np.empty((n, 2)), np.empty((n, 2))
+    at_arc = [i for i, p in enumerate(pieces) if isinstance(p, CircularArc)]
+    others = [i for i, p in enumerate(pieces) if not isinstance(p, CircularArc)]
+    if others:
+        start[others] = [pieces[i].start for i in others]
+        end[others] = [pieces[i].end for i in others]
+    if at_arc:
+        arcs = cast(list[CircularArc], [pieces[i] for i in at_arc])
+        center = np.array([p.center for p in arcs])
+        radius = np.array([p.radius for p in arcs], dtype=float)
+        a0 = np.array([p.start_angle for p in arcs], dtype=float)
+        sweep = np.array([p.sweep for p in arcs], dtype=float)
+        a1 = a0 + np.copysign(1.0, sweep) * (radius * np.abs(sweep)) / radius
+        for out, a in ((start, a0.tolist()), (end, a1.tolist())):
+            out[at_arc, 0] = center[:, 0] + radius * np.fromiter(map(math.cos, a), float, len(a))
+            out[at_arc, 1] = center[:, 1] + radius * np.fromiter(map(math.sin, a), float, len(a))
+    return start, end
+
+
 def outline_from_pieces(
     pieces: list[Piece] | tuple[Piece, ...], *, name: str = "outline", ignored: tuple[str, ...] = ()
 ) -> Outline:
@@ -354,8 +391,12 @@ def outline_from_pieces(
     pieces = tuple(pieces)
     if not pieces:
         raise PartError(f"outline {name!r}: no pieces")
-    for i, piece in enumerate(pieces):
-        nxt = pieces[(i + 1) % len(pieces)]
+    start, end = _ends(pieces)
+    # numpy's hypot is within an ulp or so of math.dist's: the gaps it finds well under JOIN_TOL are, and
+    # the others are measured as before
+    near = np.hypot(*(end - np.roll(start, -1, axis=0)).T) <= JOIN_TOL * (1.0 - 1e-9)
+    for i in np.flatnonzero(~near).tolist():
+        piece, nxt = pieces[i], pieces[(i + 1) % len(pieces)]
         gap = math.dist(piece.end, nxt.start)
         if gap > JOIN_TOL:
             raise PartError(

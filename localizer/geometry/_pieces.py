@@ -83,7 +83,7 @@ class Line:
 
     def reversed(self) -> Line:
         """The same line travelled from ``end`` to ``start``."""
-        return Line(self.end, self.start)
+        return trusted_lines([self.end], [self.start])[0]  # its own points, checked when it was made
 
 
 @dataclass(frozen=True)
@@ -400,3 +400,55 @@ def elliptical_arc(
 
 #: Any of the pieces.
 Piece = Line | CircularArc | CubicBezier
+
+
+# Readers of dense drawings make 10⁵ pieces from numbers they have checked as arrays; the constructors'
+# checks, point by point, would cost them most of the reading. These make the same pieces without them.
+
+
+def trusted_lines(starts: list[tuple[float, float]], ends: list[tuple[float, float]]) -> list[Line]:
+    """``Line(start, end)`` for each pair, unchecked: each point a tuple of two finite floats, each
+    ``start != end``."""
+    new, out = object.__new__, []
+    for a, b in zip(starts, ends, strict=True):
+        line = new(Line)
+        fields = line.__dict__
+        fields["start"] = a
+        fields["end"] = b
+        out.append(line)
+    return out
+
+
+def trusted_arcs(
+    centers: list[tuple[float, float]], radii: FloatArray, start_angles: FloatArray, sweeps: FloatArray
+) -> list[CircularArc]:
+    """``CircularArc(center, radius, start_angle, sweep)`` for each, unchecked: each centre a tuple of
+    two finite floats, each radius finite and positive, each start angle finite, each sweep finite,
+    nonzero and at most one turn (:func:`arcs_are_valid`). The numbers are kept as given (numpy's
+    floats from an array's elements)."""
+    new, out = object.__new__, []
+    for c, r, a, w in zip(centers, radii, start_angles, sweeps, strict=True):
+        arc = new(CircularArc)
+        fields = arc.__dict__
+        fields["center"] = c
+        fields["radius"] = r
+        fields["start_angle"] = a
+        fields["sweep"] = w
+        out.append(arc)
+    return out
+
+
+def arcs_are_valid(centers: FloatArray, radii: FloatArray, start_angles: FloatArray, sweeps: FloatArray) -> bool:
+    """Whether :class:`CircularArc` takes each of these (centres shape (n, 2)), as its constructor checks."""
+    return bool(
+        np.isfinite(centers).all()
+        and np.all(np.isfinite(radii) & (radii > 0))
+        and np.isfinite(start_angles).all()
+        and np.all(np.isfinite(sweeps) & (np.abs(sweeps) > 0) & (np.abs(sweeps) <= 2 * math.pi + 1e-12))
+    )
+
+
+def lines_are_valid(starts: FloatArray, ends: FloatArray) -> bool:
+    """Whether :class:`Line` takes each pair of these (shape (n, 2)) as its constructor checks: finite
+    points, distinct (then of nonzero length)."""
+    return bool(np.isfinite(starts).all() and np.isfinite(ends).all() and np.all((starts != ends).any(axis=1)))

@@ -53,6 +53,20 @@ def test_a_filleted_polyline_has_its_closed_form_perimeter_and_no_corner(tmp_pat
     assert any("TEXT" in note for note in o.ignored)
 
 
+def test_a_polyline_read_from_ezdxfs_packed_vertices_is_its_public_reading(tmp_path):
+    """The vertices read from ezdxf's packed array, and through get_points where that array is not as
+    expected (another ezdxf): the same pieces, to the bit, bulges and all."""
+    from types import SimpleNamespace
+
+    from localizer.geometry._dxf import _polyline
+
+    e = ezdxf.readfile(bracket_dxf(tmp_path / "bracket.dxf")).modelspace().query("LWPOLYLINE")[0]
+    public = SimpleNamespace(lwpoints=list(e.lwpoints), get_points=e.get_points, closed=e.closed)
+    packed = _polyline(e, "LWPOLYLINE", 2.0, "here")
+    assert len(packed) == 8 and packed == _polyline(public, "LWPOLYLINE", 2.0, "here")
+    assert repr(packed) == repr(_polyline(public, "LWPOLYLINE", 2.0, "here"))
+
+
 @pytest.mark.parametrize("units, size", [(1, 25.4), (5, 10.0), (4, 1.0)])
 def test_dxf_units_are_read_into_millimetres(tmp_path, units, size):
     o = load_outline(bracket_dxf(tmp_path / "b.dxf", units=units))

@@ -61,12 +61,31 @@ def perimeter(pts):
     return float(np.sum(np.linalg.norm(np.diff(np.vstack([pts, pts[:1]]), axis=0), axis=1)))
 
 
-def polyline_dxf(pts, path):
+def ezdxf_polyline_dxf(pts, path):
+    """A drawing (mm) of one closed LWPOLYLINE through ``pts``, written by ezdxf."""
     doc = ezdxf.new()
     doc.header["$INSUNITS"] = 4
     # the points appended to the entity's array: add_lwpolyline's own loop takes minutes at 200 000
     doc.modelspace().add_lwpolyline([], close=True).lwpoints.extend([(x, y, 0, 0, 0) for x, y in pts.tolist()])
     doc.saveas(path)
+    return path
+
+
+def vertex_tags(xy):
+    """An LWPOLYLINE's vertices as ezdxf writes them: x (10) and y (20) each by ``str``, no width or
+    bulge tags when they are zero."""
+    return "".join(f" 10\n{x}\n 20\n{y}\n" for x, y in xy)
+
+
+def polyline_dxf(pts, path):
+    """The file :func:`ezdxf_polyline_dxf` writes, byte for byte (test_the_polyline_drawings_are_ezdxfs): ezdxf
+    writes the drawing with the first vertex, and the others are spliced into its text after it, where
+    ezdxf's own export takes a second and a half at 200 000 vertices."""
+    xy = pts.tolist()
+    one = ezdxf_polyline_dxf(pts[:1], path).read_text(encoding="utf-8")
+    head = " 90\n1\n 70\n1\n" + vertex_tags(xy[:1])  # the vertex count, the closed flag, the vertex
+    assert one.count(head) == 1
+    path.write_text(one.replace(head, f" 90\n{len(xy)}\n 70\n1\n" + vertex_tags(xy)), encoding="utf-8")
     return path
 
 
@@ -164,6 +183,18 @@ def test_the_same_polygon_as_loose_lines_or_an_svg_polygon_reads_the_same(tmp_pa
     assert svg.corners == ()
     exact = 4 * 60.0 * ellipe(1 - (20.0 / 60.0) ** 2)
     assert abs(svg.perimeter - exact) <= 3.0 * (exact - perimeter(ellipse(5000))) + 2e-8 * exact
+
+
+def test_the_polyline_drawings_are_ezdxfs(tmp_path, monkeypatch):
+    """polyline_dxf writes what ezdxf writes for the same points, byte for byte (with ezdxf's option for
+    comparing files: the same date and ids in every file), and ezdxf reads the points back exactly."""
+    monkeypatch.setattr(ezdxf.options, "write_fixed_meta_data_for_testing", True)
+    odd = np.array([[0.0, -0.0], [1e-300, 5e-324], [1e16, -1e16], [123456789.123456789, 1 / 3], [-2.5e-7, 7e15]])
+    for pts in (circle(7), ellipse(9), plate(12), facet(load_outline(PARTS / "bracket.dxf"), 5.0), odd, odd[:1]):
+        mine = polyline_dxf(pts, tmp_path / "mine.dxf").read_bytes()
+        assert mine == ezdxf_polyline_dxf(pts, tmp_path / "ezdxf.dxf").read_bytes()
+        back = ezdxf.readfile(tmp_path / "mine.dxf").modelspace().query("LWPOLYLINE")[0]
+        assert back.closed and back.get_points("xyseb") == [(x, y, 0.0, 0.0, 0.0) for x, y in pts.tolist()]
 
 
 def facet(outline, h):

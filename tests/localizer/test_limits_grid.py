@@ -335,6 +335,29 @@ def test_the_1_m_star_runs_the_filter_within_the_array_limit(passed_checks):
 
 
 # ------------------------------------------------------------------------------------ the drawing's pieces
+def lwpolyline_dxf(xy, path, splice):
+    """A drawing of one closed LWPOLYLINE through the points ``xy`` (a list of (x, y)), written by ezdxf;
+    with ``splice``, ezdxf writes it with the first vertex and the others are spliced into its text after
+    it as ezdxf writes vertices (x and y by ``str``, no width or bulge when zero): the same file without
+    ezdxf's export of each vertex (2 s at MAX_PIECES)."""
+    import ezdxf
+
+    doc = ezdxf.new()
+    written = xy[:1] if splice else xy
+    doc.modelspace().add_lwpolyline([], close=True).lwpoints.extend([(x, y, 0, 0, 0) for x, y in written])
+    doc.saveas(path)
+    if splice:
+
+        def tags(points):
+            return "".join(f" 10\n{x}\n 20\n{y}\n" for x, y in points)
+
+        one = path.read_text(encoding="utf-8")
+        head = " 90\n1\n 70\n1\n" + tags(xy[:1])  # the vertex count, the closed flag, the vertex
+        assert one.count(head) == 1
+        path.write_text(one.replace(head, f" 90\n{len(xy)}\n 70\n1\n" + tags(xy)), encoding="utf-8")
+    return path
+
+
 def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_they_are_built(tmp_path, monkeypatch):
     """One LWPOLYLINE of MAX_PIECES + 1 vertices (10 MB) is refused by its count, before its pieces
     are made (the 60 MB one of 1 300 000 vertices took 45 s and 2.6 GB before); loose LINEs and SVG
@@ -345,11 +368,15 @@ def test_a_drawing_of_more_pieces_than_an_outline_may_have_is_refused_before_the
     from localizer import MAX_PIECES, load_outline
 
     t = np.linspace(0.0, 2 * np.pi, MAX_PIECES + 1, endpoint=False)
-    doc = ezdxf.new()
-    doc.modelspace().add_lwpolyline([], close=True).lwpoints.extend(
-        [(x, y, 0, 0, 0) for x, y in np.c_[600 * np.cos(t), 200 * np.sin(t)].tolist()]
-    )
-    doc.saveas(tmp_path / "dense.dxf")
+    xy = np.c_[600 * np.cos(t), 200 * np.sin(t)].tolist()
+    # the spliced file is ezdxf's own, byte for byte, on a few of the points (with ezdxf's option for
+    # comparing files: the same date and ids in every file)
+    with monkeypatch.context() as m:
+        m.setattr(ezdxf.options, "write_fixed_meta_data_for_testing", True)
+        few = xy[:: MAX_PIECES // 6]
+        spliced = lwpolyline_dxf(few, tmp_path / "spliced.dxf", splice=True).read_bytes()
+        assert spliced == lwpolyline_dxf(few, tmp_path / "ezdxf.dxf", splice=False).read_bytes()
+    lwpolyline_dxf(xy, tmp_path / "dense.dxf", splice=True)
     with pytest.raises(PartError, match=r"dense.dxf: more than 262 144 pieces .* coarser chord tolerance"):
         load_outline(tmp_path / "dense.dxf")
 
