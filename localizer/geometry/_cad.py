@@ -12,6 +12,7 @@ The readers are imported only when a CAD file is read: ``import localizer`` need
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -84,9 +85,21 @@ def load_outline(
 
 
 def _area(loop: list[Piece]) -> float:
-    pts = np.concatenate(
-        [p.point(np.linspace(0.0, p.length, 65)[:-1]) if not isinstance(p, Line) else [p.start] for p in loop]
-    )
+    # a line's start, a curve's points every 1/64 of it; a run of lines' starts as one array (a faceted
+    # drawing's loop is 10⁵ lines)
+    parts: list[Any] = []
+    run: list[tuple[float, float]] = []
+    for p in loop:
+        if isinstance(p, Line):
+            run.append(p.start)
+            continue
+        if run:
+            parts.append(np.array(run))
+            run = []
+        parts.append(p.point(np.linspace(0.0, p.length, 65)[:-1]))
+    if run:
+        parts.append(np.array(run))
+    pts = np.concatenate(parts)
     x, y = pts[:, 0], pts[:, 1]
     return float(0.5 * abs(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)))
 
