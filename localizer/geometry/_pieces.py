@@ -31,6 +31,7 @@ from ._numerics import gauss_legendre, wrap_angle
 __all__ = ["Line", "CircularArc", "CubicBezier", "Piece", "elliptical_arc"]
 
 _GL_X, _GL_W = gauss_legendre(16)
+_G4_X, _G4_W = gauss_legendre(4)  # a Newton step's arc from the last iterate (arc_to_param)
 
 
 _PLAIN = (float, int, np.float64)
@@ -292,7 +293,7 @@ class CubicBezier:
         k = np.clip(np.searchsorted(self._cum, arc, side="right") - 1, 0, len(self._breaks) - 2)
         lo, hi = self._breaks[k], self._breaks[k + 1]
         u: FloatArray = lo + (hi - lo) * (arc - self._cum[k]) / np.maximum(self._cum[k + 1] - self._cum[k], 1e-300)
-        arc_to_param(self._coef, self._diff, self._rational, _GL_X, _GL_W, self._cum, k, lo, hi, arc, u)
+        arc_to_param(self._coef, self._diff, self._rational, _GL_X, _GL_W, _G4_X, _G4_W, self._cum, k, lo, hi, arc, u)
         return u.reshape(shape)
 
     def _gauss_to(self, a: FloatArray, b: FloatArray) -> FloatArray:

@@ -107,20 +107,30 @@ def test_bezier_arc_parameter_inverts_its_arc_length():
 
 def _newton_in_numpy(b, s):
     """The arc's inversion as array arithmetic on the piece's own 16-point rule and speed (the reference the
-    compiled loop must equal to the bit: each point stepped until within 1e-12 mm, then left alone)."""
+    compiled loop must equal to the bit: each point stepped until within 1e-12 mm, then left alone; after a
+    step of at most SHORT_STEP, the arc length is the last one plus the 4-point rule's over the step, its
+    four terms added in order)."""
+    from localizer.geometry._bezier_kernels import SHORT_STEP
+    from localizer.geometry._numerics import gauss_legendre
+
+    g4_x, g4_w = gauss_legendre(4)
     arc = np.clip(np.asarray(s, dtype=float), 0.0, b.length)
     k = np.clip(np.searchsorted(b._cum, arc, side="right") - 1, 0, len(b._breaks) - 2)
     lo, hi = b._breaks[k], b._breaks[k + 1]
     u = lo + (hi - lo) * (arc - b._cum[k]) / np.maximum(b._cum[k + 1] - b._cum[k], 1e-300)
-    live = np.ones(u.shape, dtype=bool)
+    f = b._cum[k] + b._gauss_to(lo, u) - arc
+    live = np.abs(f) > 1e-12
     for _ in range(50):
-        ul, lol, hil = u[live], lo[live], hi[live]
-        f = b._cum[k[live]] + b._gauss_to(lol, ul) - arc[live]
-        done = np.abs(f) <= 1e-12
-        u[live] = np.where(done, ul, np.clip(ul - f / np.maximum(b._speed(ul), 1e-300), lol, hil))
-        live[live] = ~done
         if not live.any():
             break
+        ul, fl = u[live], f[live]
+        nxt = np.clip(ul - fl / np.maximum(b._speed(ul), 1e-300), lo[live], hi[live])
+        d = nxt - ul
+        terms = [b._speed(ul + d * x) * w for x, w in zip(g4_x, g4_w)]
+        short = fl + (((terms[0] + terms[1]) + terms[2]) + terms[3]) * d
+        again = b._cum[k[live]] + b._gauss_to(lo[live], nxt) - arc[live]
+        u[live], f[live] = nxt, np.where(np.abs(d) <= SHORT_STEP, short, again)
+        live &= np.abs(f) > 1e-12
     return u
 
 
