@@ -70,10 +70,14 @@ def test_columns_of_the_contract(reference):
         assert key in ref[0]
 
 
-def test_resume_after_a_killed_run(tmp_path):
+def test_resume_after_a_killed_run(tmp_path, capsys):
+    from driver.cli import main
+
     f = study_file(tmp_path, trials=8)
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "driver.cli", "montecarlo", str(f), "--out", str(out), "--workers", "1"]
+    args = ["montecarlo", str(f), "--out", str(out), "--workers", "1"]
+    # the run to kill is a process of its own; the resume is the command as any other, run in this process
+    cmd = [sys.executable, "-m", "driver.cli", *args]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and len(read_trials(out / "trials.csv")) < 3:
@@ -82,8 +86,7 @@ def test_resume_after_a_killed_run(tmp_path):
     proc.wait()
     partial = read_trials(out / "trials.csv")
     assert 3 <= len(partial) < 8
-    rc = subprocess.run(cmd + ["--resume"], capture_output=True, text=True, cwd=ROOT, timeout=300)
-    assert rc.returncode == 0, rc.stderr
+    assert main([*args, "--resume"]) == 0, capsys.readouterr().err
     rows = table(out)
     keys = [(r["level"], r["trial"]) for r in rows]
     assert len(keys) == 8 and len(set(keys)) == 8
@@ -402,11 +405,17 @@ WORKERS = """
 import os, sys, time
 from concurrent.futures import ProcessPoolExecutor
 from bench.montecarlo import _die_with_parent
+
+def hold():
+    # a worker runs a task only once its initializer has returned: its pid written here is a worker
+    # that watches its parent already (one write, whole: the two workers share the pipe)
+    os.write(1, f"{os.getpid()}\\n".encode())
+    time.sleep(600)
+
 pool = ProcessPoolExecutor(2, initializer=_die_with_parent, initargs=(os.getpid(),))
-futures = [pool.submit(time.sleep, 600) for _ in range(2)]
-time.sleep(1.0)
-print(" ".join(str(p) for p in pool._processes), flush=True)
-time.sleep(600)
+futures = [pool.submit(hold) for _ in range(2)]
+for fut in futures:  # held while the tasks sleep; a task that could not run ends this script at once
+    fut.result()
 """
 
 
@@ -420,8 +429,8 @@ def _state(pid):
 
 def test_workers_die_with_their_parent():
     parent = subprocess.Popen([sys.executable, "-c", WORKERS], stdout=subprocess.PIPE, text=True, cwd=ROOT)
-    pids = [int(p) for p in parent.stdout.readline().split()]
-    assert len(pids) == 2
+    pids = [int(parent.stdout.readline()) for _ in range(2)]  # both tasks hold a worker each, at once
+    assert len(set(pids)) == 2
     parent.send_signal(signal.SIGKILL)
     parent.wait()
     deadline = time.monotonic() + 10
