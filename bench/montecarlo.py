@@ -268,7 +268,7 @@ def _die_with_parent(parent: int) -> None:
 
     def watch() -> None:
         while True:
-            time.sleep(1.0)
+            time.sleep(0.2)  # a fifth of a second after the parent is gone; the check costs nothing
             if os.getppid() != parent:
                 os._exit(1)
 
