@@ -14,6 +14,8 @@ $(STAMP): pyproject.toml
 	@test -x $(PY) || { command -v $(PYTHON) >/dev/null 2>&1 || { echo "$(PYTHON) not found; run: make PYTHON=/path/to/python3.11"; exit 1; }; $(PYTHON) -m venv $(VENV); }
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[dev]'
+	@# numba's kernels compiled once into its cache, not by each process of the first commands and tests
+	$(PY) -c "import driver; print(f'compiled the kernels in {driver.compile_kernels():.1f} s')"
 	@touch $(STAMP)
 
 demo: $(STAMP)

@@ -17,6 +17,7 @@ from .rig import (
     TransportError,
     Truth,
 )
+from .warmup import compile_kernels
 
 __all__ = [
     "Rig",
@@ -35,4 +36,5 @@ __all__ = [
     "part_record",
     "check_same_part",
     "one_blas_thread",
+    "compile_kernels",
 ]

@@ -33,7 +33,7 @@ HOUSES = {
             "records": {"jaw", "wheel"},
             "cli": {"jaw", "wheel", "link", "records"},
         },
-        {"rig", "blas"},
+        {"rig", "blas", "warmup"},
     ),
 }
 #: Packages whose rooms may import a room below by the package's name (the command line's lazy imports);
