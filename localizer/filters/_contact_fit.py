@@ -112,8 +112,9 @@ class ContactFit(ContactMarginal):
         trusted = self._trusted()
         # a reading that came after a jump of the contact (a face crossed, a shallow dip bridged in one
         # step) carries the model's approximation of that jump, one reading's worth: judged by none
-        jumps = [j for j in trusted if self._jumped(j)]
-        rows = [j for j in trusted if not self._jumped(j)]
+        jumped = [self._jumped(j) for j in trusted]
+        jumps = [j for j, jump in zip(trusted, jumped, strict=True) if jump]
+        rows = [j for j, jump in zip(trusted, jumped, strict=True) if not jump]
         hyps = np.asarray([int(h) for h in np.atleast_1d(starts) if self._live[int(h)]], dtype=np.int64)
         if len(rows) < FIT_MIN_READINGS or hyps.size == 0 or self.defect_window <= 0:
             return None
@@ -131,7 +132,7 @@ class ContactFit(ContactMarginal):
         # reference start's radius of curvature when the reading came (the rotation reading's error moves
         # the contact by ρ·e), which for another start, or a reference chosen before the readings said
         # much, is not its own: the statistic compares misfit to expectation, stretch against rest
-        expect = self._expected_misfit(rows, hyps)  # (len(rows), hyps)
+        expect = self._expected_misfit(rows, hyps, stack.p[: len(rows)])  # (len(rows), hyps)
         e_all = expect.sum(axis=0)
         best_p = np.ones(hyps.size)
         best_size = np.zeros(hyps.size)
@@ -184,20 +185,13 @@ class ContactFit(ContactMarginal):
                     best, out = excess, tuple(rows[i] for i in inside)
         return out
 
-    def _expected_misfit(self, rows: list[int], hyps: IntArray) -> FloatArray:
+    def _expected_misfit(self, rows: list[int], hyps: IntArray, p: FloatArray) -> FloatArray:
         """Each reading's expected weighted misfit (in units of the told reading variance) under each start
         ``hyps``: the reading's own error and the rotation reading's, ρ·sd_turn with ρ the start's radius
-        of curvature at its contact then, times the weight the reading was given."""
-        here = np.empty((len(rows), hyps.size))
-        weight = np.empty(len(rows))
-        where: dict[int, IntArray] = {}
-        for n, j in enumerate(rows):
-            r = self._readings[j]
-            pos = where.get(id(r.live))
-            if pos is None:
-                pos = where[id(r.live)] = np.searchsorted(r.live, hyps)
-            here[n] = r.p[pos] / r.weight
-            weight[n] = r.weight
+        of curvature at its contact then, times the weight the reading was given. ``p``: the readings'
+        weighted predictions at ``hyps`` (:meth:`_stack`'s)."""
+        weight = np.array([self._readings[j].weight for j in rows], dtype=float).reshape(len(rows))
+        here = p / weight[:, None]
         kappa = self.tracks.kappa[self.tracks.node_at(self.grid[hyps][None, :] + here)]
         rho = np.where(kappa > 0, 1.0 / np.maximum(kappa, 1.0 / RHO_MAX), RHO_MAX)
         out: FloatArray = weight[:, None] ** 2 * (1.0 + (rho * self.sd_turn / self.sd_position) ** 2)
