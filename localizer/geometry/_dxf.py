@@ -11,7 +11,7 @@ import numpy as np
 
 from .._errors import PartError
 from ._cad_loops import chain_loops, check_pieces
-from ._pieces import CircularArc, CubicBezier, Line, Piece, elliptical_arc, trusted_lines
+from ._pieces import CircularArc, CubicBezier, Line, Piece, as_points, elliptical_arc, trusted_lines
 
 __all__ = ["DXF_UNITS", "DXF_NOTES", "read_dxf"]
 
@@ -166,7 +166,7 @@ def _polyline(e: Any, kind: str, k: float, where: str) -> list[Piece]:
     last = n if _closed(e, kind) else n - 1
     if last <= 0:
         return []
-    verts = list(zip(xy[:, 0].tolist(), xy[:, 1].tolist(), strict=True))
+    verts = as_points(xy)
     ends = verts[1:] + verts[:1]
     straight = bool(np.all(np.abs(bulge[:last]) <= 1e-15))
     if straight and np.isfinite(xy).all() and min(map(math.dist, verts[:last], ends[:last])) > 1e-12:

@@ -27,8 +27,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._errors import PartError
-from .._types import FloatArray
-from ._pieces import CircularArc, Line, Piece, arcs_are_valid, lines_are_valid, trusted_arcs, trusted_lines
+from ._pieces import (
+    CircularArc,
+    Line,
+    Piece,
+    arcs_are_valid,
+    as_points,
+    lines_are_valid,
+    trusted_arcs,
+    trusted_lines,
+)
 
 __all__ = ["FacetRule", "FACETS", "read_facets"]
 
@@ -141,8 +149,8 @@ def read_facets(pieces: list[Piece] | tuple[Piece, ...], rule: FacetRule = FACET
     kept = np.flatnonzero(~(line & trimmed))
     slots = np.empty(2 * n, dtype=object)
     if arcs_are_valid(centre[arcs], radius[arcs], a0[arcs], turn[arcs]) and lines_are_valid(a[cuts], b[cuts]):
-        slots[2 * arcs] = trusted_arcs(_points(centre[arcs]), radius[arcs], a0[arcs], turn[arcs])
-        slots[2 * cuts + 1] = trusted_lines(_points(a[cuts]), _points(b[cuts]))
+        slots[2 * arcs] = trusted_arcs(as_points(centre[arcs]), radius[arcs], a0[arcs], turn[arcs])
+        slots[2 * cuts + 1] = trusted_lines(as_points(a[cuts]), as_points(b[cuts]))
     else:  # the constructors say what is wrong, at the first piece it is wrong in
         for i in np.sort(np.r_[2 * arcs, 2 * cuts + 1]):
             j = i // 2
@@ -160,8 +168,3 @@ def read_facets(pieces: list[Piece] | tuple[Piece, ...], rule: FacetRule = FACET
         out[0] = CircularArc(arc.center, arc.radius, mid, 0.5 * arc.sweep)
         out.append(CircularArc(arc.center, arc.radius, arc.start_angle, 0.5 * arc.sweep))
     return out
-
-
-def _points(xy: FloatArray) -> list[tuple[float, float]]:
-    """Points (n, 2) as the (x, y) tuples of floats the pieces hold."""
-    return list(zip(xy[:, 0].tolist(), xy[:, 1].tolist(), strict=True))

@@ -115,10 +115,7 @@ class Outline(ArcPositions):
             delta[at_line] = np.array([p.end for p in lines]) - origin[at_line]
             lengths[at_line] = list(map(math.hypot, delta[at_line, 0].tolist(), delta[at_line, 1].tolist()))
         if arcs:
-            origin[at_arc] = [p.center for p in arcs]
-            radius[at_arc] = [p.radius for p in arcs]
-            polar0[at_arc] = [p.start_angle for p in arcs]
-            sweep = np.array([p.sweep for p in arcs], dtype=float)
+            origin[at_arc], radius[at_arc], polar0[at_arc], sweep = _arc_fields(arcs)
             sense[at_arc] = np.copysign(1.0, sweep)
             lengths[at_arc] = radius[at_arc] * np.abs(sweep)
         lengths[at_bezier] = [pieces[i].length for i in at_bezier.tolist()]
@@ -325,6 +322,15 @@ def nearest_corner(arcs: FloatArray, period: float, x: FloatArray) -> tuple[np.n
     return (j - 1) % arcs.size, offset, np.where(j == 0, -1, np.where(j == near.size - 1, 1, 0))
 
 
+def _arc_fields(arcs: list[CircularArc]) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The arcs' centres (n, 2), radii, start angles and sweeps, as arrays (mm, mm, rad, rad)."""
+    center = np.array([p.center for p in arcs], dtype=float).reshape(-1, 2)
+    radius = np.array([p.radius for p in arcs], dtype=float)
+    start_angle = np.array([p.start_angle for p in arcs], dtype=float)
+    sweep = np.array([p.sweep for p in arcs], dtype=float)
+    return center, radius, start_angle, sweep
+
+
 def _ends(pieces: tuple[Piece, ...]) -> tuple[FloatArray, FloatArray]:
     """Each piece's start and end, shape (n, 2), mm, to the bit as its ``start`` and ``end``: a circular
     arc's by the same arithmetic on arrays, with :mod:`math`'s cosines and sines (numpy's may differ in
@@ -337,11 +343,7 @@ def _ends(pieces: tuple[Piece, ...]) -> tuple[FloatArray, FloatArray]:
         start[others] = [pieces[i].start for i in others]
         end[others] = [pieces[i].end for i in others]
     if at_arc:
-        arcs = cast(list[CircularArc], [pieces[i] for i in at_arc])
-        center = np.array([p.center for p in arcs])
-        radius = np.array([p.radius for p in arcs], dtype=float)
-        a0 = np.array([p.start_angle for p in arcs], dtype=float)
-        sweep = np.array([p.sweep for p in arcs], dtype=float)
+        center, radius, a0, sweep = _arc_fields(cast(list[CircularArc], [pieces[i] for i in at_arc]))
         a1 = a0 + np.copysign(1.0, sweep) * (radius * np.abs(sweep)) / radius
         for out, a in ((start, a0.tolist()), (end, a1.tolist())):
             out[at_arc, 0] = center[:, 0] + radius * np.fromiter(map(math.cos, a), float, len(a))

@@ -407,6 +407,11 @@ Piece = Line | CircularArc | CubicBezier
 # checks, point by point, would cost them most of the reading. These make the same pieces without them.
 
 
+def as_points(xy: FloatArray) -> list[tuple[float, float]]:
+    """Points (n, 2), mm, as the (x, y) tuples of floats the pieces hold."""
+    return list(zip(xy[:, 0].tolist(), xy[:, 1].tolist(), strict=True))
+
+
 def trusted_lines(starts: list[tuple[float, float]], ends: list[tuple[float, float]]) -> list[Line]:
     """``Line(start, end)`` for each pair, unchecked: each point a tuple of two finite floats, each
     ``start != end``."""
