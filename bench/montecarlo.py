@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import json
+import multiprocessing
 import os
 import sys
 import threading
@@ -181,9 +182,7 @@ def _run_locked(
             for s in specs:
                 record(run_trial(s), f, writer)
         else:
-            pool = ProcessPoolExecutor(
-                max_workers=workers or os.cpu_count(), initializer=_die_with_parent, initargs=(os.getpid(),)
-            )
+            pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count(), initializer=_die_with_parent)
             try:
                 futures = [pool.submit(run_trial, s) for s in specs]
                 for fut in as_completed(futures):
@@ -262,14 +261,19 @@ def _folder_lock(out: Path) -> Iterator[None]:
         yield
 
 
-def _die_with_parent(parent: int) -> None:
-    """A worker's initializer: exit when the parent that started it is gone (SIGKILL leaves workers
-    otherwise running for ever)."""
+def _die_with_parent() -> None:
+    """A worker's initializer: exit as soon as the run that started it is gone (SIGKILL leaves workers
+    otherwise running for ever).
+
+    The run is watched through multiprocessing's own handle on it, the end of a pipe that the run holds
+    open while it lives, under every start method: the worker's parent process is the run under fork and
+    spawn, but the fork server under forkserver (the default on Linux from Python 3.14)."""
+    run = multiprocessing.parent_process()
+    if run is None:  # not a worker: called in the run itself
+        return
 
     def watch() -> None:
-        while True:
-            time.sleep(0.2)  # a fifth of a second after the parent is gone; the check costs nothing
-            if os.getppid() != parent:
-                os._exit(1)
+        run.join()  # returns once the run has exited
+        os._exit(1)
 
     threading.Thread(target=watch, daemon=True, name="die-with-parent").start()

@@ -2,6 +2,7 @@
 
 import json
 import math
+import os
 import signal
 import subprocess
 import sys
@@ -402,20 +403,24 @@ def test_one_output_folder_one_run(reference):
 
 
 WORKERS = """
-import os, sys, time
+import multiprocessing, os, sys, time
 from concurrent.futures import ProcessPoolExecutor
 from bench.montecarlo import _die_with_parent
 
 def hold():
     # a worker runs a task only once its initializer has returned: its pid written here is a worker
-    # that watches its parent already (one write, whole: the two workers share the pipe)
+    # that watches its run already (one write, whole: the two workers share the pipe), after a second
+    # in which a worker that took its living run for a dead one would have left
+    time.sleep(1.0)
     os.write(1, f"{os.getpid()}\\n".encode())
     time.sleep(600)
 
-pool = ProcessPoolExecutor(2, initializer=_die_with_parent, initargs=(os.getpid(),))
-futures = [pool.submit(hold) for _ in range(2)]
-for fut in futures:  # held while the tasks sleep; a task that could not run ends this script at once
-    fut.result()
+if __name__ == "__main__":
+    context = multiprocessing.get_context(sys.argv[1])
+    pool = ProcessPoolExecutor(2, mp_context=context, initializer=_die_with_parent)
+    futures = [pool.submit(hold) for _ in range(2)]
+    for fut in futures:  # held while the tasks sleep; a task that could not run ends this script at once
+        fut.result()
 """
 
 
@@ -427,8 +432,16 @@ def _state(pid):
         return "Z"
 
 
-def test_workers_die_with_their_parent():
-    parent = subprocess.Popen([sys.executable, "-c", WORKERS], stdout=subprocess.PIPE, text=True, cwd=ROOT)
+@pytest.mark.parametrize("method", ["fork", "forkserver"])  # a forkserver worker's parent is the fork server
+def test_workers_die_with_their_parent(tmp_path, method):
+    (tmp_path / "workers.py").write_text(WORKERS)  # a file: spawned and fork-server workers import it
+    parent = subprocess.Popen(
+        [sys.executable, str(tmp_path / "workers.py"), method],
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     pids = [int(parent.stdout.readline()) for _ in range(2)]  # both tasks hold a worker each, at once
     assert len(set(pids)) == 2
     parent.send_signal(signal.SIGKILL)
