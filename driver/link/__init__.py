@@ -15,7 +15,7 @@ from .protocol import (
     parse_reply,
     parse_request,
 )
-from .serial_rig import SerialRig, Workspace
+from .serial_rig import LineReader, SerialRig, Workspace
 from .signals import handling
 
 __all__ = [
@@ -32,6 +32,7 @@ __all__ = [
     "encode_request",
     "parse_reply",
     "parse_request",
+    "LineReader",
     "SerialRig",
     "Workspace",
     "handling",

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import IO, Any, Literal, Self, cast
+from typing import IO, Any, Literal, Self
 
 import serial
 
@@ -31,7 +31,7 @@ from .lockfile import LockHeld, hold_lock
 from .protocol import MAX_LINE, Reply, encode_request, parse_reply
 from .signals import handling
 
-__all__ = ["SerialRig", "Workspace"]
+__all__ = ["LineReader", "SerialRig", "Workspace"]
 
 #: Each URL's port still closing in this process. pyserial sleeps 0.3 s after it has closed a socket://
 #: port, room for the server to take the next connection: a rig opening that URL again waits for the
@@ -52,6 +52,40 @@ class Workspace:
         for name, v, (lo, hi) in (("x", x, self.x), ("y", y, self.y), ("phi", phi, self.phi)):
             if not (math.isfinite(v) and lo <= v <= hi):
                 raise RigError(f"move refused: {name}={v!r} is outside the workspace [{lo}, {hi}]")
+
+
+class LineReader:
+    """A port's replies, a line at a time.
+
+    What the port holds is taken at once and the rest kept for the next line: pyserial's ``read_until``
+    takes a byte per call, with a wait and a system call for each (three quarters of a reading's time
+    over a local socket).
+    """
+
+    def __init__(self, port: Any) -> None:
+        self.port = port
+        self.pending = b""  # read past the last line returned
+
+    def readline(self, deadline: float) -> bytes:
+        """The next line with its newline; else what came of it by ``deadline`` (``time.monotonic()``, s),
+        or without a newline its first ``MAX_LINE + 1`` bytes (too long: the rest is the next line).
+
+        What the port holds is taken even past the deadline: a reply that came in time is not lost to a
+        process that was kept from running."""
+        buf = self.pending
+        while True:
+            end = buf.find(b"\n", 0, MAX_LINE + 1)
+            if end >= 0 or len(buf) > MAX_LINE:
+                cut = end + 1 if end >= 0 else MAX_LINE + 1
+                self.pending = buf[cut:]
+                return buf[:cut]
+            self.port.timeout = max(deadline - time.monotonic(), 0.0)
+            first = self.port.read(1)  # waits for the line to go on, until the deadline
+            if not first:
+                self.pending = b""
+                return buf
+            self.port.timeout = 0
+            buf += first + self.port.read(4096)  # and whatever came with it
 
 
 class SerialRig:
@@ -102,6 +136,7 @@ class SerialRig:
         self._seq = 0
         self._commanded: tuple[float, float, float] | None = None
         self.ports: dict[str, Any] = {}
+        self._lines: dict[str, LineReader] = {}
         self._urls = {"arm": arm_url, "daq": daq_url}
         self._locks: list[IO[str]] = []
         try:
@@ -120,6 +155,7 @@ class SerialRig:
                     baudrate=baudrate,
                     **({"exclusive": True} if local and os.name == "posix" else {}),
                 )
+                self._lines[name] = LineReader(self.ports[name])
         except (serial.SerialException, ValueError) as exc:
             self.close()
             raise RigError(f"cannot open the {name} at {url}: {_open_problem(url, exc)}") from None
@@ -143,13 +179,6 @@ class SerialRig:
             raise
 
     # ------------------------------------------------------------ transport
-    def _readline(self, port: Any, deadline: float) -> bytes:
-        remaining = deadline - time.monotonic()
-        if remaining <= 0:
-            return b""
-        port.timeout = remaining
-        return cast(bytes, port.read_until(b"\n", MAX_LINE + 1))
-
     def _transact(self, device: str, command: str, *args: float, timeout: float | None = None) -> Reply:
         port = self.ports[device]
         timeout = self.timeout if timeout is None else timeout
@@ -162,7 +191,7 @@ class SerialRig:
                 port.flush()
                 deadline = time.monotonic() + timeout
                 while True:
-                    line = self._readline(port, deadline)
+                    line = self._lines[device].readline(deadline)
                     if not line:
                         problem = f"no reply within {timeout:.1f} s"
                         break

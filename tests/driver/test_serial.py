@@ -11,14 +11,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import serial
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from driver.jaw import run_from_here
 from driver.link import (
     ARM_COMMANDS,
+    MAX_LINE,
     Emulator,
     Faults,
+    LineReader,
     SerialRig,
     Workspace,
     encode_reply,
@@ -176,6 +179,47 @@ def test_reply_parser_only_raises_rig_error(data):
 
 
 @settings(max_examples=200, deadline=None)
+def looped(data=b""):
+    """A pyserial ``loop://`` port holding ``data``: what is written to it is read back."""
+    port = serial.serial_for_url("loop://", timeout=0)
+    port.write(data)
+    return port
+
+
+def test_lines_that_came_together_are_read_one_at_a_time():
+    lines = LineReader(looped(b"1 OK 0.5 0.25\n2 DATA 7\n3 OK"))
+    soon = time.monotonic() + 5.0  # each of these is in the port already: none waits
+    assert lines.readline(soon) == b"1 OK 0.5 0.25\n"
+    assert lines.readline(soon) == b"2 DATA 7\n"
+    lines.port.write(b" 1\n")  # the rest of the third line comes later
+    assert lines.readline(soon) == b"3 OK 1\n"
+
+
+def test_a_line_cut_by_its_deadline_is_returned_as_it_came_and_not_kept():
+    lines = LineReader(looped(b"4 OK 0."))
+    past = time.monotonic() - 1.0  # what the port holds is read even so; nothing is waited for
+    assert lines.readline(past) == b"4 OK 0."  # no newline: the reply timed out
+    lines.port.write(b"5 OK\n")
+    assert lines.readline(past) == b"5 OK\n"  # the cut line's bytes are gone
+    assert lines.readline(past) == b""
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.sampled_from([b"\n", b"7 OK 1.5", b"x" * (MAX_LINE - 3), b"y" * (MAX_LINE + 40), b"z"]), max_size=8))
+def test_lines_as_pyserials_read_until_gives_them(parts):
+    # pyserial's own reader of a line of at most MAX_LINE + 1 bytes is the reference, on the same bytes: the
+    # lines, and too-long lines cut at MAX_LINE + 1 and the rest read on (all in the port: none waits)
+    data = b"".join(parts) + b"\n"
+    ref, mine = looped(data), LineReader(looped(data))
+    ref.timeout = 60.0
+    want, got = [], []
+    while sum(map(len, want)) < len(data) and (not want or want[-1]):
+        want.append(ref.read_until(b"\n", MAX_LINE + 1))
+    while sum(map(len, got)) < len(data) and (not got or got[-1]):
+        got.append(mine.readline(time.monotonic() + 60.0))
+    assert got == want
+
+
 @given(st.integers(0, 65535), st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), max_size=4))
 def test_replies_round_trip(seq, values):
     r = parse_reply(encode_reply(seq, "OK", *values))
