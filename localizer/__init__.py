@@ -63,6 +63,7 @@ from .filters import (
     Mode,
     ParticleFilter,
     WheelFilter,
+    most_probable,
 )
 from .geometry import (
     CAD_SUFFIXES,
@@ -156,6 +157,7 @@ __all__ = [
     "ParticleFilter",
     "Belief",
     "Mode",
+    "most_probable",
     "ModeTracks",
     "tracks_for",
     "BRIDGE_EXCESS",

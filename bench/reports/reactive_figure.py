@@ -20,7 +20,7 @@ import numpy as np
 from bench.reactive_method import reactive_filter, reactive_policy
 from bench.study import load_study
 from driver.jaw import calibrate_simulated, localize_reactively
-from localizer import load_part
+from localizer import load_part, most_probable
 from sim2d import SimRig, load_noise
 
 if TYPE_CHECKING:
@@ -101,7 +101,7 @@ def draw(part: Part | Outline, snaps: Sequence[Snapshot], out: Path, title: str)
     cmap = plt.get_cmap("viridis")
     for k, i in enumerate(pick):
         r, present, w, true_arc, mass = snaps[i]
-        top = np.argsort(w)[-400:]
+        top = most_probable(w, 400)
         top = top[w[top] > 1e-3 * w.max()]
         p = part.point_at_arc(present[top])
         ax2.scatter(

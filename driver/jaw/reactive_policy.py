@@ -59,6 +59,7 @@ from localizer import (
     ROLL_STEP,
     Belief,
     ContactFilter,
+    most_probable,
 )
 
 from ..rig import RigError
@@ -210,7 +211,7 @@ def information_by_direction(
         clockwise.
     """
     w = flt.posterior()
-    top = np.argsort(w)[::-1][: max(int(hypotheses), 2)]
+    top = most_probable(w, max(int(hypotheses), 2))  # equal weights by index, on every machine
     top = top[w[top] > 0]
     if top.size < 2:
         return (0.0, 0.0)

@@ -3,7 +3,7 @@ filter, the wheel's filter, the particle filter (the conventional peer), and the
 readings a belief must not rest on when the part is not its model.
 """
 
-from ._belief import Belief, Mode
+from ._belief import Belief, Mode, most_probable
 from ._contact_filter import ContactFilter
 from ._contact_settings import (
     BRIDGE_MISS,
@@ -31,6 +31,7 @@ from ._wheel_filter import (
 __all__ = [
     "Belief",
     "Mode",
+    "most_probable",
     "BRIDGE_MISS",
     "CONTRADICTION",
     "ENCODER_SD",
