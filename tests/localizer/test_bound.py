@@ -122,8 +122,21 @@ def test_trial_bound_spread_of_the_maximum_likelihood_place():
             th = np.asarray(egg.tangent_angle_at_arc(sig), float)
             return np.r_[(z - c - bb * (sig - sig[0])) / sd_z, (om - th - phi) / sd_o, [(bb - 1) / sd_b]]
 
+        def jacobian(x):
+            # the residuals' derivatives in closed form (dθ/dσ = κ), not by differences: a tenth of the calls
+            n, sig, bb = path.size, x[: path.size], x[-1]
+            jac = np.zeros((2 * n + 1, n + 3))
+            jac[1:n, 1:n] = -bb / sd_z * np.eye(n - 1)
+            jac[1:n, 0] = bb / sd_z
+            jac[:n, n + 1] = -1 / sd_z
+            jac[:n, n + 2] = -(sig - sig[0]) / sd_z
+            jac[n : 2 * n, :n] = -np.diag(np.asarray(egg.curvature_at_arc(sig), float)) / sd_o
+            jac[n : 2 * n, n] = -1 / sd_o
+            jac[2 * n, n + 2] = 1 / sd_b
+            return jac
+
         x0 = np.r_[path, 0.5, 3.0, 1.0]
-        finals.append(least_squares(residuals, x0, x_scale="jac").x[path.size - 1] - path[-1])
+        finals.append(least_squares(residuals, x0, jac=jacobian, x_scale="jac").x[path.size - 1] - path[-1])
     bound = trial_bound(egg, path, TrialNoise(sd_position=sd_z, sd_turn=sd_o, sd_scale=sd_b))
     assert np.std(finals) == pytest.approx(bound, rel=0.15), (np.std(finals), bound)
 
