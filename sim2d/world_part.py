@@ -37,7 +37,7 @@ from localizer import Outline, Part, RolltouchError, load_part, polygon_crossing
 from ._errors import SimError
 from .machining import machined_outline, machined_part
 from .noise import NoiseModel
-from .sampled import SAMPLE_SPACING, SampledPart, model_sample
+from .sampled import SAMPLE_SPACING, SampledPart, model_params, model_sample
 
 __all__ = [
     "Defect",
@@ -391,7 +391,7 @@ def world_part(
     else:
         assert isinstance(model, Part)
         arcs, _, normal = model_sample(model, spacing)
-        xy = np.asarray(machined.point(model.param_at_arc(arcs)), dtype=float) + defects(arcs)[:, None] * normal
+        xy = np.asarray(machined.point(model_params(model, spacing)), dtype=float) + defects(arcs)[:, None] * normal
     if change.scale != 1.0:
         centre = _centroid(np.asarray(model_sample(model, max(spacing, P / 4000))[1]))
         xy = centre + change.scale * (xy - centre)
