@@ -11,17 +11,13 @@ them as this dense sample, and a contact on it reports the tagged model arc
 from __future__ import annotations
 
 import math
-import threading
-import weakref
-from collections import OrderedDict
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
 from localizer import Outline, Part, check_grid
+from localizer.geometry import per_part
 
 __all__ = ["SampledPart", "SAMPLE_SPACING", "BLOCK", "model_sample", "model_params", "polygon_vertices"]
 
@@ -80,42 +76,18 @@ class SampledPart:
         return middle, radius
 
 
-#: How many models' samples are kept (the latest used): a trial's rigs, and a study's trials on one part,
-#: sample their model alike; a study over many parts keeps only the few of its latest trials.
-KEPT_MODELS = 4
-_SAMPLES: OrderedDict[int, tuple[weakref.ref[Any], dict[tuple[str, float], tuple[np.ndarray, ...]]]] = OrderedDict()
-_SAMPLES_LOCK = threading.Lock()
-
-
-def _kept(
-    model: Part | Outline, key: tuple[str, float], make: Callable[[], tuple[np.ndarray, ...]]
-) -> tuple[np.ndarray, ...]:
-    """``make()``'s arrays for ``model`` and ``key``, read-only, made once while the model is among the
-    :data:`KEPT_MODELS` latest."""
-    with _SAMPLES_LOCK:
-        entry = _SAMPLES.get(id(model))
-        if entry is not None and entry[0]() is not model:  # another model that had the same id, gone
-            entry = None
-        hit = None if entry is None else entry[1].get(key)
-    if hit is None:
-        hit = make()
-        for a in hit:
-            a.setflags(write=False)
-    with _SAMPLES_LOCK:
-        if entry is None:
-            entry = (weakref.ref(model), {})
-        entry[1][key] = hit
-        _SAMPLES[id(model)] = entry
-        _SAMPLES.move_to_end(id(model))
-        while len(_SAMPLES) > KEPT_MODELS:
-            _SAMPLES.popitem(last=False)
-    return hit
+def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The arrays, made read-only: they are kept with the model and shared by every world made of it."""
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
 
 
 def model_sample(model: Part | Outline, spacing: float = SAMPLE_SPACING) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(arcs mm, points mm, outward unit normals) of the ``model`` every ``spacing`` mm of arc, with every
-    corner's arc among them (the normal there is the one after the corner). Read-only arrays, made once
-    per model and spacing."""
+    corner's arc among them (the normal there is the one after the corner). Read-only, kept with the model
+    (:func:`localizer.geometry.per_part`): every world made of it (each of a trial's rigs, each trial of a
+    study) samples it alike."""
     P = float(model.perimeter)
     check_grid(model, "simulated part", spacing, P / spacing + len(model.corners))
 
@@ -123,17 +95,22 @@ def model_sample(model: Part | Outline, spacing: float = SAMPLE_SPACING) -> tupl
         arcs = np.unique(np.concatenate([np.arange(0.0, P, spacing), [c.arc for c in model.corners]]))
         xy = np.asarray(model.point_at_arc(arcs), dtype=float)
         theta = np.asarray(model.tangent_angle_at_arc(arcs), dtype=float)
-        return arcs, xy, np.stack([np.sin(theta), -np.cos(theta)], axis=-1)
+        return _read_only(arcs, xy, np.stack([np.sin(theta), -np.cos(theta)], axis=-1))
 
-    arcs, xy, normal = _kept(model, ("sample", float(spacing)), make)
+    arcs, xy, normal = per_part("world sample", model, float(spacing), make)
     return arcs, xy, normal
 
 
 def model_params(model: Part, spacing: float = SAMPLE_SPACING) -> np.ndarray:
-    """The spline parameters of a spline ``model`` at the arcs of :func:`model_sample` (read-only, made once
-    per model and spacing)."""
+    """The spline parameters of a spline ``model`` at the arcs of :func:`model_sample` (read-only, kept with
+    the model)."""
     arcs = model_sample(model, spacing)[0]
-    (params,) = _kept(model, ("params", float(spacing)), lambda: (np.asarray(model.param_at_arc(arcs), dtype=float),))
+    (params,) = per_part(
+        "world sample params",
+        model,
+        float(spacing),
+        lambda: _read_only(np.asarray(model.param_at_arc(arcs), dtype=float)),
+    )
     return params
 
 

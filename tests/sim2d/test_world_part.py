@@ -8,7 +8,7 @@ import pytest
 
 from localizer import load_part, part_from_points
 from sim2d import Defect, NoiseModel, SimError, SimRig, WheelRig, WorldChange, WorldSpec, load_world, world_part
-from sim2d.sampled import KEPT_MODELS, SampledPart, model_params, model_sample
+from sim2d.sampled import SampledPart, model_params, model_sample
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
 
@@ -209,9 +209,7 @@ def test_a_models_sample_is_made_once_kept_read_only_and_is_the_models_own(trefo
     assert np.array_equal(normal, np.stack([np.sin(theta), -np.cos(theta)], axis=-1))
     assert np.array_equal(model_params(trefoil, 0.5), trefoil.param_at_arc(arcs))
     assert np.array_equal(model_sample(trefoil, 0.25)[0], np.arange(0.0, trefoil.perimeter, 0.25))  # another spacing
-    # only the latest models' samples are kept: after as many others, the first is made again, the same
-    for k in range(KEPT_MODELS):
-        a = np.linspace(0, 2 * np.pi, 24, endpoint=False)
-        model_sample(part_from_points(np.c_[(20 + k) * np.cos(a), (10 + k) * np.sin(a)]), 0.5)
+    # kept with the model's other tables: dropped with them, and made again the same
+    trefoil.forget_tables()
     again = model_sample(trefoil, 0.5)
     assert again[1] is not xy and np.array_equal(again[1], xy)
