@@ -23,6 +23,9 @@ from ._sums import _quad, _Sums
 
 __all__ = ["ContactMarginal"]
 
+#: (live, UᵀU, Uᵀz, zᵀz, Uᵀp, pᵀp, zᵀp) over the live starts and the touched columns
+_Gathered = tuple[IntArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+
 
 class ContactMarginal(ContactState):
     """The closed-form marginalisation over the live starts and what it says of the present contact."""
@@ -52,10 +55,12 @@ class ContactMarginal(ContactState):
         prior[cols < self._segments] = 1e6  # the segments' offsets: flat
         prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw**2
         prior[cols == self._drift] = self.sd_drift**2
-        live = np.flatnonzero(self._live) if hyps is None else np.asarray(hyps, dtype=np.int64)
-        uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
-        # v: (m, n_live); rows then columns, a third of the time of one gather over both
-        v, spp, szp = self._up[cols].take(live, axis=1), self._spp[live], self._szp[live]
+        if hyps is None:
+            live, uu, uz, szz, v, spp, szp = self._gathered(cols)
+        else:
+            live = np.asarray(hyps, dtype=np.int64)
+            uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
+            v, spp, szp = self._up[cols].take(live, axis=1), self._spp[live], self._szp[live]
         if without is not None:
             uu, uz, szz = uu - without.uu, uz - without.uz, szz - without.szz
             v, spp, szp = v - without.up, spp - without.spp, szp - without.szp
@@ -81,6 +86,28 @@ class ContactMarginal(ContactState):
             "qzz": qzz,
             "k_less": np.zeros(()) if without is None else without.readings,
         }
+
+    def _gathered(self, cols: IntArray) -> _Gathered:
+        """The live starts and the sums over the touched columns ``cols`` and those starts: (live, UᵀU, Uᵀz,
+        zᵀz, Uᵀp (m, n_live), pᵀp, zᵀp). Gathered once per state of the sums and of the live starts, which the
+        slope prior's factors share: with a thousand starts live the gather was a third of a solve."""
+        key = (self._version, self._live_idx)
+        hit = self._gather
+        if hit is not None and hit[0][0] == key[0] and hit[0][1] is key[1]:
+            return hit[1]
+        live = self._live_idx
+        # v: (m, n_live); rows then columns, a third of the time of one gather over both
+        out = (
+            live,
+            self._uu[np.ix_(cols, cols)],
+            self._uz[cols],
+            np.asarray(self._szz),
+            self._up[cols].take(live, axis=1),
+            self._spp[live],
+            self._szp[live],
+        )
+        self._gather = (key, out)
+        return out
 
     def _log_likelihood(self, s: dict[str, Any], prune: bool = True) -> FloatArray:
         """Log-likelihood of each start from a :meth:`_solve` (over the grid, after its leading axis if any),

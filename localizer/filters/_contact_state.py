@@ -199,6 +199,7 @@ class ContactState:
         self._version = 0  # changes to the likelihood (its cache's key)
         self._rows = 0  # readings added
         self._cached: dict[float, dict[str, Any]] = {}  # per factor on the slope prior
+        self._gather: tuple[tuple[int, IntArray], Any] | None = None  # the factors' shared gather (ContactMarginal)
         self._last_row: tuple[IntArray, FloatArray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
         # every reading as added (weighted): columns, values, z, the hypotheses live then and their
         # predictions, its arc and turn; and the readings taken out again (quarantine)
