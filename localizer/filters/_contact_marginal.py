@@ -17,14 +17,11 @@ from ._contact_settings import (
     FACE_SLOPES,
     RHO_MAX,
 )
-from ._contact_state import ContactState
+from ._contact_state import ContactState, _Gathered
 from ._filter_kernels import weigh_scales
 from ._sums import _quad, _Sums
 
 __all__ = ["ContactMarginal"]
-
-#: (live, UᵀU, Uᵀz, zᵀz, Uᵀp, pᵀp, zᵀp) over the live starts and the touched columns
-_Gathered = tuple[IntArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
 
 
 class ContactMarginal(ContactState):

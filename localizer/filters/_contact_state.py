@@ -37,6 +37,10 @@ from ._sums import _bspline, _Reading
 __all__ = ["ContactState"]
 
 
+#: (live, UᵀU, Uᵀz, zᵀz, Uᵀp, pᵀp, zᵀp) over the live starts and the touched columns
+_Gathered = tuple[IntArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+
+
 class ContactState:
     """The filter's settings, its grid of starts and its running sums (:class:`~localizer.ContactFilter` documents the
     parameters)."""
@@ -199,7 +203,7 @@ class ContactState:
         self._version = 0  # changes to the likelihood (its cache's key)
         self._rows = 0  # readings added
         self._cached: dict[float, dict[str, Any]] = {}  # per factor on the slope prior
-        self._gather: tuple[tuple[int, IntArray], Any] | None = None  # the factors' shared gather (ContactMarginal)
+        self._gather: tuple[tuple[int, IntArray], _Gathered] | None = None  # shared by the slope prior's factors
         self._last_row: tuple[IntArray, FloatArray] = (np.zeros(0, dtype=np.int64), np.zeros(0))
         # every reading as added (weighted): columns, values, z, the hypotheses live then and their
         # predictions, its arc and turn; and the readings taken out again (quarantine)
