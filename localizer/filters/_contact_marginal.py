@@ -18,7 +18,7 @@ from ._contact_settings import (
     RHO_MAX,
 )
 from ._contact_state import ContactState, _Gathered
-from ._filter_kernels import weigh_scales
+from ._filter_kernels import gather, weigh_scales
 from ._sums import _quad, _Sums
 
 __all__ = ["ContactMarginal"]
@@ -57,7 +57,7 @@ class ContactMarginal(ContactState):
         else:
             live = np.asarray(hyps, dtype=np.int64)
             uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
-            v, spp, szp = self._up[cols].take(live, axis=1), self._spp[live], self._szp[live]
+            v, spp, szp = gather(self._up, cols, live), self._spp[live], self._szp[live]
         if without is not None:
             uu, uz, szz = uu - without.uu, uz - without.uz, szz - without.szz
             v, spp, szp = v - without.up, spp - without.spp, szp - without.szp
@@ -93,13 +93,12 @@ class ContactMarginal(ContactState):
         if hit is not None and hit[0][0] == key[0] and hit[0][1] is key[1]:
             return hit[1]
         live = self._live_idx
-        # v: (m, n_live); rows then columns, a third of the time of one gather over both
         out = (
             live,
             self._uu[np.ix_(cols, cols)],
             self._uz[cols],
             np.asarray(self._szz),
-            self._up[cols].take(live, axis=1),
+            gather(self._up, cols, live),
             self._spp[live],
             self._szp[live],
         )

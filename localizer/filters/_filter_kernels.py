@@ -10,6 +10,10 @@ reading out again (a stretch of readings the filter no longer trusts: :meth:`Con
 :func:`weigh_scales` weighs the unknown noise scale out of every start's likelihood on the grid of scales:
 in numpy a (scales × starts) array of exponentials and four temporaries per call, which with ten thousand
 starts live early in a rolling, and a stretch envelope asking for a dozen such solves, was most of a belief.
+
+:func:`gather` takes the sums of the live starts over the touched basis columns, element by element: numpy's
+row gather copied every start's sums before it took the live ones (three times the time with a thousand of
+ten thousand starts live). A copy, so the same numbers.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ import numpy as np
 
 from .._types import BoolArray, FloatArray, IntArray
 
-__all__ = ["add_row", "weigh_scales"]
+__all__ = ["add_row", "gather", "weigh_scales"]
 
 #: Terms this many nats below the largest are left out of a sum of exponentials (e⁻⁵⁰ ≈ 2·10⁻²²).
 UNDERFLOW = 50.0
@@ -123,3 +127,25 @@ def weigh_scales(quad: FloatArray, k: FloatArray, lam: FloatArray) -> tuple[Floa
             log_mean[i, j] = top + math.log(total / lam.size)
             lam2[i, j] = second / total
     return log_mean, lam2
+
+
+@numba.njit(cache=True)
+def gather(a: FloatArray, rows: IntArray, cols: IntArray) -> FloatArray:
+    """``a[rows][:, cols]``, without the rows' copy.
+
+    Parameters
+    ----------
+    a : ndarray (m, n)
+    rows, cols : ndarray of int (r,), (c,)
+        Indices into a's rows and columns.
+
+    Returns
+    -------
+    ndarray (r, c)
+    """
+    out = np.empty((rows.size, cols.size))
+    for i in range(rows.size):
+        row = a[rows[i]]
+        for j in range(cols.size):
+            out[i, j] = row[cols[j]]
+    return out
