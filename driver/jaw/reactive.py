@@ -115,6 +115,10 @@ class _Roller(JawReadings):
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
         self.left: list[tuple[int, float]] = []
+        # where the last bridge each way landed on the jaw (mm), and the way being rolled back to leave through
+        # its bridge, whose landing lies on the jaw's span where the last one's did not
+        self.landed: dict[int, float] = {}
+        self.leave_way = 0
         # a drawing's corners and faces make jumps of their own, which the belief judges less well: jumps
         # are neither left nor reported as a mismatch there
         self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
@@ -286,9 +290,20 @@ class _Roller(JawReadings):
         # the re-read is a new base for the increments: a new segment with its own offset
         flt.regrasp(self.z, self.turn_now(), self.d_prev)
         self.blocked[self.direction] = True
+        if math.isfinite(d):
+            self.landed[self.direction] = d
         if self.blocked[-self.direction]:
             # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else
             if self.judges_jumps and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
+                other = self.landed.get(-self.direction, math.inf)
+                if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and self.leave_way == 0:
+                    # this way lands beyond the jaw's calibrated span (a burr's crest sits near the jaw's
+                    # end, the jump carrying the contact outwards), the other way on it: roll back there
+                    # and leave through that bridge instead
+                    self.leave_way = -self.direction
+                    self.direction = -self.direction
+                    self.reversals += 1
+                    return None
                 return self._leave(s, d - self.d_prev)
             return "blocked"
         self.direction = -self.direction
@@ -337,6 +352,7 @@ class _Roller(JawReadings):
         self.d_prev = d
         self.explored = [0.0, 0.0]
         self.blocked = {1: False, -1: False}
+        self.landed = {}
         self.unexplained = False
         self.belief = None
         self.arcs.append(self.z)

@@ -9,6 +9,7 @@ import pytest
 from driver.jaw import (
     ReactivePolicy,
     calibrate,
+    calibrate_simulated,
     clear_ahead,
     information_by_direction,
     localize_reactively,
@@ -381,6 +382,27 @@ def test_a_burr_under_the_start_is_left_reported_and_never_sure(kidney):
     assert run.stopped == "mismatch" and run.belief.mismatch is not None
     lo, hi = run.belief.mismatch
     assert lo - 2.0 <= 43.0 <= hi + 2.0
+    assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
+    assert not run.belief.sure(0.95)
+
+
+def test_a_burr_whose_second_jump_lands_beyond_the_jaw_is_left_through_the_first():
+    # the jaw laid 40 mm out on a burr's crest: rolling on, it jumps off the crest towards the jaw's middle;
+    # rolling back, off the crest the other way, the contact lands beyond the jaw's calibrated span. The jaw
+    # rolls back once more and leaves through the first jump, whose landing lies on the jaw, localizes from
+    # the part beyond and names the burr; left through the second it was lost, 130 mm off
+    from sim2d import Defect, WorldChange
+
+    part = load_part(PARTS.parent / "bench" / "parts" / "tuning" / "star-12.json")
+    cal = calibrate_simulated(part, noise="paper", seed=1)
+    rig = SimRig(part, noise="paper", seed=1, change=WorldChange(defects=(Defect(392.0, 0.3, 4.0),)))
+    run = localize_reactively(
+        rig, part, calibration=cal, approach_pose=rig.approach_pose(392.0, jaw_position=-40.0, standoff=1.0)
+    )
+    assert run.bridges >= 3 and run.reversals >= 2
+    assert run.stopped == "mismatch" and run.belief.mismatch is not None
+    lo, hi = run.belief.mismatch
+    assert lo - 2.0 <= 392.0 <= hi + 2.0
     assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
     assert not run.belief.sure(0.95)
 
