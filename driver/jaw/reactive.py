@@ -297,9 +297,15 @@ class _Roller(JawReadings):
             if self.judges_jumps and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
                 other = self.landed.get(-self.direction, math.inf)
                 if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and self.leave_way == 0:
-                    # this way lands beyond the jaw's calibrated span (a burr's crest sits near the jaw's
-                    # end, the jump carrying the contact outwards), the other way on it: roll back there
-                    # and leave through that bridge instead
+                    # this way lands beyond the jaw's calibrated span (a burr's crest sits near the jaw's end,
+                    # the jump carrying the contact outwards), the other way on it. The jaw is slid along
+                    # itself first, as the leave does; where the slid jaw's longer reach touches the part
+                    # beyond the crest instead, it rolls back and leaves through the other way's bridge
+                    jump = d - self.d_prev
+                    d_new, regrasped, _ = self._regrasp(self.d_prev)
+                    if regrasped:
+                        self.d_prev = d_new
+                        return self._leave(s, jump)
                     self.leave_way = -self.direction
                     self.direction = -self.direction
                     self.reversals += 1
