@@ -115,10 +115,10 @@ class _Roller(JawReadings):
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
         self.left: list[tuple[int, float]] = []
-        # where the last bridge each way landed on the jaw (mm), and the way being rolled back to leave through
-        # its bridge, whose landing lies on the jaw's span where the last one's did not
+        # where the last bridge each way landed on the jaw (mm), and whether the jaw is rolling back to leave
+        # through the other way's bridge, whose landing lies on the jaw's span where the last one's did not
         self.landed: dict[int, float] = {}
-        self.leave_way = 0
+        self.rolling_back = False
         # a drawing's corners and faces make jumps of their own, which the belief judges less well: jumps
         # are neither left nor reported as a mismatch there
         self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
@@ -296,7 +296,7 @@ class _Roller(JawReadings):
             # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else
             if self.judges_jumps and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
                 other = self.landed.get(-self.direction, math.inf)
-                if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and self.leave_way == 0:
+                if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and not self.rolling_back:
                     # this way lands beyond the jaw's calibrated span (a burr's crest sits near the jaw's end,
                     # the jump carrying the contact outwards), the other way on it. The jaw is slid along
                     # itself first, as the leave does; where the slid jaw's longer reach touches the part
@@ -306,7 +306,7 @@ class _Roller(JawReadings):
                     if regrasped:
                         self.d_prev = d_new
                         return self._leave(s, jump)
-                    self.leave_way = -self.direction
+                    self.rolling_back = True
                     self.direction = -self.direction
                     self.reversals += 1
                     return None

@@ -388,9 +388,10 @@ def test_a_burr_under_the_start_is_left_reported_and_never_sure(kidney):
 
 def test_a_burr_whose_second_jump_lands_beyond_the_jaw_is_left_through_the_first():
     # the jaw laid 40 mm out on a burr's crest: rolling on, it jumps off the crest towards the jaw's middle;
-    # rolling back, off the crest the other way, the contact lands beyond the jaw's calibrated span. The jaw
-    # rolls back once more and leaves through the first jump, whose landing lies on the jaw, localizes from
-    # the part beyond and names the burr; left through the second it was lost, 130 mm off
+    # rolling back, off the crest the other way, the contact lands beyond the jaw's calibrated span, and the jaw
+    # slid along itself touches the part beyond the crest. The jaw rolls back once more and leaves through the
+    # first jump, whose landing lies on the jaw, localizes from the part beyond and names the burr; left
+    # through the second it was lost, 130 mm off
     from sim2d import Defect, WorldChange
 
     part = load_part(PARTS.parent / "bench" / "parts" / "tuning" / "star-12.json")
