@@ -36,9 +36,11 @@ simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactive
    as are the readings every step after counts from; when both ways are blocked and a jump was one no
    probable place of the model predicted (the jaw sits on a burr, or between a dent's rims), the jaw
    rolls through that jump once and the filter starts afresh from where it lands (spline parts: a
-   drawing's corners and faces jump of their own); and a run that met something the model does not
-   have (a stretch the filter quarantined, a jump rolled through, one the final place does not
-   explain) ends "mismatch", saying where, never "confident".
+   drawing's corners and faces jump of their own). The jump is the last one met, unless it lands beyond
+   the jaw's calibrated span where the other way's landed on it and sliding the jaw along itself does not
+   hold: then the jaw rolls back and leaves through the other way's jump; and a run that met something
+   the model does not have (a stretch the filter quarantined, a jump rolled through, one the final place
+   does not explain) ends "mismatch", saying where, never "confident".
 
 Works on any :class:`driver.rig.Rig` (simulated or serial).
 """
