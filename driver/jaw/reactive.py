@@ -115,10 +115,11 @@ class _Roller(JawReadings):
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
         self.left: list[tuple[int, float]] = []
-        # where the last bridge each way landed on the jaw (mm), and whether the jaw is rolling back to leave
-        # through the other way's bridge, whose landing lies on the jaw's span where the last one's did not
-        self.landed: dict[int, float] = {}
-        self.rolling_back = False
+        # where the last bridge each way landed on the jaw (mm) and at which net rotation (rad); whether the jaw
+        # is rolling back to leave through the other way's bridge, whose landing lies on the jaw's span where
+        # the last one's did not, and whether it did so once already
+        self.landed: dict[int, tuple[float, float]] = {}
+        self.rolling_back = self.rolled_back = False
         # a drawing's corners and faces make jumps of their own, which the belief judges less well: jumps
         # are neither left nor reported as a mismatch there
         self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
@@ -202,6 +203,12 @@ class _Roller(JawReadings):
             self.z += self.direction * arc_from_jaw_positions([self.d_prev, d], s, self.offset)
             flt.update(self.z, turn, d)
         self.turn = turn
+        if self.rolling_back and (turn - self.landed[self.direction][1]) * self.direction > 2 * p.step:
+            # rolled back past where that way's jump was, and it did not come again (the contact's place on the
+            # jaw jumped, not the contact): back to the jump the jaw was leaving, to leave through it after all
+            self.rolling_back = False
+            self.direction = -self.direction
+            self.reversals += 1
         self.explored = [min(self.explored[0], turn), max(self.explored[1], turn)]
         self.arcs.append(self.z)
         self.turns.append(turn)
@@ -291,12 +298,12 @@ class _Roller(JawReadings):
         flt.regrasp(self.z, self.turn_now(), self.d_prev)
         self.blocked[self.direction] = True
         if math.isfinite(d):
-            self.landed[self.direction] = d
+            self.landed[self.direction] = (d, self.turn + s)
         if self.blocked[-self.direction]:
             # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else
             if self.judges_jumps and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
-                other = self.landed.get(-self.direction, math.inf)
-                if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and not self.rolling_back:
+                other = self.landed.get(-self.direction, (math.inf, 0.0))[0]
+                if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and not self.rolled_back:
                     # this way lands beyond the jaw's calibrated span (a burr's crest sits near the jaw's end,
                     # the jump carrying the contact outwards), the other way on it. The jaw is slid along
                     # itself first, as the leave does; where the slid jaw's longer reach touches the part
@@ -306,7 +313,7 @@ class _Roller(JawReadings):
                     if regrasped:
                         self.d_prev = d_new
                         return self._leave(s, jump)
-                    self.rolling_back = True
+                    self.rolling_back = self.rolled_back = True
                     self.direction = -self.direction
                     self.reversals += 1
                     return None
@@ -359,6 +366,7 @@ class _Roller(JawReadings):
         self.explored = [0.0, 0.0]
         self.blocked = {1: False, -1: False}
         self.landed = {}
+        self.rolling_back = False
         self.unexplained = False
         self.belief = None
         self.arcs.append(self.z)
