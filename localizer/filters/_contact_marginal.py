@@ -52,12 +52,8 @@ class ContactMarginal(ContactState):
         prior[cols < self._segments] = 1e6  # the segments' offsets: flat
         prior[(cols >= self._jaw0) & (cols < self._jaw_end)] = self.sd_jaw**2
         prior[cols == self._drift] = self.sd_drift**2
-        if hyps is None:
-            live, uu, uz, szz, v, spp, szp = self._gathered(cols)
-        else:
-            live = np.asarray(hyps, dtype=np.int64)
-            uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
-            v, spp, szp = gather(self._up, cols, live), self._spp[live], self._szp[live]
+        gathered = self._gathered(cols) if hyps is None else self._sums_over(cols, np.asarray(hyps, dtype=np.int64))
+        live, uu, uz, szz, v, spp, szp = gathered
         if without is not None:
             uu, uz, szz = uu - without.uu, uz - without.uz, szz - without.szz
             v, spp, szp = v - without.up, spp - without.spp, szp - without.szp
@@ -92,18 +88,14 @@ class ContactMarginal(ContactState):
         hit = self._gather
         if hit is not None and hit[0][0] == key[0] and hit[0][1] is key[1]:
             return hit[1]
-        live = self._live_idx
-        out = (
-            live,
-            self._uu[np.ix_(cols, cols)],
-            self._uz[cols],
-            np.asarray(self._szz),
-            gather(self._up, cols, live),
-            self._spp[live],
-            self._szp[live],
-        )
+        out = self._sums_over(cols, self._live_idx)
         self._gather = (key, out)
         return out
+
+    def _sums_over(self, cols: IntArray, live: IntArray) -> _Gathered:
+        """(live, UᵀU, Uᵀz, zᵀz, Uᵀp (m, n_live), pᵀp, zᵀp) over the columns ``cols`` and the starts ``live``."""
+        uu, uz, szz = self._uu[np.ix_(cols, cols)], self._uz[cols], np.asarray(self._szz)
+        return live, uu, uz, szz, gather(self._up, cols, live), self._spp[live], self._szp[live]
 
     def _log_likelihood(self, s: dict[str, Any], prune: bool = True) -> FloatArray:
         """Log-likelihood of each start from a :meth:`_solve` (over the grid, after its leading axis if any),
