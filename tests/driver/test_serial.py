@@ -178,7 +178,6 @@ def test_reply_parser_only_raises_rig_error(data):
         parse_reply(data)
 
 
-@settings(max_examples=200, deadline=None)
 def looped(data=b""):
     """A pyserial ``loop://`` port holding ``data``: what is written to it is read back."""
     port = serial.serial_for_url("loop://", timeout=0)
@@ -220,6 +219,7 @@ def test_lines_as_pyserials_read_until_gives_them(parts):
     assert got == want
 
 
+@settings(max_examples=200, deadline=None)
 @given(st.integers(0, 65535), st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), max_size=4))
 def test_replies_round_trip(seq, values):
     r = parse_reply(encode_reply(seq, "OK", *values))
