@@ -21,6 +21,7 @@ from .reactive import localize_reactively
 from .reactive_policy import (
     CONFIRM,
     MAX_LEAVES,
+    MAX_RESTARTS,
     MAX_ROTATION,
     REACTIVE_POLICY,
     SEEK_HYPOTHESES,
@@ -66,6 +67,7 @@ __all__ = [
     "CONFIRM",
     "REACTIVE_POLICY",
     "MAX_LEAVES",
+    "MAX_RESTARTS",
     "MAX_ROTATION",
     "ReactivePolicy",
     "ReactiveRun",

@@ -29,6 +29,7 @@ from .calibration import Calibration
 from .hand import PRESS, PressSettings, edge_offset, establish_contact
 from .reactive_policy import (
     MAX_LEAVES,
+    MAX_RESTARTS,
     REACTIVE_POLICY,
     ReactivePolicy,
     ReactiveRun,
@@ -37,6 +38,7 @@ from .reactive_policy import (
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
+from .reactive_verdict import Verdict
 
 __all__ = ["localize_reactively"]
 
@@ -77,7 +79,7 @@ def localize_reactively(
     return _Roller(rig, flt, calibration, policy, pressing, observer).run(approach_pose)
 
 
-class _Roller(JawReadings):
+class _Roller(JawReadings, Verdict):
     """One reactive localization: the hand, the filter, the counters and the traces it returns.
 
     :meth:`run` rolls step by step (:meth:`_step`); a step at the end of the jaw's span is a
@@ -115,6 +117,7 @@ class _Roller(JawReadings):
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
         self.left: list[tuple[int, float]] = []
+        self.found: list[tuple[float, float, float]] = []  # what the verdict reads (:class:`Verdict`)
         # where the last bridge each way landed on the jaw (mm) and at which net rotation (rad); whether the jaw
         # is rolling back to leave through the other way's bridge, whose landing lies on the jaw's span where
         # the last one's did not, and whether it did so once already
@@ -124,6 +127,7 @@ class _Roller(JawReadings):
         # are neither left nor reported as a mismatch there
         self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
         self.segment_base = 0  # segments of the filters before a restart
+        self.since = 0  # the first record of the present filter's (``arcs``, ``turns``, ...)
         self.rereads = 0  # readings taken again because one jumped
 
     # ------------------------------------------------------------------ the run
@@ -328,7 +332,7 @@ class _Roller(JawReadings):
         rims): roll through the jump of ``jump`` mm on the jaw and localize afresh from where it lands. The
         readings so far came from something that is not the part's model; the filter starts again there,
         and the run ends "mismatch" whatever it finds (:meth:`_verdict`)."""
-        p, flt = self.policy, self.flt
+        p = self.policy
         if abs(self.d_prev + jump) > self.jaw_limit:
             # the contact would land beyond the jaw's calibrated span: slide the jaw along itself first. On a
             # burr's crest the slid jaw's longer reach may touch the part beyond it instead (the slide is then
@@ -357,6 +361,13 @@ class _Roller(JawReadings):
             # where the jaw left the model behind is that much further back
             jump = math.copysign(abs(jump) + abs(d - target), jump)
         self.left.append((self.direction, float(jump)))
+        self._afresh(d)
+        return None
+
+    def _afresh(self, d: float) -> None:
+        """Start the filter again from the present contact, ``d`` mm on the jaw: what came before is not
+        the part's model (the jaw rolled through a jump it does not explain, or nothing on it fits)."""
+        flt = self.flt
         self.segment_base += flt.segment + 1
         flt.reset()
         flt.touch(d)
@@ -369,54 +380,31 @@ class _Roller(JawReadings):
         self.rolling_back = False
         self.unexplained = False
         self.belief = None
+        self.since = len(self.arcs)
         self.arcs.append(self.z)
         self.turns.append(self.turn)
         self.true_arcs.append(self.true_arc())
         self.segments.append(self.segment_base)
-        return None
-
-    def _verdict(self, belief: Belief) -> tuple[tuple[float, float], float] | None:
-        """Where the part seems to differ from its model and by how much (mm), or None: the filter's misfit,
-        the stretch the jaw left (behind where the present filter started, by the jump), or a jump the most
-        probable start does not explain (ahead of its contact then). NaN ends where it cannot be told (the
-        belief has no place holding half of it)."""
-        flt = self.flt
-        if belief.mismatch is not None or not belief.consistent or flt.ruled_out:
-            return None if belief.mismatch is None else (belief.mismatch, belief.mismatch_mm)
-        start = int(np.argmax(flt.posterior()))
-        part = flt.part
-        if self.left:
-            direction, jump = self.left[-1]
-            s0 = float(flt.grid[start])
-            ends = (s0 - direction * (abs(jump) + 1.0), s0)
-            lo = ends[0] if direction > 0 else ends[1]
-            # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
-            # explains it (a bridge the belief of the time misjudged), a convex stretch does not
-            between = flt.tracks.node_at(np.linspace(lo, lo + abs(jump) + 1.0, 32))
-            if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
-                return None
-            if belief.mass < 0.5:  # left, but not localized since: where it left is not known
-                return (math.nan, math.nan), abs(jump)
-            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
-        missed = flt.unexplained_bridges(start)
-        if not self.judges_jumps:
-            missed = []
-        elif self.unexplained and belief.mass < 0.5:
-            # jumps nothing on the model explains, and no place known well enough to say where
-            return (math.nan, math.nan), math.nan
-        if missed and belief.mass >= 0.5:
-            before, turn, _, jump = missed[0]
-            at = float(flt.tracks.step(np.array([start]), before)[0][0])
-            width = abs(self.policy.bridge_jump) + 2.0
-            lo = at if turn > before else at - width
-            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), math.nan
-        return None
 
     def _decide(self, belief: Belief) -> str | None:
         """Whether ``belief`` ends the run: "mismatch" (nothing fits, or sure on a part that showed
         something its model does not have), "confident", or None (counts the checks sure in a row)."""
         if not belief.consistent:
-            return "mismatch"  # nothing on the part fits the readings: never sure
+            # nothing on the part fits the readings (the true start pruned by a defect's readings before the fit
+            # test found them): localize afresh from here, where rotation is left, and say where it was
+            if not self.judges_jumps or len(self.found) >= MAX_RESTARTS:
+                return "mismatch"
+            # the stretch that did not fit (else all that was rolled), in rolled arc from here: the new filter's
+            # start places it on the model
+            misfits = self.flt.misfits
+            if misfits:
+                travel, mm = misfits[-1].travel, misfits[-1].rms_mm
+            else:
+                rolled = self.arcs[self.since :]
+                travel, mm = (min(rolled), max(rolled)), math.nan
+            self.found.append((travel[0] - self.z, travel[1] - self.z, mm))
+            self._afresh(self.d_prev)
+            return None
         self.sure = self.sure + 1 if belief.mass >= self.policy.confidence else 0
         if self.sure >= self.policy.confirm:
             # sure where it is, but never "sure" on a part that showed something its model does not have
@@ -448,7 +436,7 @@ class _Roller(JawReadings):
                 }
             )
         decided = self._decide(belief)
-        if decided is not None:
+        if decided is not None or self.belief is None:  # stopped, or the filter started again from here
             return decided
         direction = self.direction
         # a concavity ahead for most of the belief: turn round before bridging it, if the other way

@@ -38,7 +38,9 @@ simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactive
    rolls through that jump once and the filter starts afresh from where it lands (spline parts: a
    drawing's corners and faces jump of their own). The jump is the last one met, unless it lands beyond
    the jaw's calibrated span where the other way's landed on it and sliding the jaw along itself does not
-   hold: then the jaw rolls back and leaves through the other way's jump; and a run that met something
+   hold: then the jaw rolls back and leaves through the other way's jump. Where nothing on the part fits
+   the readings any more (a defect's readings ruled the true start out before the fit test found them), the
+   filter starts again once from the present contact; and a run that met something
    the model does not have (a stretch the filter quarantined, a jump rolled through, one the final place
    does not explain) ends "mismatch", saying where, never "confident".
 
@@ -69,6 +71,7 @@ from ..rig import RigError
 __all__ = [
     "CONFIRM",
     "MAX_LEAVES",
+    "MAX_RESTARTS",
     "MAX_ROTATION",
     "ReactiveRun",
     "spread_by_direction",
@@ -87,6 +90,10 @@ CONFIRM = 1
 #: How many times a run rolls through such a jump to leave what the jaw sat on (rule 8 above):
 #: once, off the thing under the start; a second would be a real concavity the belief misjudged.
 MAX_LEAVES = 1
+
+#: How many times a run starts its filter again where nothing on the part fits the readings (rule 8): once,
+#: past the defect whose readings ruled the true start out; a second time the part is not its model at all.
+MAX_RESTARTS = 1
 
 
 #: Budget of rolled rotation, both directions counted, rad (the command line's and the studies' too).

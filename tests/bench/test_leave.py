@@ -17,3 +17,14 @@ def test_a_jump_that_does_not_come_again_is_not_left_through():
     row = run_trial(TrialSpec(load_study(STUDIES / "world-heldout-g-spikes.toml"), 0, 81))
     assert row["reactive_stopped"] == "confident" and row["reactive_mismatch_arc"] == ""
     assert row["reactive_success"] == 1
+
+
+def test_a_filter_that_rules_out_every_start_starts_again_from_where_the_jaw_is():
+    # the tuning family, a 0.3 x 4 mm burr 1.7 mm behind the start on a filleted plate: its readings rule out
+    # every start after 94 degrees (the run ended there, 150 mm off). The filter starts again from the present
+    # contact and localizes; the run is right, ends "mismatch" and places the burr from the new start
+    row = run_trial(TrialSpec(load_study(STUDIES / "world-tuning.toml"), 0, 58))
+    assert row["reactive_stopped"] == "mismatch" and row["reactive_success"] == 1
+    lo, hi = map(float, row["reactive_mismatch_arc"].split("-"))
+    half = 0.5 * 4.0  # the burr's stretch, and the 2 mm the issue allows beside it
+    assert lo - half - 2.0 <= float(row["world_defect_arc"]) <= hi + half + 2.0

@@ -1,0 +1,71 @@
+"""Where a reactive run says the part differs from its model: the filter's misfit, a jump the jaw rolled through
+to leave what it sat on, a stretch before the filter started again, or a jump the final place does not explain."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from localizer import Belief, ContactFilter
+
+from .reactive_policy import ReactivePolicy
+
+__all__ = ["Verdict"]
+
+
+class Verdict:
+    """The verdict of a reactive run (:class:`driver.jaw.reactive` rolls with it) from what it met."""
+
+    flt: ContactFilter
+    policy: ReactivePolicy
+    # the jumps rolled through to leave what the jaw sat on (direction, jump on the jaw mm)
+    left: list[tuple[int, float]]
+    # where the readings stopped fitting under filters that ruled out every start: rolled arc from where the
+    # filter started again (mm, both ends) and the misfit's size (mm)
+    found: list[tuple[float, float, float]]
+    unexplained: bool  # a jump no place of the model explains since the filter last started
+    judges_jumps: bool  # a spline part: a drawing's corners and faces make jumps of their own
+
+    def _verdict(self, belief: Belief) -> tuple[tuple[float, float], float] | None:
+        """Where the part seems to differ from its model and by how much (mm), or None: the filter's misfit,
+        the stretch the jaw left (behind where the present filter started, by the jump), or a jump the most
+        probable start does not explain (ahead of its contact then). NaN ends where it cannot be told (the
+        belief has no place holding half of it)."""
+        flt = self.flt
+        if belief.mismatch is not None or not belief.consistent or flt.ruled_out:
+            return None if belief.mismatch is None else (belief.mismatch, belief.mismatch_mm)
+        start = int(np.argmax(flt.posterior()))
+        part = flt.part
+        if self.found:
+            lo, hi, mm = self.found[0]
+            if belief.mass < 0.5:  # not localized since: where it did not fit is not known
+                return (math.nan, math.nan), mm
+            s0 = float(flt.grid[start])
+            return (float(part.wrap_arc(s0 + lo)), float(part.wrap_arc(s0 + hi))), mm
+        if self.left:
+            direction, jump = self.left[-1]
+            s0 = float(flt.grid[start])
+            ends = (s0 - direction * (abs(jump) + 1.0), s0)
+            lo = ends[0] if direction > 0 else ends[1]
+            # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
+            # explains it (a bridge the belief of the time misjudged), a convex stretch does not
+            between = flt.tracks.node_at(np.linspace(lo, lo + abs(jump) + 1.0, 32))
+            if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
+                return None
+            if belief.mass < 0.5:  # left, but not localized since: where it left is not known
+                return (math.nan, math.nan), abs(jump)
+            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
+        missed = flt.unexplained_bridges(start)
+        if not self.judges_jumps:
+            missed = []
+        elif self.unexplained and belief.mass < 0.5:
+            # jumps nothing on the model explains, and no place known well enough to say where
+            return (math.nan, math.nan), math.nan
+        if missed and belief.mass >= 0.5:
+            before, turn, _, jump = missed[0]
+            at = float(flt.tracks.step(np.array([start]), before)[0][0])
+            width = abs(self.policy.bridge_jump) + 2.0
+            lo = at if turn > before else at - width
+            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), math.nan
+        return None
