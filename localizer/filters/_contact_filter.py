@@ -409,7 +409,7 @@ class ContactFilter(ContactFit):
             ambiguous=ambiguous,
             informative=informative,
             steps=self.steps,
-            mismatch=self._where(list(self._misfits[0].rows), i) if self._misfits else None,
+            mismatch=self._where(self._in_travel(self._misfits[0].travel), i) if self._misfits else None,
             mismatch_mm=self._misfits[0].rms_mm if self._misfits else math.nan,
         )
 

@@ -224,6 +224,15 @@ class ContactMarginal(ContactState):
         posterior: FloatArray = s["w"]
         return posterior.copy()
 
+    def _in_travel(self, travel: tuple[float, float]) -> list[int]:
+        """The readings (indices, the first's aside: it only places the start) taken within ``travel``, rolled
+        arc mm as :meth:`update` took it: a stretch the fit test found, whose readings the most probable start
+        of the end places on the model. Not the readings taken out for it (``Misfit.rows``): those are the
+        stretch whose absence lets some start fit best, which where the model's own tight bends misfit a
+        little over many readings is not always the stretch that stopped fitting."""
+        lo, hi = travel
+        return [j for j in range(1, len(self._readings)) if lo <= self._readings[j].arc <= hi]
+
     def _where(self, rows: list[int], start: int) -> tuple[float, float]:
         """The stretch of the model (arc positions, mm, counter-clockwise from first to last) the contact
         covered over the readings ``rows`` if the rolling started at grid point ``start``."""

@@ -28,3 +28,15 @@ def test_a_filter_that_rules_out_every_start_starts_again_from_where_the_jaw_is(
     lo, hi = map(float, row["reactive_mismatch_arc"].split("-"))
     half = 0.5 * 4.0  # the burr's stretch, and the 2 mm the issue allows beside it
     assert lo - half - 2.0 <= float(row["world_defect_arc"]) <= hi + half + 2.0
+
+
+def test_the_reported_stretch_is_the_one_that_stopped_fitting_not_the_one_taken_out():
+    # the tuning family, a 0.3 x 4 mm dent 0.9 mm ahead of the start on a superellipse: the fit test finds the
+    # dent's readings, but the stretch taken out of the likelihood (the one whose absence lets some start fit
+    # best) lay 22 mm on, at the part's tight bend, and was what the run reported. The run is right; where it
+    # reports is where the readings stopped fitting, placed by the start it ends with
+    row = run_trial(TrialSpec(load_study(STUDIES / "world-tuning-dent.toml"), 0, 12))
+    assert row["reactive_stopped"] == "mismatch" and row["reactive_success"] == 1
+    lo, hi = map(float, row["reactive_mismatch_arc"].split("-"))
+    half = 0.5 * 4.0
+    assert lo - half - 2.0 <= float(row["world_defect_arc"]) <= hi + half + 2.0
