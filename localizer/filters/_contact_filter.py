@@ -387,6 +387,9 @@ class ContactFilter(ContactFit):
                 # necessarily the one the most probable start misfits (a wrong start that the stretch
                 # made probable would otherwise keep it and drop the rest)
                 rows = self._best_stretch()
+                if any(m.travel == found.travel for m in self._misfits):
+                    # ... unless the test finds the same stretch again: what was taken out for it was not it
+                    rows = found.rows
                 self._misfits.append(found._replace(rows=rows) if rows else found)
                 taken = list(rows or found.rows)
                 # the zone: the stretch's readings, and at least one defect window around their middle (on a
