@@ -72,7 +72,9 @@ class Misfit(NamedTuple):
     start : float, mm
         The start of the rolling under which it was judged.
     rows : tuple of int
-        The readings of the stretch (in the order given, 0 the first).
+        The readings of the stretch (in the order given, 0 the first). In :attr:`ContactFilter.misfits`, the
+        readings taken out of the likelihood for it: the stretch whose absence lets some start fit best, or
+        this one's own where the test found the same stretch before.
     rms_mm : float, mm
         How far off the model the stretch's readings are, root mean square (as the noise the filter was
         told would put them).
