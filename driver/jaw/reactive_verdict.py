@@ -22,14 +22,15 @@ class Verdict:
     # the jumps rolled through to leave what the jaw sat on (direction, jump on the jaw mm)
     left: list[tuple[int, float]]
     # where the readings stopped fitting under filters that ruled out every start: rolled arc from where the
-    # filter started again (mm, both ends) and the misfit's size (mm)
-    found: list[tuple[float, float, float]]
+    # filter started again (mm, both ends), the misfit's size (mm) and how many jumps the jaw had left by then
+    found: list[tuple[float, float, float, int]]
     unexplained: bool  # a jump no place of the model explains since the filter last started
     judges_jumps: bool  # a spline part: a drawing's corners and faces make jumps of their own
 
     def _verdict(self, belief: Belief) -> tuple[tuple[float, float], float] | None:
         """Where the part seems to differ from its model and by how much (mm), or None: the filter's misfit,
-        the stretch the jaw left (behind where the present filter started, by the jump), or a jump the most
+        the stretch a filter that ruled out every start did not fit (from where the present one started), the
+        stretch the jaw left (behind where the present filter started, by the jump), or a jump the most
         probable start does not explain (ahead of its contact then). NaN ends where it cannot be told (the
         belief has no place holding half of it)."""
         flt = self.flt
@@ -38,24 +39,17 @@ class Verdict:
         start = int(np.argmax(flt.posterior()))
         part = flt.part
         if self.found:
-            lo, hi, mm = self.found[0]
-            if belief.mass < 0.5:  # not localized since: where it did not fit is not known
-                return (math.nan, math.nan), mm
-            s0 = float(flt.grid[start])
-            return (float(part.wrap_arc(s0 + lo)), float(part.wrap_arc(s0 + hi))), mm
+            lo, hi, mm, leaves = self.found[0]
+            if leaves == len(self.left):  # measured from where the present filter started
+                if belief.mass < 0.5:  # not localized since: where it did not fit is not known
+                    return (math.nan, math.nan), mm
+                s0 = float(flt.grid[start])
+                return (float(part.wrap_arc(s0 + lo)), float(part.wrap_arc(s0 + hi))), mm
+            # the jaw left what it sat on since: the jump it rolled through is measured from the present start,
+            # that stretch is not; a run that ruled out every start is never sure all the same
+            return self._left(belief, start) or ((math.nan, math.nan), mm)
         if self.left:
-            direction, jump = self.left[-1]
-            s0 = float(flt.grid[start])
-            ends = (s0 - direction * (abs(jump) + 1.0), s0)
-            lo = ends[0] if direction > 0 else ends[1]
-            # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
-            # explains it (a bridge the belief of the time misjudged), a convex stretch does not
-            between = flt.tracks.node_at(np.linspace(lo, lo + abs(jump) + 1.0, 32))
-            if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
-                return None
-            if belief.mass < 0.5:  # left, but not localized since: where it left is not known
-                return (math.nan, math.nan), abs(jump)
-            return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
+            return self._left(belief, start)
         missed = flt.unexplained_bridges(start)
         if not self.judges_jumps:
             missed = []
@@ -69,3 +63,20 @@ class Verdict:
             lo = at if turn > before else at - width
             return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), math.nan
         return None
+
+    def _left(self, belief: Belief, start: int) -> tuple[tuple[float, float], float] | None:
+        """The stretch the jaw left by its last jump, behind where the present filter started (most probable
+        start ``start``, a grid index), or None where a concavity of the model there explains the jump."""
+        flt, part = self.flt, self.flt.part
+        direction, jump = self.left[-1]
+        s0 = float(flt.grid[start])
+        ends = (s0 - direction * (abs(jump) + 1.0), s0)
+        lo = ends[0] if direction > 0 else ends[1]
+        # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
+        # explains it (a bridge the belief of the time misjudged), a convex stretch does not
+        between = flt.tracks.node_at(np.linspace(lo, lo + abs(jump) + 1.0, 32))
+        if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
+            return None
+        if belief.mass < 0.5:  # left, but not localized since: where it left is not known
+            return (math.nan, math.nan), abs(jump)
+        return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)

@@ -388,8 +388,8 @@ class ContactFilter(ContactFit):
                 # made probable would otherwise keep it and drop the rest)
                 rows = self._best_stretch()
                 if any(m.travel == found.travel for m in self._misfits):
-                    # ... unless the test finds the same window again (laid out from the same first reading):
-                    # what was taken out for it was not it
+                    # ... unless the test finds the same window again (laid out from the same least rolled arc
+                    # of the readings it judges): what was taken out for it was not it
                     rows = found.rows
                 self._misfits.append(found._replace(rows=rows) if rows else found)
                 taken = list(rows or found.rows)

@@ -28,6 +28,7 @@ def test_a_filter_that_rules_out_every_start_starts_again_from_where_the_jaw_is(
     lo, hi = map(float, row["reactive_mismatch_arc"].split("-"))
     half = 0.5 * 4.0  # the burr's stretch, and the 2 mm the issue allows beside it
     assert lo - half - 2.0 <= float(row["world_defect_arc"]) <= hi + half + 2.0
+    assert hi - lo <= 12.0  # no wider than the fit test's window
 
 
 def test_the_reported_stretch_is_the_one_that_stopped_fitting_not_the_one_taken_out():
@@ -40,6 +41,7 @@ def test_the_reported_stretch_is_the_one_that_stopped_fitting_not_the_one_taken_
     lo, hi = map(float, row["reactive_mismatch_arc"].split("-"))
     half = 0.5 * 4.0
     assert lo - half - 2.0 <= float(row["world_defect_arc"]) <= hi + half + 2.0
+    assert hi - lo <= 12.0  # no wider than the fit test's window
 
 
 def test_a_stretch_found_again_after_its_quarantine_is_taken_out_itself():
