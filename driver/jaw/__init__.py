@@ -19,6 +19,7 @@ from .hand import (
 )
 from .reactive import localize_reactively
 from .reactive_policy import (
+    BOXED_ROTATION,
     CONFIRM,
     MAX_LEAVES,
     MAX_RESTARTS,
@@ -68,6 +69,7 @@ __all__ = [
     "REACTIVE_POLICY",
     "MAX_LEAVES",
     "MAX_RESTARTS",
+    "BOXED_ROTATION",
     "MAX_ROTATION",
     "ReactivePolicy",
     "ReactiveRun",

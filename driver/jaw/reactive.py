@@ -28,6 +28,7 @@ from ..rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 from .calibration import Calibration
 from .hand import PRESS, PressSettings, edge_offset, establish_contact
 from .reactive_policy import (
+    BOXED_ROTATION,
     MAX_LEAVES,
     MAX_RESTARTS,
     REACTIVE_POLICY,
@@ -128,6 +129,8 @@ class _Roller(JawReadings, Verdict):
         self.judges_jumps = not (flt.tracks.has_faces or flt.part.corners)
         self.segment_base = 0  # segments of the filters before a restart
         self.since = 0  # the first record of the present filter's (``arcs``, ``turns``, ...)
+        self.rotation_at_start = 0.0  # the rolled rotation when the present filter started, rad
+        self.boxed = False  # left a place boxed in by jumps the model explains (:class:`Verdict`)
         self.rereads = 0  # readings taken again because one jumped
 
     # ------------------------------------------------------------------ the run
@@ -304,8 +307,12 @@ class _Roller(JawReadings, Verdict):
         if math.isfinite(d):
             self.landed[self.direction] = (d, self.turn + s)
         if self.blocked[-self.direction]:
-            # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else
-            if self.judges_jumps and self.unexplained and len(self.left) < MAX_LEAVES and math.isfinite(d):
+            # both ways blocked, by a jump nothing on the model explains: the jaw sits on something else. Or by
+            # jumps it explains, within BOXED_ROTATION of where the filter started: no run on a part that is its
+            # model is boxed in that soon, a burr's crest boxes it in often
+            boxed = self.rotation - self.rotation_at_start <= BOXED_ROTATION
+            if self.judges_jumps and (self.unexplained or boxed) and len(self.left) < MAX_LEAVES and math.isfinite(d):
+                self.boxed = self.boxed or not self.unexplained
                 other = self.landed.get(-self.direction, (math.inf, 0.0))[0]
                 if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and not self.rolled_back:
                     # this way lands beyond the jaw's calibrated span (a burr's crest sits near the jaw's end,
@@ -382,6 +389,7 @@ class _Roller(JawReadings, Verdict):
         self.belief = None
         self.sure = 0
         self.since = len(self.arcs)
+        self.rotation_at_start = self.rotation
         self.arcs.append(self.z)
         self.turns.append(self.turn)
         self.true_arcs.append(self.true_arc())

@@ -40,7 +40,9 @@ simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactive
    the jaw's calibrated span where the other way's landed on it and sliding the jaw along itself does not
    hold: then the jaw rolls back and leaves through the other way's jump. Where nothing on the part fits
    the readings any more (a defect's readings ruled the true start out before the fit test found them), the
-   filter starts again once from the present contact; and a run that met something
+   filter starts again once from the present contact. Blocked both ways within ``BOXED_ROTATION`` of where
+   the filter started, by jumps the model explains, the jaw leaves as from a burr all the same (no run
+   on a part that is its model is boxed in so soon); and a run that met something
    the model does not have (a stretch the filter quarantined, a jump rolled through, one the final place
    does not explain) ends "mismatch", saying where, never "confident".
 
@@ -72,6 +74,7 @@ __all__ = [
     "CONFIRM",
     "MAX_LEAVES",
     "MAX_RESTARTS",
+    "BOXED_ROTATION",
     "MAX_ROTATION",
     "ReactiveRun",
     "spread_by_direction",
@@ -94,6 +97,10 @@ MAX_LEAVES = 1
 #: How many times a run starts its filter again where nothing on the part fits the readings (rule 8): once,
 #: past the defect whose readings ruled the true start out; a second time the part is not its model at all.
 MAX_RESTARTS = 1
+
+#: Boxed in: blocked both ways, by jumps the model explains, within this much rolled rotation of where the
+#: filter started (rad). The jaw then leaves as from a burr (rule 8), and the run never ends "confident".
+BOXED_ROTATION = math.radians(45.0)
 
 
 #: Budget of rolled rotation, both directions counted, rad (the command line's and the studies' too).

@@ -24,6 +24,7 @@ class Verdict:
     # where the readings stopped fitting under filters that ruled out every start: rolled arc from where the
     # filter started again (mm, both ends), the misfit's size (mm) and how many jumps the jaw had left by then
     found: list[tuple[float, float, float, int]]
+    boxed: bool  # the jaw left a place boxed in by jumps the model explains (never sure after)
     unexplained: bool  # a jump no place of the model explains since the filter last started
     judges_jumps: bool  # a spline part: a drawing's corners and faces make jumps of their own
 
@@ -49,7 +50,8 @@ class Verdict:
             # that stretch is not; a run that ruled out every start is never sure all the same
             return self._left(belief, start) or ((math.nan, math.nan), mm)
         if self.left:
-            return self._left(belief, start)
+            # left a place boxed in by jumps the model explains: never sure, where it left if it can be told
+            return self._left(belief, start) or (((math.nan, math.nan), math.nan) if self.boxed else None)
         missed = flt.unexplained_bridges(start)
         if not self.judges_jumps:
             missed = []
