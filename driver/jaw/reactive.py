@@ -39,7 +39,7 @@ from .reactive_policy import (
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
-from .reactive_verdict import Verdict
+from .reactive_verdict import Unfit, Verdict
 
 __all__ = ["localize_reactively"]
 
@@ -118,7 +118,7 @@ class _Roller(JawReadings, Verdict):
         # rolled through to leave what it sat on (direction, jump on the jaw mm): a part not its model
         self.unexplained = False
         self.left: list[tuple[int, float]] = []
-        self.found: list[tuple[float, float, float, int]] = []  # what the verdict reads (:class:`Verdict`)
+        self.found: list[Unfit] = []  # what the verdict reads (:class:`Verdict`)
         # where the last bridge each way landed on the jaw (mm) and at which net rotation (rad); whether the jaw
         # is rolling back to leave through the other way's bridge, whose landing lies on the jaw's span where
         # the last one's did not, and whether it did so once already
@@ -159,7 +159,7 @@ class _Roller(JawReadings, Verdict):
             if stopped == "max_rotation":
                 # the budget ran out between two checks: the readings since the last one are judged as a
                 # check would judge them (a belief that became sure there is sure)
-                stopped = self._decide(belief, restart=False) or stopped
+                stopped = self._decide(belief) or stopped
         belief = self.belief
         if stopped != "mismatch":
             where = self._verdict(belief) if belief.consistent else None
@@ -395,29 +395,27 @@ class _Roller(JawReadings, Verdict):
         self.true_arcs.append(self.true_arc())
         self.segments.append(self.segment_base)
 
-    def _decide(self, belief: Belief, restart: bool = True) -> str | None:
-        """Whether ``belief`` ends the run: "mismatch" (sure on a part that showed something its model does
-        not have, or nothing fits and the filter may not start again), "confident", or None (counts the
-        checks sure in a row; or nothing fits, and the filter started again from the present contact when
-        ``restart``: the run rolls on)."""
+    def _start_again(self) -> None:
+        """Nothing on the part fits the readings (the true start pruned by a defect's readings before the fit
+        test found them): localize afresh from the present contact, and keep where the readings stopped
+        fitting for the verdict."""
+        # the last stretch found (the readings that then ruled every start out came over it or just after), as
+        # far as the jaw rolled in it; else all that was rolled. In rolled arc from here: the new filter's start
+        # places it on the model
+        rolled = self.arcs[self.since :]
+        misfits = self.flt.misfits
+        mm = misfits[-1].rms_mm if misfits else math.nan
+        if misfits:
+            t0, t1 = misfits[-1].travel
+            rolled = [a for a in rolled if t0 <= a <= t1] or [t0, t1]
+        self.found.append(Unfit(min(rolled) - self.z, max(rolled) - self.z, mm, len(self.left)))
+        self._afresh(self.d_prev)
+
+    def _decide(self, belief: Belief) -> str | None:
+        """Whether ``belief`` ends the run: "mismatch" (nothing fits, or sure on a part that showed
+        something its model does not have), "confident", or None (counts the checks sure in a row)."""
         if not belief.consistent:
-            # nothing on the part fits the readings (the true start pruned by a defect's readings before the fit
-            # test found them): localize afresh from here and say where it was. Spline parts only, as the leave:
-            # a drawing's corners and faces misfit of their own
-            if not (restart and self.judges_jumps) or len(self.found) >= MAX_RESTARTS:
-                return "mismatch"
-            # the last stretch found (the readings that then ruled every start out came over it or just after),
-            # as far as the jaw rolled in it; else all that was rolled. In rolled arc from here: the new
-            # filter's start places it on the model
-            rolled = self.arcs[self.since :]
-            misfits = self.flt.misfits
-            mm = misfits[-1].rms_mm if misfits else math.nan
-            if misfits:
-                t0, t1 = misfits[-1].travel
-                rolled = [a for a in rolled if t0 <= a <= t1] or [t0, t1]
-            self.found.append((min(rolled) - self.z, max(rolled) - self.z, mm, len(self.left)))
-            self._afresh(self.d_prev)
-            return None
+            return "mismatch"  # nothing on the part fits the readings: never sure
         self.sure = self.sure + 1 if belief.mass >= self.policy.confidence else 0
         if self.sure >= self.policy.confirm:
             # sure where it is, but never "sure" on a part that showed something its model does not have
@@ -448,8 +446,12 @@ class _Roller(JawReadings, Verdict):
                     "direction": self.direction,
                 }
             )
+        if not belief.consistent and self.judges_jumps and len(self.found) < MAX_RESTARTS:
+            # spline parts only, as the leave: a drawing's corners and faces misfit of their own
+            self._start_again()
+            return None
         decided = self._decide(belief)
-        if decided is not None or self.belief is None:  # stopped, or the filter started again from here
+        if decided is not None:
             return decided
         direction = self.direction
         # a concavity ahead for most of the belief: turn round before bridging it, if the other way

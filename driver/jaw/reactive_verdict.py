@@ -4,6 +4,7 @@ to leave what it sat on, a stretch before the filter started again, or a jump th
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -11,7 +12,17 @@ from localizer import Belief, ContactFilter
 
 from .reactive_policy import ReactivePolicy
 
-__all__ = ["Verdict"]
+__all__ = ["Unfit", "Verdict"]
+
+
+class Unfit(NamedTuple):
+    """Where the readings stopped fitting under a filter that ruled out every start, kept when the filter
+    starts again."""
+
+    lo: float  #: rolled arc from where the filter started again, mm (the stretch's first end)
+    hi: float  #: ... its second end, mm
+    mm: float  #: how far off the model the readings were there (RMS), mm; NaN when not known
+    leaves: int  #: how many jumps the jaw had rolled through to leave what it sat on, by then
 
 
 class Verdict:
@@ -21,9 +32,7 @@ class Verdict:
     policy: ReactivePolicy
     # the jumps rolled through to leave what the jaw sat on (direction, jump on the jaw mm)
     left: list[tuple[int, float]]
-    # where the readings stopped fitting under filters that ruled out every start: rolled arc from where the
-    # filter started again (mm, both ends), the misfit's size (mm) and how many jumps the jaw had left by then
-    found: list[tuple[float, float, float, int]]
+    found: list[Unfit]  # where the readings stopped fitting, each time the filter started again
     boxed: bool  # the jaw left a place boxed in by jumps the model explains (never sure after)
     unexplained: bool  # a jump no place of the model explains since the filter last started
     judges_jumps: bool  # a spline part: a drawing's corners and faces make jumps of their own
