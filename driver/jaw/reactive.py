@@ -27,6 +27,7 @@ from localizer import (
 from ..rig import DEVICE_FAULTS, Reading, Rig, RigError, Truth
 from .calibration import Calibration
 from .hand import PRESS, PressSettings, edge_offset, establish_contact
+from .reactive_moves import JawMoves
 from .reactive_policy import (
     BOXED_ROTATION,
     MAX_LEAVES,
@@ -38,8 +39,7 @@ from .reactive_policy import (
     information_by_direction,
     spread_by_direction,
 )
-from .reactive_sensing import JawReadings
-from .reactive_verdict import Unfit, Verdict
+from .reactive_verdict import Unfit
 
 __all__ = ["localize_reactively"]
 
@@ -80,7 +80,7 @@ def localize_reactively(
     return _Roller(rig, flt, calibration, policy, pressing, observer).run(approach_pose)
 
 
-class _Roller(JawReadings, Verdict):
+class _Roller(JawMoves):
     """One reactive localization: the hand, the filter, the counters and the traces it returns.
 
     :meth:`run` rolls step by step (:meth:`_step`); a step at the end of the jaw's span is a
@@ -132,6 +132,9 @@ class _Roller(JawReadings, Verdict):
         self.rotation_at_start = 0.0  # the rolled rotation when the present filter started, rad
         self.boxed = False  # left a place boxed in by jumps the model explains (:class:`Verdict`)
         self.rereads = 0  # readings taken again because one jumped
+        self.moved_from: tuple[tuple[float, float], float] | None = None  # what it met, before it moved on
+        self.moves = 0  # times the jaw moved on, blocked both ways after meeting something (:meth:`_move_on`)
+        self.away = 0  # the way it is moving on (+1, -1), 0 when it is not
 
     # ------------------------------------------------------------------ the run
     def run(self, approach_pose: Iterable[float]) -> ReactiveRun:
@@ -248,38 +251,6 @@ class _Roller(JawReadings, Verdict):
         fits = ok & (np.abs(step - arc) <= max(1.0, 0.1 * abs(arc)))
         return bool(w[fits].sum() > w[~ok].sum())
 
-    def _slid(self, slide: float) -> float:
-        """Lift the jaw by the policy's backoff, slide it ``slide`` mm along itself, press it back and read
-        where the contact is on it (mm; inf when the press was refused or the place cannot be read)."""
-        self.hand.press_by(-self.policy.backoff)
-        self.hand.slide_by(slide)
-        try:
-            return self.read_base() if self.pressed() else math.inf
-        except DEVICE_FAULTS:
-            raise
-        except RigError:
-            return math.inf
-
-    def _regrasp(self, d: float) -> tuple[float, bool, bool]:
-        """The contact reached the end of the jaw's span: lift, slide the jaw along itself so that the
-        contact comes back near the other end, put it back on the same point. Returns (the new place
-        on the jaw, regrasped, slid off: the slid jaw found another point, a bridge)."""
-        p = self.policy
-        target_d = -math.copysign(self.jaw_limit - 2 * p.end_margin, d)
-        slide = d - target_d
-        d_new = self._slid(slide)
-        if abs(d_new - target_d) <= p.bridge_jump:
-            self.turn = self.turn_now()
-            self.flt.regrasp(self.z, self.turn, d_new)
-            self.regrasps += 1
-            return d_new, True, False
-        # the longer reach of the slid jaw found another point: the stretch ends here on the hull;
-        # put the jaw back and treat it as a bridge
-        self.hand.press_by(-p.backoff)
-        self.hand.slide_by(-slide)
-        self.pressed()
-        return d, False, True
-
     def _undo_bridge(self, s: float, slid_off: bool, d: float) -> str | None:
         """The step bridged a concavity: roll back, re-read, and go the other way ("lost" or "blocked"
         when that is not possible). A jump no place of the belief predicted, once both ways are blocked,
@@ -329,87 +300,10 @@ class _Roller(JawReadings, Verdict):
                     self.reversals += 1
                     return None
                 return self._leave(s, d - self.d_prev)
-            return "blocked"
+            return self._move_on(s, d)
         self.direction = -self.direction
         self.reversals += 1
         return None
-
-    def _leave(self, s: float, jump: float) -> str | None:
-        """Blocked both ways by jumps the model does not explain (the jaw sits on a burr, or between a dent's
-        rims): roll through the jump of ``jump`` mm on the jaw and localize afresh from where it lands. The
-        readings so far came from something that is not the part's model; the filter starts again there,
-        and the run ends "mismatch" whatever it finds (:meth:`_verdict`)."""
-        p = self.policy
-        if abs(self.d_prev + jump) > self.jaw_limit:
-            # the contact would land beyond the jaw's calibrated span: slide the jaw along itself first. On a
-            # burr's crest the slid jaw's longer reach may touch the part beyond it instead (the slide is then
-            # undone): roll through as it is, and slide the jaw from where the contact lands
-            d_new, regrasped, _ = self._regrasp(self.d_prev)
-            if regrasped:
-                self.d_prev = d_new
-        self.hand.rotate_by(s)
-        self.rotation += p.step
-        try:
-            if not self.pressed():
-                raise RigError("the press beyond the jump was refused")
-            d = self.read_base()
-        except DEVICE_FAULTS:
-            raise
-        except RigError:
-            return "lost"
-        if abs(d) > self.jaw_limit:
-            # landed at the jaw's end (its tip may be what touches): slide the jaw along itself and start
-            # afresh from whatever point of the part it then touches (the filter starts again anyway)
-            target = -math.copysign(self.jaw_limit - 2 * p.end_margin, d)
-            d = self._slid(d - target)
-            if not abs(d) <= self.jaw_limit:
-                return "lost"
-            # the contact moved on along the part by about as much as it moved from the target on the jaw:
-            # where the jaw left the model behind is that much further back
-            jump = math.copysign(abs(jump) + abs(d - target), jump)
-        self.left.append((self.direction, float(jump)))
-        self._afresh(d)
-        return None
-
-    def _afresh(self, d: float) -> None:
-        """Start the filter again from the present contact, ``d`` mm on the jaw: what came before is not
-        the part's model (the jaw rolled through a jump it does not explain, or nothing on it fits)."""
-        flt = self.flt
-        self.segment_base += flt.segment + 1
-        flt.reset()
-        flt.touch(d)
-        self.phi0 = self.hand.measured_angle()
-        self.z = self.turn = 0.0
-        self.d_prev = d
-        self.explored = [0.0, 0.0]
-        self.blocked = {1: False, -1: False}
-        self.landed = {}
-        self.rolling_back = False
-        self.unexplained = False
-        self.belief = None
-        self.sure = 0
-        self.since = len(self.arcs)
-        self.rotation_at_start = self.rotation
-        self.arcs.append(self.z)
-        self.turns.append(self.turn)
-        self.true_arcs.append(self.true_arc())
-        self.segments.append(self.segment_base)
-
-    def _start_again(self) -> None:
-        """Nothing on the part fits the readings (the true start pruned by a defect's readings before the fit
-        test found them): localize afresh from the present contact, and keep where the readings stopped
-        fitting for the verdict."""
-        # the last stretch found (the readings that then ruled every start out came over it or just after), as
-        # far as the jaw rolled in it; else all that was rolled. In rolled arc from here: the new filter's start
-        # places it on the model
-        rolled = self.arcs[self.since :]
-        misfits = self.flt.misfits
-        mm = misfits[-1].rms_mm if misfits else math.nan
-        if misfits:
-            t0, t1 = misfits[-1].travel
-            rolled = [a for a in rolled if t0 <= a <= t1] or [t0, t1]
-        self.found.append(Unfit(min(rolled) - self.z, max(rolled) - self.z, mm, len(self.left)))
-        self._afresh(self.d_prev)
 
     def _decide(self, belief: Belief) -> str | None:
         """Whether ``belief`` ends the run: "mismatch" (nothing fits, or sure on a part that showed

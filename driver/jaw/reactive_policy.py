@@ -42,7 +42,11 @@ simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactive
    the readings any more (a defect's readings ruled the true start out before the fit test found them), the
    filter starts again once from the present contact. Blocked both ways within ``BOXED_ROTATION`` of where
    the filter started, by jumps the model explains, the jaw leaves as from a burr all the same (no run
-   on a part that is its model is boxed in so soon); and a run that met something
+   on a part that is its model is boxed in so soon). Blocked both ways and not sure, in a run that met
+   something its model does not have, with ``MOVE_BUDGET`` of the budget left, the jaw moves on once:
+   through the jump away from what it met (the way it left, or away from the stretch that stopped
+   fitting; rolling back to that jump first), and the filter starts afresh beyond it (where the move
+   fails the jaw is put back and the run ends blocked); and a run that met something
    the model does not have (a stretch the filter quarantined, a jump rolled through, one the final place
    does not explain) ends "mismatch", saying where, never "confident".
 
@@ -75,6 +79,8 @@ __all__ = [
     "MAX_LEAVES",
     "MAX_RESTARTS",
     "BOXED_ROTATION",
+    "MAX_MOVES",
+    "MOVE_BUDGET",
     "MAX_ROTATION",
     "ReactiveRun",
     "spread_by_direction",
@@ -101,6 +107,12 @@ MAX_RESTARTS = 1
 #: Boxed in: blocked both ways, by jumps the model explains, within this much rolled rotation of where the
 #: filter started (rad). The jaw then leaves as from a burr (rule 8), and the run never ends "confident".
 BOXED_ROTATION = math.radians(45.0)
+
+#: Blocked both ways, not sure, in a run that met something its model does not have, with at least
+#: ``MOVE_BUDGET`` of the rotation budget left: the jaw moves on once, through the jump away from what it
+#: met, and the filter starts afresh there (rule 8); the run stays "mismatch", never "confident".
+MAX_MOVES = 1
+MOVE_BUDGET = math.radians(60.0)
 
 
 #: Budget of rolled rotation, both directions counted, rad (the command line's and the studies' too).

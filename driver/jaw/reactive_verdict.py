@@ -35,6 +35,7 @@ class Verdict:
     found: list[Unfit]  # where the readings stopped fitting, each time the filter started again
     boxed: bool  # the jaw left a place boxed in by jumps the model explains (never sure after)
     unexplained: bool  # a jump no place of the model explains since the filter last started
+    moved_from: tuple[tuple[float, float], float] | None  # what it met, before it moved on (see reactive)
     judges_jumps: bool  # a spline part: a drawing's corners and faces make jumps of their own
 
     def _verdict(self, belief: Belief) -> tuple[tuple[float, float], float] | None:
@@ -46,6 +47,8 @@ class Verdict:
         flt = self.flt
         if belief.mismatch is not None or not belief.consistent or flt.ruled_out:
             return None if belief.mismatch is None else (belief.mismatch, belief.mismatch_mm)
+        if self.moved_from is not None:  # what it met before it moved on, where the belief of then put it
+            return self.moved_from
         start = int(np.argmax(flt.posterior()))
         part = flt.part
         if self.found:

@@ -65,3 +65,30 @@ def test_a_jaw_boxed_in_by_jumps_the_model_explains_soon_after_its_start_leaves_
     assert row["reactive_stopped"] == "mismatch"
     lo, hi = map(float, row["reactive_mismatch_arc"].split("-"))
     assert lo <= float(row["world_defect_arc"]) <= hi
+
+
+def test_a_jaw_blocked_both_ways_after_it_left_a_burr_moves_on_and_localizes_there():
+    # the tuning family, a 0.3 x 4 mm burr 4.4 mm ahead of the start on a star: the jaw leaves the burr and is
+    # blocked both ways again, by the burr and by the star's next concavity, with a belief of 0.54 that ended
+    # the run 0.32 mm off at 101 degrees. It moves on through the concavity away from the burr, localizes
+    # afresh there with the budget left and is right; the stretch it reports is where the belief before the
+    # move put the burr
+    row = run_trial(TrialSpec(load_study(STUDIES / "world-tuning.toml"), 0, 20))
+    assert row["reactive_stopped"] == "mismatch" and row["reactive_success"] == 1
+    assert row["reactive_rotation_deg"] > 120.0
+    assert reported_near_the_defect(row)
+
+
+def test_a_move_on_that_fails_puts_the_jaw_back_where_it_was_blocked(monkeypatch):
+    # the tuning family with a bump or dent, a 0.31 mm bump 2.8 mm ahead of the start on a star: blocked both
+    # ways after leaving it, the jaw moves on, lands at its end, and slid along itself finds no contact on its
+    # span. The jaw is put back and the run ends on the belief it had there, as it ends without moving on; it
+    # ended "lost", 131 mm off, before the jaw was put back
+    study = load_study(STUDIES / "world-tuning-defect.toml")
+    row = run_trial(TrialSpec(study, 0, 42))
+    monkeypatch.setattr("driver.jaw.reactive_moves.MAX_MOVES", 0)
+    unmoved = run_trial(TrialSpec(study, 0, 42))
+    assert row["reactive_stopped"] == unmoved["reactive_stopped"] == "mismatch"
+    assert row["reactive_rotation_deg"] > unmoved["reactive_rotation_deg"]  # it tried
+    assert abs(row["reactive_error_mm"] - unmoved["reactive_error_mm"]) < 0.05
+    assert row["reactive_mismatch_arc"] == unmoved["reactive_mismatch_arc"]
