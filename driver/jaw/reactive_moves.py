@@ -102,8 +102,8 @@ class JawMoves(JawReadings, Verdict):
         self.moved_from = self._verdict(belief) or ((math.nan, math.nan), math.nan)
         if self.left:
             away = self.left[-1][0]
-        else:
-            lo, hi = self.flt.misfits[-1].travel
+        else:  # away from the stretch that stopped fitting: the present filter's, else the one it started again past
+            lo, hi = self.flt.misfits[-1].travel if self.flt.misfits else self.found[-1][:2]
             away = 1 if self.z >= 0.5 * (lo + hi) else -1
         if away == self.direction and math.isfinite(d):
             return self._leave(s, d - self.d_prev, moving=True)

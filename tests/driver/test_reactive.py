@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from driver.jaw import (
+    REACTIVE_POLICY,
     ReactivePolicy,
     calibrate,
     calibrate_simulated,
@@ -431,3 +432,37 @@ def test_a_spike_of_the_wrist_is_read_again_and_not_taken(kidney):
         policy=ReactivePolicy(reread_jump=math.inf),
     )
     assert run.stopped != "confident"
+
+
+@pytest.mark.parametrize(
+    ("left", "misfits", "found", "away"),
+    [
+        ([(-1, 3.0)], [(1.0, 4.0)], [], -1),  # the way it left a jump, whatever stretch the filter found since
+        ([], [(-6.0, -2.0)], [], 1),  # away from the present filter's stretch that stopped fitting
+        ([], [(8.0, 12.0)], [], -1),
+        ([], [], [(-4.0, -1.0)], 1),  # ... else from the stretch it started its filter again past
+    ],
+)
+def test_moving_on_goes_away_from_what_the_run_met(left, misfits, found, away):
+    from types import SimpleNamespace
+
+    from driver.jaw.reactive_moves import JawMoves
+    from driver.jaw.reactive_verdict import Unfit
+
+    moves = object.__new__(JawMoves)  # the moves' own state, without a rig: blocked going the way ``away`` is not
+    moves.flt = SimpleNamespace(
+        misfits=[SimpleNamespace(travel=t) for t in misfits],
+        belief=lambda: SimpleNamespace(consistent=True, mass=0.4),
+    )
+    moves.policy = REACTIVE_POLICY
+    moves.left, moves.found = left, [Unfit(lo, hi, 0.2, 0) for lo, hi in found]
+    moves.z, moves.direction, moves.rotation = 3.0, -away, math.radians(30.0)
+    moves.moves = moves.away = moves.reversals = 0
+    moves.judges_jumps, moves.moved_from = True, None
+    moves._verdict = lambda belief: None
+    assert moves._move_on(math.radians(0.2), 1.0) is None  # turned round, to leave through that way's jump
+    assert moves.away == moves.direction == away and moves.moves == 1 and moves.reversals == 1
+    assert all(math.isnan(v) for v in (*moves.moved_from[0], moves.moved_from[1]))  # nowhere it could tell
+    moves.rotation = moves.policy.max_rotation - math.radians(10.0)
+    moves.moves, moves.away = 0, 0
+    assert moves._move_on(math.radians(0.2), 1.0) == "blocked"  # too little budget left to localize afresh
