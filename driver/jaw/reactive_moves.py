@@ -181,6 +181,7 @@ class JawMoves(JawReadings, Verdict):
         self.blocked = {1: False, -1: False}
         self.landed = {}
         self.rolling_back = False
+        self.away = 0  # whatever moved the jaw on, it left: a move that was heading for its jump is done
         self.unexplained = False
         self.belief = None
         self.sure = 0
