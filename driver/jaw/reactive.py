@@ -39,7 +39,7 @@ from .reactive_policy import (
     information_by_direction,
     spread_by_direction,
 )
-from .reactive_verdict import Unfit
+from .reactive_verdict import Moved, Unfit
 
 __all__ = ["localize_reactively"]
 
@@ -133,6 +133,7 @@ class _Roller(JawMoves):
         self.boxed = False  # left a place boxed in by jumps the model explains (:class:`Verdict`)
         self.rereads = 0  # readings taken again because one jumped
         self.moved_from: tuple[tuple[float, float], float] | None = None  # what it met, before it moved on
+        self.moved: Moved | None = None  # ... measured from where the jaw took off
         self.moves = 0  # times the jaw moved on, blocked both ways after meeting something (:meth:`_move_on`)
         self.away = 0  # the way it is moving on (+1, -1), 0 when it is not
 
@@ -282,7 +283,8 @@ class _Roller(JawMoves):
             # jumps it explains, within BOXED_ROTATION of where the filter started: no run on a part that is its
             # model is boxed in that soon, a burr's crest boxes it in often
             boxed = self.rotation - self.rotation_at_start <= BOXED_ROTATION
-            if self.judges_jumps and (self.unexplained or boxed) and len(self.left) < MAX_LEAVES and math.isfinite(d):
+            leave = self.judges_jumps and (self.unexplained or boxed) and len(self.left) < MAX_LEAVES
+            if leave and not self.away and math.isfinite(d):  # (a jaw moving on leaves by its own way)
                 self.boxed = self.boxed or not self.unexplained
                 other = self.landed.get(-self.direction, (math.inf, 0.0))[0]
                 if abs(d) > self.jaw_limit and abs(other) <= self.jaw_limit and not self.rolled_back:

@@ -12,7 +12,7 @@ from localizer import Belief
 from ..rig import DEVICE_FAULTS, RigError
 from .reactive_policy import MAX_MOVES, MOVE_BUDGET
 from .reactive_sensing import JawReadings
-from .reactive_verdict import Unfit, Verdict
+from .reactive_verdict import Moved, Unfit, Verdict
 
 __all__ = ["JawMoves"]
 
@@ -89,26 +89,25 @@ class JawMoves(JawReadings, Verdict):
             return self._leave(s, d - self.d_prev, moving=True)
         met = bool(self.left or self.found or self.flt.misfits)
         belief = self.flt.belief()
-        if not (
-            self.judges_jumps
-            and met
-            and self.moves < MAX_MOVES
-            and p.max_rotation - self.rotation >= MOVE_BUDGET
-            and belief.consistent
-            and belief.mass < p.confidence
-        ):
+        sure = belief.mass >= p.confidence
+        if not (self.judges_jumps and met and self.moves < MAX_MOVES and belief.consistent) or sure:
             return "blocked"
-        self.moves += 1
-        self.moved_from = self._verdict(belief) or ((math.nan, math.nan), math.nan)
         if self.left:
             away = self.left[-1][0]
         else:  # away from the stretch that stopped fitting: the present filter's, else the one it started again past
             lo, hi = self.flt.misfits[-1].travel if self.flt.misfits else self.found[-1][:2]
             away = 1 if self.z >= 0.5 * (lo + hi) else -1
-        if away == self.direction and math.isfinite(d):
+        # the budget left when it decides (the way back to the other way's jump not counted: on the tuning family
+        # counting it stopped two runs that were wrong, and were right after moving on)
+        if p.max_rotation - self.rotation < MOVE_BUDGET or (away == self.direction and not math.isfinite(d)):
+            return "blocked"
+        self.moves += 1
+        self.moved_from = self._verdict(belief) or ((math.nan, math.nan), math.nan)
+        if away == self.direction:
             return self._leave(s, d - self.d_prev, moving=True)
         self.away = away
         self.direction = away
+        self.rolling_back = False  # heading for that jump, not back from it
         self.reversals += 1
         return None
 
@@ -147,15 +146,40 @@ class JawMoves(JawReadings, Verdict):
             # the contact moved on along the part by about as much as it moved from the target on the jaw:
             # where the jaw left the model behind is that much further back
             jump = math.copysign(abs(jump) + abs(d - target), jump)
+        if moving:
+            met = self._met()
+            if met is not None:
+                self.moved = Moved(met[0] - self.z, met[1] - self.z, met[2], self.direction, float(jump))
         self.left.append((self.direction, float(jump)))
         self._afresh(d)
         return None
 
+    def _met(self) -> tuple[float, float, float] | None:
+        """What the run met, in the present filter's rolled arc (mm, its two ends) and how far off the model (mm,
+        NaN when not known), in the order the verdict reports it: the stretch the fit test found, the stretch
+        the filter started again past, the stretch behind the jump the jaw left by; None when none."""
+        rolled = self.arcs[self.since :]
+        if self.flt.misfits:
+            misfit = self.flt.misfits[0]
+            t0, t1 = misfit.travel
+            inside = [a for a in rolled if t0 <= a <= t1] or [t0, t1]
+            return min(inside), max(inside), misfit.rms_mm
+        if self.found and self.found[-1].leaves == len(self.left):
+            return self.found[-1].lo, self.found[-1].hi, self.found[-1].mm
+        if self.left:
+            direction, jump = self.left[-1]
+            behind = -direction * (abs(jump) + 1.0)
+            return min(behind, 0.0), max(behind, 0.0), abs(jump)
+        return None
+
     def _put_back(self, pose: tuple[float, ...]) -> str:
         """Moving on failed: lift the jaw, put it back at ``pose`` (where it was blocked both ways) and press;
-        the run ends "blocked" on the belief it had there ("lost" where that press is refused too)."""
+        the run ends "blocked" on the belief it had there, as it would have without trying ("lost" where that
+        press is refused too)."""
+        self.moved_from = self.moved = None  # it did not move on: the run ends as it would have without trying
         self.hand.press_by(-self.policy.backoff)
         self.hand.go(*pose)
+        self.rotation += self.policy.step  # the turn the leave made, back
         try:
             if not self.pressed():
                 return "lost"

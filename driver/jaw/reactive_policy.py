@@ -46,9 +46,10 @@ simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactive
    something its model does not have, with ``MOVE_BUDGET`` of the budget left, the jaw moves on once:
    through the jump away from what it met (the way it left, or away from the stretch that stopped
    fitting; rolling back to that jump first), and the filter starts afresh beyond it (where the move
-   fails the jaw is put back and the run ends blocked); and a run that met something
-   the model does not have (a stretch the filter quarantined, a jump rolled through, one the final place
-   does not explain) ends "mismatch", saying where, never "confident".
+   fails the jaw is put back and the run ends as if it had not tried); what it met is reported from
+   where the jaw took off, placed by the belief it ends with. A run that met something the model does
+   not have (a stretch the filter quarantined, a jump rolled through, one the final place does not
+   explain) ends "mismatch", saying where, never "confident".
 
 Works on any :class:`driver.rig.Rig` (simulated or serial).
 """

@@ -8,11 +8,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from localizer import Belief, ContactFilter
+from localizer import Belief, Boundary, ContactFilter
 
 from .reactive_policy import ReactivePolicy
 
-__all__ = ["Unfit", "Verdict"]
+__all__ = ["Unfit", "Moved", "takeoff_arc", "Verdict"]
 
 
 class Unfit(NamedTuple):
@@ -23,6 +23,49 @@ class Unfit(NamedTuple):
     hi: float  #: ... its second end, mm
     mm: float  #: how far off the model the readings were there (RMS), mm; NaN when not known
     leaves: int  #: how many jumps the jaw had rolled through to leave what it sat on, by then
+
+
+class Moved(NamedTuple):
+    """What a run met before it moved on (:mod:`driver.jaw.reactive_moves`), measured from where the jaw rolled
+    through the jump it moved on by, to be placed by the belief it ends with."""
+
+    lo: float  #: rolled arc from where the jaw took off, mm (the stretch's first end)
+    hi: float  #: ... its second end, mm
+    mm: float  #: how far off the model it was, mm; NaN when not known
+    direction: int  #: the way the jaw rolled through the jump
+    jump: float  #: the jump on the jaw, mm
+
+
+#: How near the jaw's line at the landing the point it took off from must lie, mm, and how far the distance
+#: along that line may be from the jump the jaw read, mm (a 0.2° step turns the line by 3.5 mrad: 0.1 mm over
+#: 30 mm; the jump read is the places on the jaw of two presses)
+TAKEOFF_OFF = 0.5
+TAKEOFF_ALONG = 3.0
+
+
+def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> float | None:
+    """Where on ``part`` the jaw took off (arc, mm) when, rolling ``direction`` (+1: arc increasing), it jumped
+    ``jump`` mm along itself to land at arc ``landing``: the point behind the landing on the jaw's line there
+    (the tangent at the landing), about ``|jump|`` mm from it along the line, where the line touches the model.
+    None where the model does not touch that line within ``TAKEOFF_OFF`` so far along it (the landing is not
+    where the model has such a jump)."""
+    P = part.perimeter
+    theta = float(part.tangent_angle_at_arc(landing))
+    tangent = np.array([math.cos(theta), math.sin(theta)])
+    outward = np.array([tangent[1], -tangent[0]])  # counter-clockwise outline: the outside on the right
+    back = landing - direction * np.arange(0.25, 0.5 * P, 0.05)
+    rel = np.asarray(part.point_at_arc(part.wrap_arc(back))) - np.asarray(part.point_at_arc(landing))
+    along, off = rel @ tangent, rel @ outward
+    near = np.flatnonzero((np.abs(np.abs(along) - abs(jump)) <= TAKEOFF_ALONG) & (along * direction < 0))
+    if near.size == 0:
+        return None
+    best = near[np.argmax(off[near])]
+    # the line touches the model there (the nearest of the points about it, not the nearest of a stretch the
+    # line only cuts: a convex stretch behind the landing falls away from the line further back)
+    touches = best - 1 in near and best + 1 in near
+    if not (touches and off[best] >= -TAKEOFF_OFF):
+        return None
+    return float(part.wrap_arc(back[best]))
 
 
 class Verdict:
@@ -36,6 +79,7 @@ class Verdict:
     boxed: bool  # the jaw left a place boxed in by jumps the model explains (never sure after)
     unexplained: bool  # a jump no place of the model explains since the filter last started
     moved_from: tuple[tuple[float, float], float] | None  # what it met, before it moved on (see reactive)
+    moved: Moved | None  # ... measured from where the jaw took off when it moved on
     judges_jumps: bool  # a spline part: a drawing's corners and faces make jumps of their own
 
     def _verdict(self, belief: Belief) -> tuple[tuple[float, float], float] | None:
@@ -47,10 +91,19 @@ class Verdict:
         flt = self.flt
         if belief.mismatch is not None or not belief.consistent or flt.ruled_out:
             return None if belief.mismatch is None else (belief.mismatch, belief.mismatch_mm)
-        if self.moved_from is not None:  # what it met before it moved on, where the belief of then put it
-            return self.moved_from
         start = int(np.argmax(flt.posterior()))
         part = flt.part
+        if self.moved_from is not None:
+            # what it met before it moved on: from where the jaw took off, under the belief it ends with, where that
+            # places it; else where the belief before the move put it
+            takeoff = None
+            if self.moved is not None and belief.mass >= 0.5:
+                m = self.moved
+                takeoff = takeoff_arc(part, float(flt.grid[start]), m.direction, m.jump)
+            if takeoff is None or self.moved is None:
+                return self.moved_from
+            ends = part.wrap_arc(np.array([takeoff + self.moved.lo, takeoff + self.moved.hi]))
+            return (float(ends[0]), float(ends[1])), self.moved.mm
         if self.found:
             lo, hi, mm, leaves = self.found[0]
             if leaves == len(self.left):  # measured from where the present filter started

@@ -434,6 +434,7 @@ def test_a_spike_of_the_wrist_is_read_again_and_not_taken(kidney):
     assert run.stopped != "confident"
 
 
+@pytest.mark.parametrize("blocked_going", [1, -1])
 @pytest.mark.parametrize(
     ("left", "misfits", "found", "away"),
     [
@@ -443,26 +444,63 @@ def test_a_spike_of_the_wrist_is_read_again_and_not_taken(kidney):
         ([], [], [(-4.0, -1.0)], 1),  # ... else from the stretch it started its filter again past
     ],
 )
-def test_moving_on_goes_away_from_what_the_run_met(left, misfits, found, away):
+def test_moving_on_goes_away_from_what_the_run_met(monkeypatch, left, misfits, found, away, blocked_going):
     from types import SimpleNamespace
 
     from driver.jaw.reactive_moves import JawMoves
     from driver.jaw.reactive_verdict import Unfit
 
-    moves = object.__new__(JawMoves)  # the moves' own state, without a rig: blocked going the way ``away`` is not
+    leaves = []
+    monkeypatch.setattr(JawMoves, "_leave", lambda self, s, jump, moving=False: leaves.append((s, jump, moving)))
+    moves = object.__new__(JawMoves)  # the moves' own state, without a rig
     moves.flt = SimpleNamespace(
         misfits=[SimpleNamespace(travel=t) for t in misfits],
         belief=lambda: SimpleNamespace(consistent=True, mass=0.4),
     )
     moves.policy = REACTIVE_POLICY
     moves.left, moves.found = left, [Unfit(lo, hi, 0.2, 0) for lo, hi in found]
-    moves.z, moves.direction, moves.rotation = 3.0, -away, math.radians(30.0)
+    moves.z, moves.d_prev, moves.direction = 3.0, -5.0, blocked_going
+    moves.rotation, moves.explored = math.radians(30.0), [math.radians(-10.0), math.radians(20.0)]
     moves.moves = moves.away = moves.reversals = 0
-    moves.judges_jumps, moves.moved_from = True, None
+    moves.judges_jumps, moves.moved_from, moves.rolling_back = True, None, False
     moves._verdict = lambda belief: None
-    assert moves._move_on(math.radians(0.2), 1.0) is None  # turned round, to leave through that way's jump
-    assert moves.away == moves.direction == away and moves.moves == 1 and moves.reversals == 1
-    assert all(math.isnan(v) for v in (*moves.moved_from[0], moves.moved_from[1]))  # nowhere it could tell
-    moves.rotation = moves.policy.max_rotation - math.radians(10.0)
-    moves.moves, moves.away = 0, 0
-    assert moves._move_on(math.radians(0.2), 1.0) == "blocked"  # too little budget left to localize afresh
+    step = math.radians(0.2)
+    moves._move_on(step, 1.0)
+    assert moves.moves == 1 and all(math.isnan(v) for v in (*moves.moved_from[0], moves.moved_from[1]))
+    if blocked_going == away:  # through the jump just met, at once
+        assert leaves == [(step, 6.0, True)] and moves.reversals == 0 and moves.away == 0
+    else:  # turned round, to leave through that way's jump when it comes
+        assert leaves == [] and moves.away == moves.direction == away and moves.reversals == 1
+    # too little budget left to localize afresh
+    moves.moves = moves.away = 0
+    moves.direction = blocked_going
+    moves.rotation = moves.policy.max_rotation - math.radians(55.0)
+    assert moves._move_on(step, 1.0) == "blocked" and moves.moves == 0
+
+
+def test_where_the_jaw_took_off_is_the_other_end_of_the_hull_edge_it_landed_by():
+    # the trefoil's three concavities bridged: the edges of the convex hull of a dense sampling of the outline
+    # (scipy's, an independent reference) that span more arc than their chord are the jaw's lines across
+    # them; landing at one end after rolling towards it, the jaw took off from the other
+    from scipy.spatial import ConvexHull
+
+    from driver.jaw.reactive_verdict import takeoff_arc
+
+    part = load_part(PARTS / "trefoil.json")
+    arcs = np.arange(0.0, part.perimeter, 0.02)
+    xy = part.point_at_arc(arcs)
+    hull = np.sort(ConvexHull(xy).vertices)
+    gaps = np.diff(np.r_[arcs[hull], arcs[hull[0]] + part.perimeter])
+    chords = np.linalg.norm(xy[np.roll(hull, -1)] - xy[hull], axis=1)
+    bridges = np.flatnonzero(gaps > chords + 0.05)
+    assert bridges.size == 3
+    for i in bridges:
+        a, b = arcs[hull[i]], arcs[hull[(i + 1) % hull.size]]
+        jump = float(chords[i])
+        assert abs(part.arc_offset(takeoff_arc(part, b, 1, jump), a)) < 0.3
+        assert abs(part.arc_offset(takeoff_arc(part, a, -1, -jump), b)) < 0.3
+        # a jump the model does not have there: nothing on the jaw's line that far back
+        assert takeoff_arc(part, b, 1, jump + 10.0) is None
+    # on a stretch of the hull itself, no point of the model lies on the tangent line behind it
+    convex = arcs[hull[int(np.argmax(np.where(gaps > chords + 0.05, 0.0, gaps)))]]
+    assert takeoff_arc(part, convex, 1, 8.0) is None
