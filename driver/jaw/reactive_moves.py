@@ -158,11 +158,9 @@ class JawMoves(JawReadings, Verdict):
         """What the run met, in the present filter's rolled arc (mm, its two ends) and how far off the model (mm,
         NaN when not known), in the order the verdict reports it: the stretch the fit test found, the stretch
         the filter started again past, the stretch behind the jump the jaw left by; None when none."""
-        rolled = self.arcs[self.since :]
         if self.flt.misfits:
             misfit = self.flt.misfits[0]
-            t0, t1 = misfit.travel
-            inside = [a for a in rolled if t0 <= a <= t1] or [t0, t1]
+            inside = self._rolled_in(misfit.travel)
             return min(inside), max(inside), misfit.rms_mm
         if self.found and self.found[-1].leaves == len(self.left):
             return self.found[-1].lo, self.found[-1].hi, self.found[-1].mm
@@ -171,6 +169,12 @@ class JawMoves(JawReadings, Verdict):
             behind = -direction * (abs(jump) + 1.0)
             return min(behind, 0.0), max(behind, 0.0), abs(jump)
         return None
+
+    def _rolled_in(self, travel: tuple[float, float]) -> list[float]:
+        """The present filter's readings' rolled arcs (mm) within ``travel`` (a stretch the fit test found), or
+        its two ends where the jaw took no reading in it."""
+        t0, t1 = travel
+        return [a for a in self.arcs[self.since :] if t0 <= a <= t1] or [t0, t1]
 
     def _put_back(self, pose: tuple[float, ...]) -> str:
         """Moving on failed: lift the jaw, put it back at ``pose`` (where it was blocked both ways) and press;
@@ -223,11 +227,8 @@ class JawMoves(JawReadings, Verdict):
         # the last stretch found (the readings that then ruled every start out came over it or just after), as
         # far as the jaw rolled in it; else all that was rolled. In rolled arc from here: the new filter's start
         # places it on the model
-        rolled = self.arcs[self.since :]
         misfits = self.flt.misfits
         mm = misfits[-1].rms_mm if misfits else math.nan
-        if misfits:
-            t0, t1 = misfits[-1].travel
-            rolled = [a for a in rolled if t0 <= a <= t1] or [t0, t1]
+        rolled = self._rolled_in(misfits[-1].travel) if misfits else self.arcs[self.since :]
         self.found.append(Unfit(min(rolled) - self.z, max(rolled) - self.z, mm, len(self.left)))
         self._afresh(self.d_prev)
