@@ -149,7 +149,9 @@ class JawMoves(JawReadings, Verdict):
         if moving:
             met = self._met()
             if met is not None:
-                self.moved = Moved(met[0] - self.z, met[1] - self.z, met[2], self.direction, float(jump))
+                self.moved = Moved(
+                    met[0] - self.z, met[1] - self.z, met[2], self.direction, float(jump), len(self.found)
+                )
         self.left.append((self.direction, float(jump)))
         self._afresh(d)
         return None

@@ -34,21 +34,25 @@ class Moved(NamedTuple):
     mm: float  #: how far off the model it was, mm; NaN when not known
     direction: int  #: the way the jaw rolled through the jump
     jump: float  #: the jump on the jaw, mm
+    restarts: int  #: how many times the filter had started again where nothing fit, by then
 
 
 #: How near the jaw's line at the landing the point it took off from must lie, mm, and how far the distance
 #: along that line may be from the jump the jaw read, mm (a 0.2° step turns the line by 3.5 mrad: 0.1 mm over
-#: 30 mm; the jump read is the places on the jaw of two presses)
+#: 30 mm; the jump read is the places on the jaw of two presses), and a most probable landing a little off the
+#: true one tilts the line by up to ``TAKEOFF_TILT`` rad more, either way (a line the model crosses further out,
+#: or passes further in, is not the jaw's)
 TAKEOFF_OFF = 0.5
 TAKEOFF_ALONG = 3.0
+TAKEOFF_TILT = math.radians(5.0)
 
 
 def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> float | None:
     """Where on ``part`` the jaw took off (arc, mm) when, rolling ``direction`` (+1: arc increasing), it jumped
     ``jump`` mm along itself to land at arc ``landing``: the point behind the landing on the jaw's line there
     (the tangent at the landing), about ``|jump|`` mm from it along the line, where the line touches the model.
-    None where the model does not touch that line within ``TAKEOFF_OFF`` so far along it (the landing is not
-    where the model has such a jump)."""
+    None where the model does not touch that line so far along it (within ``TAKEOFF_OFF`` and the tilt of
+    ``TAKEOFF_TILT`` over the jump: the landing is not where the model has such a jump)."""
     P = part.perimeter
     theta = float(part.tangent_angle_at_arc(landing))
     tangent = np.array([math.cos(theta), math.sin(theta)])
@@ -63,7 +67,7 @@ def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> 
     # the line touches the model there (the nearest of the points about it, not the nearest of a stretch the
     # line only cuts: a convex stretch behind the landing falls away from the line further back)
     touches = best - 1 in near and best + 1 in near
-    if not (touches and off[best] >= -TAKEOFF_OFF):
+    if not (touches and abs(off[best]) <= TAKEOFF_OFF + abs(jump) * math.tan(TAKEOFF_TILT)):
         return None
     return float(part.wrap_arc(back[best]))
 
@@ -97,8 +101,9 @@ class Verdict:
             # what it met before it moved on: from where the jaw took off, under the belief it ends with, where that
             # places it; else where the belief before the move put it
             takeoff = None
-            if self.moved is not None and belief.mass >= 0.5:
-                m = self.moved
+            m = self.moved
+            # the present filter started where the jaw landed (not again, past a stretch nothing fit)
+            if m is not None and m.restarts == len(self.found) and belief.mass >= 0.5:
                 takeoff = takeoff_arc(part, float(flt.grid[start]), m.direction, m.jump)
             if takeoff is None or self.moved is None:
                 return self.moved_from

@@ -501,6 +501,11 @@ def test_where_the_jaw_took_off_is_the_other_end_of_the_hull_edge_it_landed_by()
         assert abs(part.arc_offset(takeoff_arc(part, a, -1, -jump), b)) < 0.3
         # a jump the model does not have there: nothing on the jaw's line that far back
         assert takeoff_arc(part, b, 1, jump + 10.0) is None
+        # a most probable landing 1 mm off the true one: the jaw's line tilts, the takeoff is still found
+        for landing in (b - 1.0, b + 1.0):
+            assert abs(part.arc_offset(takeoff_arc(part, landing, 1, jump), a)) < 2.0
+    # a line the model crosses (the takeoff it would give lies 18 mm outside it): not the jaw's
+    assert takeoff_arc(part, 66.1, 1, 40.0) is None
     # on a stretch of the hull itself, no point of the model lies on the tangent line behind it
     convex = arcs[hull[int(np.argmax(np.where(gaps > chords + 0.05, 0.0, gaps)))]]
     assert takeoff_arc(part, convex, 1, 8.0) is None
