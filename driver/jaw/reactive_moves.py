@@ -12,7 +12,7 @@ from localizer import Belief
 from ..rig import DEVICE_FAULTS, RigError
 from .reactive_policy import MAX_MOVES, MOVE_BUDGET
 from .reactive_sensing import JawReadings
-from .reactive_verdict import Moved, Unfit, Verdict
+from .reactive_verdict import Moved, Unfit, Verdict, behind_jump
 
 __all__ = ["JawMoves"]
 
@@ -168,8 +168,7 @@ class JawMoves(JawReadings, Verdict):
             return self.found[-1].lo, self.found[-1].hi, self.found[-1].mm
         if self.left:
             direction, jump = self.left[-1]
-            behind = -direction * (abs(jump) + 1.0)
-            return min(behind, 0.0), max(behind, 0.0), abs(jump)
+            return (*behind_jump(direction, jump), abs(jump))
         return None
 
     def _rolled_in(self, travel: tuple[float, float]) -> list[float]:

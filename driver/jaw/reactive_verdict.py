@@ -12,7 +12,7 @@ from localizer import Belief, Boundary, ContactFilter
 
 from .reactive_policy import ReactivePolicy
 
-__all__ = ["Unfit", "Moved", "takeoff_arc", "Verdict"]
+__all__ = ["Unfit", "Moved", "takeoff_arc", "behind_jump", "Verdict"]
 
 
 class Unfit(NamedTuple):
@@ -72,6 +72,14 @@ def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> 
     return float(part.wrap_arc(back[best]))
 
 
+def behind_jump(direction: int, jump: float) -> tuple[float, float]:
+    """The stretch a jaw rolling ``direction`` left by a jump of ``jump`` mm along itself: rolled arc from where it
+    landed, mm (the lesser end first), the jump and a millimetre (the contact moves on the part about as far as on
+    the jaw across a burr)."""
+    back = -direction * (abs(jump) + 1.0)
+    return min(back, 0.0), max(back, 0.0)
+
+
 class Verdict:
     """The verdict of a reactive run (:class:`driver.jaw.reactive` rolls with it) from what it met."""
 
@@ -100,15 +108,15 @@ class Verdict:
         if self.moved_from is not None:
             # what it met before it moved on: from where the jaw took off, under the belief it ends with, where that
             # places it; else where the belief before the move put it
-            takeoff = None
             m = self.moved
             # the present filter started where the jaw landed (not again, past a stretch nothing fit)
-            if m is not None and m.restarts == len(self.found) and belief.mass >= 0.5:
-                takeoff = takeoff_arc(part, float(flt.grid[start]), m.direction, m.jump)
-            if takeoff is None or self.moved is None:
+            if m is None or m.restarts != len(self.found) or belief.mass < 0.5:
                 return self.moved_from
-            ends = part.wrap_arc(np.array([takeoff + self.moved.lo, takeoff + self.moved.hi]))
-            return (float(ends[0]), float(ends[1])), self.moved.mm
+            takeoff = takeoff_arc(part, float(flt.grid[start]), m.direction, m.jump)
+            if takeoff is None:
+                return self.moved_from
+            ends = part.wrap_arc(np.array([takeoff + m.lo, takeoff + m.hi]))
+            return (float(ends[0]), float(ends[1])), m.mm
         if self.found:
             lo, hi, mm, leaves = self.found[0]
             if leaves == len(self.left):  # measured from where the present filter started
@@ -141,14 +149,13 @@ class Verdict:
         start ``start``, a grid index), or None where a concavity of the model there explains the jump."""
         flt, part = self.flt, self.flt.part
         direction, jump = self.left[-1]
-        s0 = float(flt.grid[start])
-        ends = (s0 - direction * (abs(jump) + 1.0), s0)
-        lo = ends[0] if direction > 0 else ends[1]
+        a, b = behind_jump(direction, jump)
+        lo, width = float(flt.grid[start]) + a, b - a
         # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
         # explains it (a bridge the belief of the time misjudged), a convex stretch does not
-        between = flt.tracks.node_at(np.linspace(lo, lo + abs(jump) + 1.0, 32))
+        between = flt.tracks.node_at(np.linspace(lo, lo + width, 32))
         if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
             return None
         if belief.mass < 0.5:  # left, but not localized since: where it left is not known
             return (math.nan, math.nan), abs(jump)
-        return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + abs(jump) + 1.0))), abs(jump)
+        return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), abs(jump)
