@@ -86,9 +86,16 @@ METHOD_COLUMNS = (
 FINGER_COLUMNS = ("jaw", "redraws", "reachable", "arc_mm")
 
 
-#: Columns of a study with a ``[world]`` table: the defects' centres (model arc, mm) and signed heights
-#: (mm), space-separated, the world's scale, and the wrist's spikes in the localizing rig's readings.
-WORLD_COLUMNS = ("world_defect_arc", "world_defect_height_mm", "world_scale", "world_spikes")
+#: Columns of a study with a ``[world]`` table: the defects' centres (model arc, mm), signed heights and
+#: lengths along the arc (mm), space-separated, the world's scale, and the wrist's spikes in the localizing
+#: rig's readings.
+WORLD_COLUMNS = (
+    "world_defect_arc",
+    "world_defect_height_mm",
+    "world_scale",
+    "world_spikes",
+    "world_defect_length_mm",
+)
 
 
 class TrialHead(TypedDict):
@@ -161,6 +168,7 @@ class WorldCells(TypedDict):
     world_defect_height_mm: str
     world_scale: float | str
     world_spikes: int | str
+    world_defect_length_mm: str
 
 
 class Rolled(Protocol):
@@ -202,10 +210,17 @@ def trial_row(head: TrialHead, rolled: Rolled, scored: Scored, seconds: float, *
 def world_cells(change: WorldChange | None, spikes: int | str = "") -> WorldCells:
     """The :data:`WORLD_COLUMNS` cells of a trial in world ``change`` (empty before one was drawn)."""
     if change is None:
-        return {"world_defect_arc": "", "world_defect_height_mm": "", "world_scale": "", "world_spikes": ""}
+        return {
+            "world_defect_arc": "",
+            "world_defect_height_mm": "",
+            "world_scale": "",
+            "world_spikes": "",
+            "world_defect_length_mm": "",
+        }
     return {
         "world_defect_arc": " ".join(f"{d.arc:.3f}" for d in change.defects),
         "world_defect_height_mm": " ".join(f"{d.height:.4f}" for d in change.defects),
         "world_scale": change.scale,
         "world_spikes": spikes,
+        "world_defect_length_mm": " ".join(f"{d.length:.3f}" for d in change.defects),
     }

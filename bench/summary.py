@@ -4,6 +4,7 @@ and the lines printed at the end of a run."""
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -11,6 +12,8 @@ from typing import Any, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
+
+from localizer import load_part
 
 from .study import Study
 
@@ -24,6 +27,8 @@ __all__ = [
     "summarize",
     "method_detail",
     "error_over_bound",
+    "NEAR_DEFECT_MM",
+    "mismatch_near",
     "summarize_methods",
     "sure_by_rotation",
     "rotation_marks",
@@ -87,6 +92,45 @@ def cell_number(text: Any) -> float:
         return float(text)
     except (TypeError, ValueError):
         return math.nan
+
+
+#: A run's reported mismatch interval is *near* a defect when it overlaps the defect's stretch (its centre ±
+#: half its length) or lies within this of it, mm (issue 29's target).
+NEAR_DEFECT_MM = 2.0
+
+
+@functools.lru_cache(maxsize=64)
+def _perimeter(path: str) -> float:
+    return float(load_part(path).perimeter)
+
+
+def mismatch_near(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> int | None:
+    """How many of method ``m``'s runs in ``rows`` that ended ``mismatch`` reported an interval near one of
+    their world's defects (:data:`NEAR_DEFECT_MM`); None when no row has a defect, or the table has no
+    defect lengths (written before ``world_defect_length_mm``)."""
+    paths = {Path(p).name: p for p in study.parts}
+    near = counted = 0
+    for r in rows:
+        centres = [float(c) for c in str(r.get("world_defect_arc", "")).split()]
+        if not centres:
+            continue
+        if "world_defect_length_mm" not in r:
+            return None
+        counted += 1
+        cell = str(r.get(f"{m}_mismatch_arc", ""))
+        if r.get(f"{m}_stopped") != "mismatch" or cell in ("", "unknown"):
+            continue
+        lo, hi = (float(v) for v in cell.rsplit("-", 1))
+        lengths = [float(v) for v in str(r["world_defect_length_mm"]).split()]
+        per = _perimeter(paths[r["part"]])
+        span = (hi - lo) % per
+        for c, length in zip(centres, lengths):
+            ahead = (c - lo) % per  # the defect's centre, forward from the interval's start
+            gap = 0.0 if ahead <= span else min(ahead - span, per - ahead)
+            if gap <= 0.5 * length + NEAR_DEFECT_MM:
+                near += 1
+                break
+    return near if counted else None
 
 
 def summarize(study: Study, rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
@@ -164,6 +208,7 @@ def method_detail(study: Study, m: str, rows: Sequence[dict[str, Any]]) -> dict[
         "confident": len(confident),
         "confident_wrong": wrong,
         "mismatch": stopped.count("mismatch"),
+        "mismatch_near": mismatch_near(study, m, rows),
         "confident_wrong_ci95": list(wilson(wrong, len(confident))),
         "stopped": {k: stopped.count(k) for k in sorted(set(stopped)) if k},
         "failures": sum(bool(r.get(f"{m}_failure", "")) for r in rows),
@@ -333,6 +378,7 @@ def _print_method(m: str, d: dict[str, Any], indent: str) -> None:
         f"(95% CI {d['ci95'][0]:.1%}–{d['ci95'][1]:.1%}), {rot}median error {d['error_median_mm']:.3f} mm; "
         f"stopped confident {d['confident']}, of which wrong {d['confident_wrong']}"
         + (f"; model mismatch {d['mismatch']}" if d.get("mismatch") else "")
+        + (f" ({d['mismatch_near']} near a defect)" if d.get("mismatch") and d.get("mismatch_near") is not None else "")
     )
     cal = d.get("calibration")
     if cal is not None:

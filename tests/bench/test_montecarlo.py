@@ -535,12 +535,14 @@ def test_a_world_study_writes_how_each_trials_world_differs_and_counts_mismatche
         assert rolled.failure == "" and float(r["start_arc"]) == rolled.start and r["part"] == part
         assert abs(float(r["world_defect_arc"]) - float(r["start_arc"])) <= 5.0
         assert float(r["world_defect_height_mm"]) == 0.3 and float(r["world_scale"]) == 1.0
+        assert float(r["world_defect_length_mm"]) == 4.0
         assert r["reactive_stopped"] in ("confident", "mismatch", "budget", "ambiguous")
         assert bool(r["reactive_mismatch_arc"]) == (r["reactive_stopped"] == "mismatch")
         assert not (r["reactive_stopped"] == "confident" and r["reactive_success"] == "0")
     summary = json.loads((tmp_path / "w" / "summary.json").read_text())
     d = summary["method_details"]["reactive"]
     assert d["mismatch"] == sum(r["reactive_stopped"] == "mismatch" for r in rows)
+    assert 0 <= d["mismatch_near"] <= d["mismatch"]
 
 
 def test_resume_refuses_a_part_file_edited_since(tmp_path):

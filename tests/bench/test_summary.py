@@ -131,3 +131,55 @@ def test_a_quantile_among_failed_trials_is_infinite_not_nan():
     assert quantile(err[:8], 0.5) == pytest.approx(np.quantile(err[:8], 0.5))
     assert quantile(np.array([0.1, np.inf]), 0.5) == np.inf
     assert np.isnan(quantile(np.array([0.1, np.nan]), 0.5))  # an unknown error stays unknown
+
+
+def _mismatch_row(interval: str, centres: str, lengths: str, stopped: str = "mismatch") -> dict[str, str]:
+    return {
+        "part": "trefoil.json",
+        "world_defect_arc": centres,
+        "world_defect_length_mm": lengths,
+        "reactive_stopped": stopped,
+        "reactive_mismatch_arc": interval,
+    }
+
+
+def test_a_mismatch_interval_is_near_a_defect_within_two_millimetres_of_its_stretch_across_the_seam():
+    from pathlib import Path
+
+    from bench.study import Study
+    from bench.summary import NEAR_DEFECT_MM, mismatch_near
+    from localizer import load_part
+
+    path = str(Path(__file__).resolve().parents[2] / "parts" / "trefoil.json")
+    per = load_part(path).perimeter
+    study = Study(name="near", parts=(path,), rolls_deg=(20.0,))
+    assert NEAR_DEFECT_MM == 2.0
+
+    def near(*rows: dict[str, str]) -> int | None:
+        return mismatch_near(study, "reactive", rows)
+
+    # (interval, centre, length, near?): the defect's stretch is its centre ± half its length
+    cases = [
+        ("10.00-20.00", 15.0, 4.0, True),  # inside
+        ("10.00-20.00", 23.9, 4.0, True),  # 3.9 mm past the end: 1.9 mm from the stretch
+        ("10.00-20.00", 24.1, 4.0, False),
+        ("10.00-20.00", 7.1, 2.0, True),  # 2.9 mm before the start, 1 mm half-length
+        ("10.00-20.00", 6.9, 2.0, False),
+        (f"{per - 5:.2f}-3.00", 1.0, 2.0, True),  # the interval runs across the seam
+        (f"{per - 5:.2f}-3.00", per - 7.9, 2.0, True),
+        (f"{per - 5:.2f}-3.00", per - 8.1, 2.0, False),
+        ("1.00-3.00", per - 1.9, 2.0, True),  # the defect across the seam from the interval
+        ("1.00-3.00", per - 2.1, 2.0, False),
+    ]
+    for interval, centre, length, expected in cases:
+        assert near(_mismatch_row(interval, f"{centre:.3f}", f"{length:.3f}")) == int(expected), (interval, centre)
+    # several defects: near one of them counts once
+    assert near(_mismatch_row("10.00-20.00", "100.000 15.000", "4.000 4.000")) == 1
+    # a run that did not end mismatch, or could not tell where, is not near
+    assert near(_mismatch_row("10.00-20.00", "15.000", "4.000", stopped="budget")) == 0
+    assert near(_mismatch_row("unknown", "15.000", "4.000")) == 0
+    # no defect in the study's worlds, or a table written before the lengths: nothing to count
+    assert near(_mismatch_row("10.00-20.00", "", "")) is None
+    old = _mismatch_row("10.00-20.00", "15.000", "4.000")
+    del old["world_defect_length_mm"]
+    assert near(old) is None
