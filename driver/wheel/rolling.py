@@ -6,16 +6,20 @@
 what was read (a jam that reads as rolling in a concave arc of the wheel's own radius), it retraces
 its poses back to where that segment of rolling started and starts afresh there: away from the
 segment's last jump when it had one (a jam wedges the disc at a mouth it then jumps across, so the way
-the wheel turned to after that jump), else the other way.
+the wheel turned to after that jump), else the other way. When that fresh start fails too, the wheel sits on
+what the model does not have (pressed onto a bump or into a dent, both ways read the same misfit): it rolls
+on through it (:func:`_roll_on`), localizes afresh beyond, and the run ends "mismatch", the stretch that did
+not fit placed under the estimate.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
-from localizer import Belief, Outline, Part, WheelFilter, WheelJaw
+from localizer import DEFECT_WINDOW, Belief, Outline, Part, WheelFilter, WheelJaw
 
 from ..jaw import PRESS, PressSettings
 from ..rig import Rig, RigError
@@ -53,10 +57,10 @@ class WheelRun:
     stopped : str
         "confident" (the final belief sure, whatever ended the rolling), "max_rotation", "max_arc", "blocked"
         (jumps both ways at one place, or again where the wheel jumped the same way before: enclosed) or
-        "mismatch" (a stretch of the readings fits no probable
-        place, or nothing fits after :data:`MAX_RESTARTS` fresh starts: the part is not its model,
-        ``belief.mismatch`` says where when it can); slip beyond the policy's limit raises
-        :class:`WheelSlip` instead.
+        "mismatch" (a stretch of the readings fits no probable place, or nothing fits after :data:`MAX_RESTARTS`
+        fresh starts, or the wheel rolled on through what did not fit (module notes): the part is not its model,
+        ``belief.mismatch`` says where when it can); slip beyond the policy's limit raises :class:`WheelSlip`
+        instead.
     reversals, jumps : int
     slip : float, mm
         The rim's slip summed over the run (:mod:`driver.wheel.disc`, step 5).
@@ -95,6 +99,22 @@ class WheelRun:
     @property
     def estimate_arc(self) -> float:
         return self.belief.map_arc
+
+
+def _roll_on(disc: WheelDisc, direction: int, length: float, policy: WheelPolicy) -> tuple[float, float, float, bool]:
+    """Roll ``direction`` until ``length`` mm of arc is rolled, without judging the readings: the hand's turning
+    (rad, both ways counted), the arc (signed, mm) and the rim's slip (mm) over it, and whether it got through
+    (False: the wheel jumped first, and stays where that step started; or it pivots on a corner where no arc is
+    rolled)."""
+    turned = d_len = slip = 0.0
+    for _ in range(int(math.ceil(4 * length / policy.step))):  # a step rolls about policy.step of arc
+        moved = disc.step(direction)
+        if moved is None:
+            return turned, d_len, slip, False
+        turned, d_len, slip = turned + abs(moved[0]), d_len + moved[1], slip + moved[2]
+        if abs(d_len) >= length:
+            return turned, d_len, slip, True
+    return turned, d_len, slip, False
 
 
 def localize_with_wheel(
@@ -148,6 +168,7 @@ def localize_with_wheel(
     rotation = arc = slip = 0.0
     blocked: list[tuple[int, float]] = []  # (direction, L mm) of the jumps of this segment
     stopped = "max_rotation"
+    met: tuple[float, float] | None = None  # what the wheel rolled on through (:func:`_roll_on`)
     while True:
         moved = disc.step(direction)
         if moved is None:
@@ -202,6 +223,31 @@ def localize_with_wheel(
                 if segment >= MAX_RESTARTS:
                     stopped = "blocked"
                     break
+                if segment == MAX_RESTARTS - 1:
+                    # the fresh start failed too: from where every segment started, rolling either way (or the
+                    # same way again) reads what the model does not have (the wheel started on a bump or in a
+                    # dent). Roll on through it instead, and localize afresh beyond
+                    here = lengths[-1]
+                    rolled = [L for L, g in zip(lengths, segments) if g <= segment]
+                    turned, d_len, mismatch, through = _roll_on(disc, direction, DEFECT_WINDOW, pol)
+                    rotation += turned
+                    arc += abs(d_len)
+                    slip += mismatch
+                    if not through:
+                        stopped = "blocked"
+                        break
+                    # what did not fit, in the rolled arc from where the next segment starts
+                    met = (min(rolled) - here - d_len, max(rolled) - here - d_len)
+                    poses, segment_rotation = [disc.hand.pose], 0.0
+                    start, segment = disc.state, segment + 1
+                    flt.reset()
+                    flt.update(0.0, 0.0)
+                    lengths.append(0.0)
+                    turns.append(0.0)
+                    truths.append(disc.truth())
+                    segments.append(segment)
+                    blocked = []
+                    continue
                 for pose in reversed(poses[:-1]):
                     disc.hand.go(*pose)
                 disc.state = disc.settled()
@@ -232,6 +278,16 @@ def localize_with_wheel(
         stopped = "confident"
     if stopped != "confident" and (final.mismatch is not None or not final.consistent):
         stopped = "mismatch"
+    if met is not None:
+        # the wheel rolled on through what did not fit: the run met a part that is not its model, whatever it
+        # found beyond; said where under the most probable start when something fits
+        stopped = "mismatch"
+        if final.mismatch is None:
+            ends = (math.nan, math.nan)
+            if final.consistent:
+                first = final.map_arc - lengths[-1]  # where the last segment started, under the estimate
+                ends = (float(part.wrap_arc(first + met[0])), float(part.wrap_arc(first + met[1])))
+            final = replace(final, mismatch=ends)
     return WheelRun(
         belief=final,
         rotation=rotation,

@@ -355,3 +355,21 @@ def test_a_wheel_that_jumps_both_ways_at_one_place_stops_blocked_unsure():
     run, err = localize(slot, WheelJaw(5.0), 168.0)  # the floor's middle
     assert run.stopped == "blocked" and run.jumps == 2 and run.reversals == 1 and run.arc < 0.5
     assert not run.belief.sure(0.95) and abs(err) < 0.3
+
+
+@pytest.mark.parametrize("noise", ["none", "paper"])
+def test_a_wheel_started_on_a_bump_rolls_on_through_it_localizes_beyond_and_says_where_it_was(noise):
+    """A 0.2 mm bump 7.9 mm long on a tuning part, the wheel pressed 1.8 mm past its crest: nothing fits rolling
+    either way, nor the first way again. The wheel rolls on through instead and localizes beyond it; the run ends
+    "mismatch" (never sure), the stretch that did not fit placed under the estimate, on the bump."""
+    from sim2d import Defect, WorldChange
+
+    part = load_part("bench/parts/tuning/filleted-03.json")
+    bump = Defect(190.2, 0.2, 7.9)
+    run, err = localize(part, WheelJaw(5.0), 192.0, noise=noise, seed=1, change=WorldChange(defects=(bump,)))
+    assert run.restarts == 2 and run.stopped == "mismatch" and not run.belief.sure(0.95)
+    assert abs(err) < 0.3  # localized beyond the bump
+    assert run.belief.mismatch is not None
+    lo, hi = run.belief.mismatch
+    assert 0.0 < hi - lo < 8.0
+    assert lo < bump.arc + bump.length / 2 and hi > bump.arc - bump.length / 2  # on the bump's stretch
