@@ -12,7 +12,7 @@ from localizer import Belief, Boundary, ContactFilter
 
 from .reactive_policy import ReactivePolicy
 
-__all__ = ["Unfit", "Moved", "takeoff_arc", "behind_jump", "Verdict"]
+__all__ = ["Unfit", "Moved", "PLACE_RADIUS", "takeoff_arc", "behind_jump", "Verdict"]
 
 
 class Unfit(NamedTuple):
@@ -45,6 +45,12 @@ class Moved(NamedTuple):
 TAKEOFF_OFF = 0.5
 TAKEOFF_ALONG = 3.0
 TAKEOFF_TILT = math.radians(5.0)
+
+
+#: What a run met is placed under its most probable start where the belief holds at least half its mass within
+#: this of that start, mm: the place is claimed to within it (the mass within the success radius, 0.3 mm, asks how
+#: near, not which place)
+PLACE_RADIUS = 2.0
 
 
 def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> float | None:
@@ -110,17 +116,22 @@ class Verdict:
             # places it; else where the belief before the move put it
             m = self.moved
             # the present filter started where the jaw landed (not again, past a stretch nothing fit)
-            if m is None or m.restarts != len(self.found) or belief.mass < 0.5:
+            if m is None or m.restarts != len(self.found) or not self._placed(start):
                 return self.moved_from
-            takeoff = takeoff_arc(part, float(flt.grid[start]), m.direction, m.jump)
+            landing = float(flt.grid[start])
+            takeoff = takeoff_arc(part, landing, m.direction, m.jump)
             if takeoff is None:
-                return self.moved_from
+                if all(math.isfinite(a) for a in self.moved_from[0]):
+                    return self.moved_from
+                # nor did the belief before the move place it: the model has no such jump there (it was what the
+                # jaw met), and the contact moved on the part about as far as on the jaw (:func:`behind_jump`)
+                takeoff = landing - m.direction * abs(m.jump)
             ends = part.wrap_arc(np.array([takeoff + m.lo, takeoff + m.hi]))
             return (float(ends[0]), float(ends[1])), m.mm
         if self.found:
             lo, hi, mm, leaves = self.found[0]
             if leaves == len(self.left):  # measured from where the present filter started
-                if belief.mass < 0.5:  # not localized since: where it did not fit is not known
+                if not self._placed(start):  # not localized since: where it did not fit is not known
                     return (math.nan, math.nan), mm
                 s0 = float(flt.grid[start])
                 return (float(part.wrap_arc(s0 + lo)), float(part.wrap_arc(s0 + hi))), mm
@@ -144,6 +155,14 @@ class Verdict:
             return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), math.nan
         return None
 
+    def _placed(self, start: int) -> bool:
+        """Whether the belief holds at least half its mass within :data:`PLACE_RADIUS` of start ``start`` (a grid
+        index): which place is known, to place what the run met under it."""
+        flt = self.flt
+        grid = np.asarray(flt.grid)
+        near = np.abs(np.asarray(flt.part.arc_offset(grid, float(grid[start])))) <= PLACE_RADIUS
+        return float(np.asarray(flt.posterior())[near].sum()) >= 0.5
+
     def _left(self, belief: Belief, start: int) -> tuple[tuple[float, float], float] | None:
         """The stretch the jaw left by its last jump, behind where the present filter started (most probable
         start ``start``, a grid index), or None where a concavity of the model there explains the jump."""
@@ -156,6 +175,6 @@ class Verdict:
         between = flt.tracks.node_at(np.linspace(lo, lo + width, 32))
         if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
             return None
-        if belief.mass < 0.5:  # left, but not localized since: where it left is not known
+        if not self._placed(start):  # left, but not localized since: where it left is not known
             return (math.nan, math.nan), abs(jump)
         return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), abs(jump)

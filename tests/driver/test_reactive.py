@@ -509,3 +509,67 @@ def test_where_the_jaw_took_off_is_the_other_end_of_the_hull_edge_it_landed_by()
     # on a stretch of the hull itself, no point of the model lies on the tangent line behind it
     convex = arcs[hull[int(np.argmax(np.where(gaps > chords + 0.05, 0.0, gaps)))]]
     assert takeoff_arc(part, convex, 1, 8.0) is None
+
+
+def test_what_a_run_met_is_placed_where_half_the_belief_lies_within_two_millimetres_of_its_most_probable_start():
+    # the mass within the success radius (0.3 mm) asks how near; placing a defect asks which place: a belief
+    # spread over 0.8 mm (sd) holds 29% within 0.3 mm of its centre and 99% within 2 mm
+    from types import SimpleNamespace
+
+    from scipy.stats import norm
+
+    from driver.jaw.reactive_verdict import PLACE_RADIUS, Verdict
+
+    part = load_part(PARTS / "trefoil.json")
+    grid = np.arange(0.0, part.perimeter, 0.02)
+
+    def spread(centre, sd):
+        d = np.asarray(part.arc_offset(grid, centre))
+        return np.exp(-0.5 * (d / sd) ** 2)
+
+    def placed(w, at):
+        verdict = Verdict()
+        verdict.flt = SimpleNamespace(grid=grid, part=part, posterior=lambda: w / w.sum())
+        return verdict._placed(int(np.argmin(np.abs(np.asarray(part.arc_offset(grid, at))))))
+
+    assert PLACE_RADIUS == 2.0
+    one = spread(50.0, 0.8)
+    within = float(one[np.abs(grid - 50.0) <= 0.3].sum() / one.sum())
+    assert within == pytest.approx(2 * norm.cdf(0.3 / 0.8) - 1, abs=0.02) and within < 0.5
+    assert placed(one, 50.0)
+    assert not placed(one, 53.0)  # the most probable start 3 mm off what the belief holds
+    # two places: the one with 55% is placed, the other not
+    two = 0.45 * spread(50.0, 0.8) + 0.55 * spread(150.0, 0.8)
+    assert placed(two, 150.0) and not placed(two, 50.0)
+    # across the seam
+    seam = spread(0.5, 0.8)
+    assert placed(seam, part.perimeter - 0.5)
+    # too wide to place: sd 5 mm holds 31% within 2 mm
+    assert not placed(spread(50.0, 5.0), 50.0)
+
+
+def test_a_moved_run_whose_takeoff_the_model_does_not_have_is_placed_by_the_jump_read_on_the_jaw():
+    # the jaw moved on through a jump of 14.7 mm (rolling clockwise) that no pair of points of the model explains
+    # where it landed, and the belief before the move placed nothing: what it met is placed behind the landing
+    # by the jump read on the jaw (the contact moves on the part about as far as on the jaw across a burr); where
+    # the belief before the move placed it, that place is kept
+    from types import SimpleNamespace
+
+    from driver.jaw.reactive_verdict import Moved, Verdict, takeoff_arc
+    from localizer import Belief
+
+    part = load_part(PARTS / "trefoil.json")
+    grid = np.arange(0.0, part.perimeter, 0.02)
+    landing = 20.0
+    assert takeoff_arc(part, landing, -1, -14.7) is None
+    w = np.exp(-0.5 * (np.asarray(part.arc_offset(grid, landing)) / 0.2) ** 2)
+    verdict = Verdict()
+    verdict.flt = SimpleNamespace(grid=grid, part=part, posterior=lambda: w / w.sum(), ruled_out=False)
+    verdict.found, verdict.left = [], [(-1, -14.7)]
+    verdict.moved = Moved(lo=0.3, hi=6.7, mm=5.4, direction=-1, jump=-14.7, restarts=0)
+    belief = Belief(map_arc=landing, mass=0.99, radius=0.3, modes=(), ambiguous=False, informative=True, steps=99)
+    verdict.moved_from = ((math.nan, math.nan), math.nan)
+    (lo, hi), mm = verdict._verdict(belief)
+    assert (lo, hi) == pytest.approx((landing + 14.7 + 0.3, landing + 14.7 + 6.7), abs=0.02) and mm == 5.4
+    verdict.moved_from = ((70.0, 75.0), 5.4)
+    assert verdict._verdict(belief) == ((70.0, 75.0), 5.4)
