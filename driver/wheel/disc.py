@@ -259,9 +259,10 @@ class WheelDisc:
         phi = float(self.hand.measured_angle())
         return phi, a, float(self.rig.axle()), float(x), float(y)
 
-    def step(self, direction: int) -> tuple[float, float, float] | None:
+    def step(self, direction: int, through: bool = False) -> tuple[float, float, float] | None:
         """Roll one step ``direction`` (+1: counter-clockwise); (ΔΩ rad, ΔL mm, the axle path's mismatch mm),
-        or None after a jump, which is undone (the hand back where the step started)."""
+        or None after a jump, which is undone (the hand back where the step started); ``through``: a jump is
+        kept (the wheel rolls over what the model does not have)."""
         pol, r = self.policy, self.cal.radius
         before, prev = self.hand.pose, self.state
         x, y, phi = before
@@ -277,7 +278,8 @@ class WheelDisc:
             hi += self.pivot
         else:
             lo -= self.pivot
-        if not (lo - JUMP_FLOOR <= d_turn <= hi + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step:
+        jumped = not (lo - JUMP_FLOOR <= d_turn <= hi + JUMP_FLOOR) or abs(mismatch) > JUMP_MISMATCH * pol.step
+        if jumped and not through:
             self.hand.go(*before)
             self.state = self.settled()
             return None

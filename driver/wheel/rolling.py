@@ -9,7 +9,9 @@ segment's last jump when it had one (a jam wedges the disc at a mouth it then ju
 the wheel turned to after that jump), else the other way. When that fresh start fails too, the wheel sits on
 what the model does not have (pressed onto a bump or into a dent, both ways read the same misfit): it rolls
 on through it (:func:`_roll_on`), localizes afresh beyond, and the run ends "mismatch", the stretch that did
-not fit placed under the estimate.
+not fit placed under the estimate. Likewise where it jumps both ways at once and no place of the model has such
+jumps (pressed onto a short bump, or into a narrow dent, whose sides it cannot roll over as the model's curve):
+it rolls over this way, jumps and all, and localizes afresh beyond.
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 from typing import Any
+
+import numpy as np
 
 from localizer import DEFECT_WINDOW, Belief, Outline, Part, WheelFilter, WheelJaw
 
@@ -101,14 +105,16 @@ class WheelRun:
         return self.belief.map_arc
 
 
-def _roll_on(disc: WheelDisc, direction: int, length: float, policy: WheelPolicy) -> tuple[float, float, float, bool]:
+def _roll_on(
+    disc: WheelDisc, direction: int, length: float, policy: WheelPolicy, through: bool = False
+) -> tuple[float, float, float, bool]:
     """Roll ``direction`` until ``length`` mm of arc is rolled, without judging the readings: the hand's turning
     (rad, both ways counted), the arc (signed, mm) and the rim's slip (mm) over it, and whether it got through
     (False: the wheel jumped first, and stays where that step started; or it pivots on a corner where no arc is
-    rolled)."""
+    rolled); ``through``: over jumps too (:meth:`WheelDisc.step`)."""
     turned = d_len = slip = 0.0
     for _ in range(int(math.ceil(4 * length / policy.step))):  # a step rolls about policy.step of arc
-        moved = disc.step(direction)
+        moved = disc.step(direction, through)
         if moved is None:
             return turned, d_len, slip, False
         turned, d_len, slip = turned + abs(moved[0]), d_len + moved[1], slip + moved[2]
@@ -172,12 +178,32 @@ def localize_with_wheel(
     while True:
         moved = disc.step(direction)
         if moved is None:
-            flt.jumped(direction, margin=1.0 + pol.step)
+            margin = 1.0 + pol.step
+            flt.jumped(direction, margin=margin)
             jumps += 1
             # a jump where the last one was (stuck), or where one the same way was before (the wheel enclosed
             # between two places it cannot pass: rolling on reads the same ground again)
             near = [(d, L) for d, L in blocked if abs(lengths[-1] - L) < 2 * pol.step]
             if near and (near[-1] == blocked[-1] or any(d == direction for d, _ in near)):
+                if met is None and not bool(np.any(flt.explains_jump(1, margin) & flt.explains_jump(-1, margin))):
+                    # jumps both ways where no place of the model has them (the wheel pressed onto a short bump
+                    # or into a narrow dent, whose sides it cannot roll over as the model's curve): roll over it
+                    # this way, and localize afresh beyond
+                    turned, d_len, _, through = _roll_on(disc, direction, DEFECT_WINDOW, pol, through=True)
+                    rotation += turned
+                    arc += abs(d_len)
+                    if through:
+                        met = (-d_len - 1.0, -d_len + 1.0)  # where it was blocked, from here
+                        poses, segment_rotation = [disc.hand.pose], 0.0
+                        start, segment = disc.state, segment + 1
+                        flt.reset()
+                        flt.update(0.0, 0.0)
+                        lengths.append(0.0)
+                        turns.append(0.0)
+                        truths.append(disc.truth())
+                        segments.append(segment)
+                        blocked = []
+                        continue
                 stopped = "blocked"
                 break
             blocked.append((direction, lengths[-1]))

@@ -373,3 +373,22 @@ def test_a_wheel_started_on_a_bump_rolls_on_through_it_localizes_beyond_and_says
     lo, hi = run.belief.mismatch
     assert 0.0 < hi - lo < 8.0
     assert lo < bump.arc + bump.length / 2 and hi > bump.arc - bump.length / 2  # on the bump's stretch
+
+
+@pytest.mark.parametrize("noise", ["none", "paper"])
+def test_a_wheel_pressed_onto_a_short_bump_rolls_over_it_and_says_where_it_was_blocked(noise):
+    """A 0.39 mm bump 2.4 mm long on a tuning part, the wheel pressed onto its side: a step either way turns the
+    hand beyond what rolling on the model's curve can, read as a jump both ways at once, which no place of the
+    model has. The wheel rolls over it instead and localizes beyond; the run ends "mismatch" (never sure), the
+    place where it was blocked said under the estimate, on the bump (blocked, nothing localized, before)."""
+    from sim2d import Defect, WorldChange
+
+    part = load_part("bench/parts/tuning/superellipse-01.json")
+    bump = Defect(211.35, 0.39, 2.36)
+    run, err = localize(part, WheelJaw(5.0), 211.6, noise=noise, seed=1, change=WorldChange(defects=(bump,)))
+    assert run.jumps == 2 and run.restarts == 1 and run.stopped == "mismatch" and not run.belief.sure(0.95)
+    assert abs(err) < 0.3
+    assert run.belief.mismatch is not None
+    lo, hi = run.belief.mismatch
+    assert hi - lo == pytest.approx(2.0, abs=1e-6)
+    assert lo < bump.arc + bump.length / 2 and hi > bump.arc - bump.length / 2
