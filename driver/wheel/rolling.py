@@ -67,7 +67,8 @@ class WheelRun:
         instead.
     reversals, jumps : int
     slip : float, mm
-        The rim's slip summed over the run (:mod:`driver.wheel.disc`, step 5).
+        The rim's slip summed over the steps the rolling judged (:mod:`driver.wheel.disc`, step 5; not over a
+        roll on past what the model does not have).
     depth : float, mm
         The wrist's give at the target force (measured at the first press).
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
@@ -175,6 +176,24 @@ def localize_with_wheel(
     blocked: list[tuple[int, float]] = []  # (direction, L mm) of the jumps of this segment
     stopped = "max_rotation"
     met: tuple[float, float] | None = None  # what the wheel rolled on through (:func:`_roll_on`)
+    # the rim's slip (mm) and the arc (mm) it is judged over: since the wheel last started afresh beyond what the
+    # model does not have (rolling over a bump sharper than the rim reads as slip there)
+    judged = [0.0, 0.0]
+
+    def start_beyond() -> None:
+        """Localize afresh where the wheel is, having rolled on past what did not fit."""
+        nonlocal poses, segment_rotation, start, segment, blocked
+        poses, segment_rotation = [disc.hand.pose], 0.0
+        start, segment = disc.state, segment + 1
+        flt.reset()
+        flt.update(0.0, 0.0)
+        lengths.append(0.0)
+        turns.append(0.0)
+        truths.append(disc.truth())
+        segments.append(segment)
+        blocked = []
+        judged[:] = [0.0, 0.0]
+
     while True:
         moved = disc.step(direction)
         if moved is None:
@@ -194,15 +213,7 @@ def localize_with_wheel(
                     arc += abs(d_len)
                     if through:
                         met = (-d_len - 1.0, -d_len + 1.0)  # where it was blocked, from here
-                        poses, segment_rotation = [disc.hand.pose], 0.0
-                        start, segment = disc.state, segment + 1
-                        flt.reset()
-                        flt.update(0.0, 0.0)
-                        lengths.append(0.0)
-                        turns.append(0.0)
-                        truths.append(disc.truth())
-                        segments.append(segment)
-                        blocked = []
+                        start_beyond()
                         continue
                 stopped = "blocked"
                 break
@@ -211,6 +222,8 @@ def localize_with_wheel(
             continue
         d_turn, d_len, mismatch = moved
         slip += mismatch
+        judged[0] += mismatch
+        judged[1] += abs(d_len)
         rotation += abs(d_turn)
         segment_rotation += abs(d_turn)
         arc += abs(d_len)
@@ -224,10 +237,10 @@ def localize_with_wheel(
         flt.update(lengths[-1], turns[-1])
         if observer is not None:
             observer({"event": "reading", "length": lengths[-1], "turn": turns[-1], "segment": segment})
-        if abs(slip) > pol.max_slip + pol.max_slip_fraction * arc:
+        if abs(judged[0]) > pol.max_slip + pol.max_slip_fraction * judged[1]:
             raise WheelSlip(
-                f"the wheel's rim slipped {slip:+.3f} mm over {arc:.1f} mm rolled (the axle's path against the "
-                f"encoders, more than {pol.max_slip} mm + {pol.max_slip_fraction:.1%} of the arc): its readings "
+                f"the wheel's rim slipped {judged[0]:+.3f} mm over {judged[1]:.1f} mm rolled (the axle's path against "
+                f"the encoders, more than {pol.max_slip} mm + {pol.max_slip_fraction:.1%} of the arc): its readings "
                 "are not the part's arc, so the rolling stopped with the wheel on the part. Clean the rim and "
                 "the part, or press harder"
             )
@@ -255,24 +268,15 @@ def localize_with_wheel(
                     # dent). Roll on through it instead, and localize afresh beyond
                     here = lengths[-1]
                     rolled = [L for L, g in zip(lengths, segments) if g <= segment]
-                    turned, d_len, mismatch, through = _roll_on(disc, direction, DEFECT_WINDOW, pol)
+                    turned, d_len, _, through = _roll_on(disc, direction, DEFECT_WINDOW, pol)
                     rotation += turned
                     arc += abs(d_len)
-                    slip += mismatch
                     if not through:
                         stopped = "blocked"
                         break
                     # what did not fit, in the rolled arc from where the next segment starts
                     met = (min(rolled) - here - d_len, max(rolled) - here - d_len)
-                    poses, segment_rotation = [disc.hand.pose], 0.0
-                    start, segment = disc.state, segment + 1
-                    flt.reset()
-                    flt.update(0.0, 0.0)
-                    lengths.append(0.0)
-                    turns.append(0.0)
-                    truths.append(disc.truth())
-                    segments.append(segment)
-                    blocked = []
+                    start_beyond()
                     continue
                 for pose in reversed(poses[:-1]):
                     disc.hand.go(*pose)
