@@ -10,7 +10,7 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from localizer import SUCCESS_RADIUS, Outline, Part, QueryError, WheelJaw, wheel_reach_for
+from localizer import Outline, Part, QueryError, WheelJaw, wheel_reach_for
 
 from ..records import check_finger, check_same_part, part_record
 from ..rig import Rig, RigError
@@ -232,22 +232,21 @@ def locate_wheel(args: argparse.Namespace, record: RunRecord) -> int:
     doc = {
         "part": part.name,
         "jaw": trace.metadata["jaw"],
-        "estimate_arc": b.map_arc,
-        "mass": b.mass,
-        "ambiguous": b.ambiguous,
+        **belief_fields(b),
         "readings": int(trace.columns["length"].size),
         "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
     }
+    # where the run found the part not to be its model (it may have rolled on past it: the belief replayed is the
+    # last segment's, which did not read it)
+    result = trace.metadata.get("result")
+    if doc["mismatch"] is None and isinstance(result, dict) and isinstance(result.get("mismatch"), dict):
+        doc["mismatch"] = result["mismatch"]
     if math.isfinite(true):
         doc["true_arc"] = true
         doc["error_mm"] = float(abs(part.arc_offset(b.map_arc, true)))
     if args.json:
         print(json.dumps(doc, indent=2))
     else:
-        print(
-            f"{doc['jaw']} trace, {doc['readings']} readings: contact now at arc {b.map_arc:.3f} mm, "
-            f"{b.mass:.1%} within {SUCCESS_RADIUS} mm{' (AMBIGUOUS)' if b.ambiguous else ''}"
-        )
-        if "error_mm" in doc:
-            print(f"truth: {true:.3f} mm, error {doc['error_mm']:.3f} mm")
-    return 0
+        print(f"{doc['jaw']} trace, {doc['readings']} readings replayed")
+        print_belief(doc)
+    return exit_status(doc)

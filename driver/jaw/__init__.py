@@ -35,6 +35,7 @@ from .reactive_policy import (
     spread_by_direction,
 )
 from .reactive_sensing import JawReadings
+from .reactive_verdict import PLACE_RADIUS, holds_place
 from .roll_result import RollingRun, RollResult, step_sequence
 from .rolling import (
     FACE_ANGLE_TOL,
@@ -52,6 +53,8 @@ from .rolling import (
 from .simulated import calibrate_simulated
 
 __all__ = [
+    "PLACE_RADIUS",
+    "holds_place",
     "step_sequence",
     "Calibration",
     "calibrate",

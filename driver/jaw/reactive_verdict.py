@@ -7,12 +7,13 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from localizer import Belief, Boundary, ContactFilter
 
 from .reactive_policy import ReactivePolicy
 
-__all__ = ["Unfit", "Moved", "PLACE_RADIUS", "takeoff_arc", "behind_jump", "Verdict"]
+__all__ = ["Unfit", "Moved", "PLACE_RADIUS", "holds_place", "takeoff_arc", "behind_jump", "Verdict"]
 
 
 class Unfit(NamedTuple):
@@ -51,6 +52,14 @@ TAKEOFF_TILT = math.radians(5.0)
 #: this of that start, mm: the place is claimed to within it (the mass within the success radius, 0.3 mm, asks how
 #: near, not which place)
 PLACE_RADIUS = 2.0
+
+
+def holds_place(part: Boundary, grid: npt.NDArray[np.float64], weights: npt.NDArray[np.float64], at: int) -> bool:
+    """Whether the belief ``weights`` over starts ``grid`` (model arc, mm; summing to 1) holds at least half its
+    mass within :data:`PLACE_RADIUS` of start ``at`` (a grid index): which place is known, to place what a run
+    met under it."""
+    near = np.abs(np.asarray(part.arc_offset(grid, float(grid[at])))) <= PLACE_RADIUS
+    return float(np.asarray(weights)[near].sum()) >= 0.5
 
 
 def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> float | None:
@@ -157,11 +166,8 @@ class Verdict:
 
     def _placed(self, start: int) -> bool:
         """Whether the belief holds at least half its mass within :data:`PLACE_RADIUS` of start ``start`` (a grid
-        index): which place is known, to place what the run met under it."""
-        flt = self.flt
-        grid = np.asarray(flt.grid)
-        near = np.abs(np.asarray(flt.part.arc_offset(grid, float(grid[start])))) <= PLACE_RADIUS
-        return float(np.asarray(flt.posterior())[near].sum()) >= 0.5
+        index, :func:`holds_place`)."""
+        return holds_place(self.flt.part, np.asarray(self.flt.grid), np.asarray(self.flt.posterior()), start)
 
     def _left(self, belief: Belief, start: int) -> tuple[tuple[float, float], float] | None:
         """The stretch the jaw left by its last jump, behind where the present filter started (most probable
@@ -173,8 +179,11 @@ class Verdict:
         # the jump it rolled through, seen from where the rolling went on: a concavity of the model there
         # explains it (a bridge the belief of the time misjudged), a convex stretch does not
         between = flt.tracks.node_at(np.linspace(lo, lo + width, 32))
-        if belief.mass >= 0.5 and not bool(np.all(flt.tracks.convex[between])):
+        explained = not bool(np.all(flt.tracks.convex[between]))
+        if belief.mass >= 0.5 and explained:
             return None
-        if not self._placed(start):  # left, but not localized since: where it left is not known
+        if explained or not self._placed(start):
+            # left, but not localized since (or only about where, and a concavity there would explain the jump):
+            # where it left is not known
             return (math.nan, math.nan), abs(jump)
         return (float(part.wrap_arc(lo)), float(part.wrap_arc(lo + width))), abs(jump)

@@ -6,12 +6,15 @@
 what was read (a jam that reads as rolling in a concave arc of the wheel's own radius), it retraces
 its poses back to where that segment of rolling started and starts afresh there: away from the
 segment's last jump when it had one (a jam wedges the disc at a mouth it then jumps across, so the way
-the wheel turned to after that jump), else the other way. When that fresh start fails too, the wheel sits on
-what the model does not have (pressed onto a bump or into a dent, both ways read the same misfit): it rolls
-on through it (:func:`_roll_on`), localizes afresh beyond, and the run ends "mismatch", the stretch that did
-not fit placed under the estimate. Likewise where it jumps both ways at once and no place of the model has such
-jumps (pressed onto a short bump, or into a narrow dent, whose sides it cannot roll over as the model's curve):
-it rolls over this way, jumps and all, and localizes afresh beyond.
+the wheel turned to after that jump), else the other way; :data:`MAX_RESTARTS` times at the most. When the
+last fresh start fails too, the wheel sits on what the model does not have (pressed onto a bump or into a
+dent, every way reads the same misfit): it rolls on through it (:func:`_roll_on`), localizes afresh beyond,
+and the run ends "mismatch", the stretch that did not fit placed under the estimate where the belief holds
+that place (:func:`driver.jaw.holds_place`). Likewise where it is stuck or enclosed by jumps (both ways at one
+place, or again where it jumped the same way) and no start of the model has a place it cannot roll over at every
+one of them (pressed onto a short bump, or into a dent, whose sides it cannot roll over as the model's curve):
+it rolls over this way, jumps and all, and localizes afresh beyond. A roll on
+that cannot be made retraces its steps and the rolling stops "blocked" as it would have.
 """
 
 from __future__ import annotations
@@ -19,13 +22,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
-from localizer import DEFECT_WINDOW, Belief, Outline, Part, WheelFilter, WheelJaw
+from localizer import DEFECT_WINDOW, Belief, Outline, Part, WheelFilter, WheelJaw, wheel_reach_for
 
-from ..jaw import PRESS, PressSettings
+from ..jaw import PRESS, PressSettings, holds_place
 from ..rig import Rig, RigError
 from .disc import (
     WHEEL_POLICY,
@@ -38,7 +42,8 @@ from .disc import (
 
 __all__ = ["WheelRun", "WheelSlip", "localize_with_wheel", "MAX_RESTARTS"]
 
-#: Times the rolling may start afresh after nothing fit its readings, before it stops "blocked".
+#: Times the rolling may retrace and start afresh after nothing fit its readings, before it rolls on through
+#: (module notes).
 MAX_RESTARTS = 2
 
 
@@ -106,22 +111,30 @@ class WheelRun:
         return self.belief.map_arc
 
 
-def _roll_on(
-    disc: WheelDisc, direction: int, length: float, policy: WheelPolicy, through: bool = False
-) -> tuple[float, float, float, bool]:
-    """Roll ``direction`` until ``length`` mm of arc is rolled, without judging the readings: the hand's turning
-    (rad, both ways counted), the arc (signed, mm) and the rim's slip (mm) over it, and whether it got through
-    (False: the wheel jumped first, and stays where that step started; or it pivots on a corner where no arc is
-    rolled); ``through``: over jumps too (:meth:`WheelDisc.step`)."""
-    turned = d_len = slip = 0.0
-    for _ in range(int(math.ceil(4 * length / policy.step))):  # a step rolls about policy.step of arc
+class _RolledOn(NamedTuple):
+    turned: float  # the hand's turning, both ways counted (the way back too, where it went back), rad
+    arc: float  # the arc rolled, signed, mm (0 where it went back)
+    through: bool  # it rolled the whole length
+
+
+def _roll_on(disc: WheelDisc, direction: int, length: float, policy: WheelPolicy, through: bool = False) -> _RolledOn:
+    """Roll ``direction`` until ``length`` mm of arc is rolled, without judging the readings; ``through``: over
+    jumps too (:meth:`WheelDisc.step`). Where it cannot (the wheel jumped first, or pivots on a corner where no
+    arc is rolled), it retraces its steps to where it started."""
+    turned = d_len = 0.0
+    poses = [disc.hand.pose]
+    for _ in range(int(math.ceil(4 * length / policy.step))):  # a step rolls about policy.step of arc on a curve
         moved = disc.step(direction, through)
         if moved is None:
-            return turned, d_len, slip, False
-        turned, d_len, slip = turned + abs(moved[0]), d_len + moved[1], slip + moved[2]
+            break
+        turned, d_len = turned + abs(moved[0]), d_len + moved[1]
+        poses.append(disc.hand.pose)
         if abs(d_len) >= length:
-            return turned, d_len, slip, True
-    return turned, d_len, slip, False
+            return _RolledOn(turned, d_len, True)
+    for pose in reversed(poses[:-1]):
+        disc.hand.go(*pose)
+    disc.state = disc.settled()
+    return _RolledOn(2 * turned, 0.0, False)
 
 
 def localize_with_wheel(
@@ -179,9 +192,14 @@ def localize_with_wheel(
     # the rim's slip (mm) and the arc (mm) it is judged over: since the wheel last started afresh beyond what the
     # model does not have (rolling over a bump sharper than the rim reads as slip there)
     judged = [0.0, 0.0]
+    # per start, whether every jump of this segment was where the model has a place the wheel cannot roll over,
+    # at a contact it can touch (empty: no jump yet)
+    explained: list[npt.NDArray[np.bool_]] = []
+    reach = wheel_reach_for(part, wheel)
 
-    def start_beyond() -> None:
-        """Localize afresh where the wheel is, having rolled on past what did not fit."""
+    def afresh(beyond: bool) -> None:
+        """Start the filter afresh where the wheel is, as a new segment; ``beyond``: having rolled on past what did
+        not fit (the rim's slip is judged from here)."""
         nonlocal poses, segment_rotation, start, segment, blocked
         poses, segment_rotation = [disc.hand.pose], 0.0
         start, segment = disc.state, segment + 1
@@ -192,28 +210,32 @@ def localize_with_wheel(
         truths.append(disc.truth())
         segments.append(segment)
         blocked = []
-        judged[:] = [0.0, 0.0]
+        explained[:] = []
+        if beyond:
+            judged[:] = [0.0, 0.0]
 
     while True:
         moved = disc.step(direction)
         if moved is None:
             margin = 1.0 + pol.step
             flt.jumped(direction, margin=margin)
+            here = flt.explains_jump(direction, margin) & np.asarray(reach.touchable(flt.present()))
+            explained[:] = [here & explained[0] if explained else here]
             jumps += 1
             # a jump where the last one was (stuck), or where one the same way was before (the wheel enclosed
             # between two places it cannot pass: rolling on reads the same ground again)
             near = [(d, L) for d, L in blocked if abs(lengths[-1] - L) < 2 * pol.step]
             if near and (near[-1] == blocked[-1] or any(d == direction for d, _ in near)):
-                if met is None and not bool(np.any(flt.explains_jump(1, margin) & flt.explains_jump(-1, margin))):
-                    # jumps both ways where no place of the model has them (the wheel pressed onto a short bump
-                    # or into a narrow dent, whose sides it cannot roll over as the model's curve): roll over it
-                    # this way, and localize afresh beyond
-                    turned, d_len, _, through = _roll_on(disc, direction, DEFECT_WINDOW, pol, through=True)
-                    rotation += turned
-                    arc += abs(d_len)
-                    if through:
-                        met = (-d_len - 1.0, -d_len + 1.0)  # where it was blocked, from here
-                        start_beyond()
+                if met is None and not explained[0].any():
+                    # stuck or enclosed by jumps no place of the model has (the wheel pressed onto a short bump or
+                    # into a dent, whose sides it cannot roll over as the model's curve). Roll over this way, and
+                    # localize afresh beyond
+                    rolled_on = _roll_on(disc, direction, DEFECT_WINDOW, pol, through=True)
+                    rotation += rolled_on.turned
+                    arc += abs(rolled_on.arc)
+                    if rolled_on.through:
+                        met = (-rolled_on.arc - 1.0, -rolled_on.arc + 1.0)  # where it was blocked, from here
+                        afresh(beyond=True)
                         continue
                 stopped = "blocked"
                 break
@@ -258,43 +280,35 @@ def localize_with_wheel(
             if not belief.consistent:
                 # nothing fits what was read since the segment's start: the wheel jammed where it read
                 # as rolling. Retrace the segment's poses back to its start (the jam unwinds as it
-                # was wound), and start afresh there, away from its last jump; twice at the most
+                # was wound), and start afresh there, away from its last jump; MAX_RESTARTS times at the most
                 if segment >= MAX_RESTARTS:
-                    stopped = "blocked"
-                    break
-                if segment == MAX_RESTARTS - 1:
-                    # the fresh start failed too: from where every segment started, rolling either way (or the
-                    # same way again) reads what the model does not have (the wheel started on a bump or in a
-                    # dent). Roll on through it instead, and localize afresh beyond
-                    here = lengths[-1]
-                    rolled = [L for L, g in zip(lengths, segments) if g <= segment]
-                    turned, d_len, _, through = _roll_on(disc, direction, DEFECT_WINDOW, pol)
-                    rotation += turned
-                    arc += abs(d_len)
-                    if not through:
+                    if met is not None:
                         stopped = "blocked"
                         break
-                    # what did not fit, in the rolled arc from where the next segment starts
-                    met = (min(rolled) - here - d_len, max(rolled) - here - d_len)
-                    start_beyond()
+                    # every fresh start, from where the first segment started, failed too: rolling either way
+                    # (and again) reads what the model does not have there (the wheel was pressed onto a bump or
+                    # into a dent). Roll on through it this way, and localize afresh beyond
+                    rolled_on = _roll_on(disc, direction, DEFECT_WINDOW, pol)
+                    rotation += rolled_on.turned
+                    arc += abs(rolled_on.arc)
+                    if not rolled_on.through:
+                        stopped = "blocked"
+                        break
+                    # what did not fit (every segment's readings, from that one start), from where the next starts
+                    back = lengths[-1] + rolled_on.arc
+                    met = (min(lengths) - back, max(lengths) - back)
+                    afresh(beyond=True)
                     continue
                 for pose in reversed(poses[:-1]):
                     disc.hand.go(*pose)
                 disc.state = disc.settled()
                 rotation += segment_rotation
-                poses, segment_rotation = [disc.hand.pose], 0.0
-                start, segment = disc.state, segment + 1
-                flt.reset()
-                flt.update(0.0, 0.0)
-                lengths.append(0.0)
-                turns.append(0.0)
-                truths.append(disc.truth())
-                segments.append(segment)
                 # away from the segment's last jump (a jam wedges the disc at a mouth it then jumps across):
                 # the way the wheel turned to after that jump, which it keeps; without a jump, the other way
-                if not blocked:
+                turn_round = not blocked
+                afresh(beyond=False)
+                if turn_round:
                     direction, reversals = -direction, reversals + 1
-                blocked = []
         if rotation >= pol.max_rotation:
             stopped = "max_rotation"
             break
@@ -314,8 +328,9 @@ def localize_with_wheel(
         stopped = "mismatch"
         if final.mismatch is None:
             ends = (math.nan, math.nan)
-            if final.consistent:
-                first = final.map_arc - lengths[-1]  # where the last segment started, under the estimate
+            first = final.map_arc - lengths[-1]  # where the last segment started, under the estimate
+            at = int(np.argmin(np.abs(np.asarray(part.arc_offset(flt.grid, first)))))
+            if final.consistent and holds_place(part, flt.grid, flt.posterior(), at):
                 ends = (float(part.wrap_arc(first + met[0])), float(part.wrap_arc(first + met[1])))
             final = replace(final, mismatch=ends)
     return WheelRun(

@@ -323,17 +323,15 @@ class WheelFilter:
         ``direction`` (+1: counter-clockwise). The starts under which the wheel could still have rolled
         on for ``margin`` mm there are made :data:`~localizer.BRIDGE_MISS` times less likely (soft: a
         jump may be read where there was none)."""
+        if direction not in (1, -1):
+            raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
         self._penalty += np.where(self.explains_jump(direction, margin), 0.0, math.log(BRIDGE_MISS))
 
     def explains_jump(self, direction: int, margin: float = 1.0) -> BoolArray:
-        """Per start, whether the wheel, rolling on from its present contact in ``direction`` (+1:
-        counter-clockwise), meets a place it cannot roll over (it would jump) within ``margin`` mm."""
-        if direction not in (1, -1):
-            raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
-        n = self.grid.size
-        here = np.rint(self.part.wrap_arc(self.grid + self.current) / self.h).astype(np.int64) % n
-        free = (self._ahead_jump if direction > 0 else self._behind_jump)[here]
-        out: BoolArray = free <= margin
+        """Per start, whether the wheel rolling on from its present contact ``direction`` (+1: counter-clockwise)
+        meets within ``margin`` mm a place it cannot roll over (it would jump there)."""
+        here = np.rint(self.part.wrap_arc(self.grid + self.current) / self.h).astype(np.intp) % self.grid.size
+        out: BoolArray = (self._ahead_jump if direction > 0 else self._behind_jump)[here] <= margin
         return out
 
     # --------------------------------------------------------------- belief

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from driver.rig import RigError
-from driver.wheel import WheelCalibration, WheelPolicy, WheelSlip, localize_with_wheel
+from driver.wheel import MAX_RESTARTS, WheelCalibration, WheelPolicy, WheelSlip, localize_with_wheel
 from localizer import WheelJaw, load_part, part_from_points, wheel_reach_for
 from sim2d import SimRig, WheelRig
 
@@ -360,14 +360,15 @@ def test_a_wheel_that_jumps_both_ways_at_one_place_stops_blocked_unsure():
 @pytest.mark.parametrize("noise", ["none", "paper"])
 def test_a_wheel_started_on_a_bump_rolls_on_through_it_localizes_beyond_and_says_where_it_was(noise):
     """A 0.2 mm bump 7.9 mm long on a tuning part, the wheel pressed 1.8 mm past its crest: nothing fits rolling
-    either way, nor the first way again. The wheel rolls on through instead and localizes beyond it; the run ends
-    "mismatch" (never sure), the stretch that did not fit placed under the estimate, on the bump."""
+    either way, nor the first way again (each fresh start retraced to the first's start). The wheel then rolls on
+    through and localizes beyond it; the run ends "mismatch" (never sure), the stretch that did not fit placed
+    under the estimate, on the bump (before, it stopped there with nothing localized and no place)."""
     from sim2d import Defect, WorldChange
 
     part = load_part("bench/parts/tuning/filleted-03.json")
     bump = Defect(190.2, 0.2, 7.9)
     run, err = localize(part, WheelJaw(5.0), 192.0, noise=noise, seed=1, change=WorldChange(defects=(bump,)))
-    assert run.restarts == 2 and run.stopped == "mismatch" and not run.belief.sure(0.95)
+    assert run.restarts == MAX_RESTARTS + 1 and run.stopped == "mismatch" and not run.belief.sure(0.95)
     assert abs(err) < 0.3  # localized beyond the bump
     assert run.belief.mismatch is not None
     lo, hi = run.belief.mismatch
@@ -392,3 +393,63 @@ def test_a_wheel_pressed_onto_a_short_bump_rolls_over_it_and_says_where_it_was_b
     lo, hi = run.belief.mismatch
     assert hi - lo == pytest.approx(2.0, abs=1e-6)
     assert lo < bump.arc + bump.length / 2 and hi > bump.arc - bump.length / 2
+
+
+def test_a_roll_on_that_cannot_be_made_retraces_its_steps():
+    """A roll on past what does not fit that jumps (or pivots) before its length: the hand goes back through the
+    poses it took, last first, and the wheel is where the roll on began; the turning counts the way back too."""
+    from types import SimpleNamespace
+
+    from driver.wheel.rolling import _roll_on
+
+    class Disc:
+        def __init__(self, moves):
+            self.moves, self.went, self.state = list(moves), [], None
+            self.hand = SimpleNamespace(pose=(0.0, 0.0, 0.0), go=self.go)
+
+        def go(self, *pose):
+            self.went.append(pose)
+            self.hand.pose = pose
+
+        def step(self, direction, through=False):
+            move = self.moves.pop(0)
+            if move is not None:
+                x, y, phi = self.hand.pose
+                self.hand.pose = (x + direction * 0.5, y, phi + move[0])
+            return move
+
+        def settled(self):
+            return ("settled", self.hand.pose)
+
+    policy = WheelPolicy()
+    disc = Disc([(0.01, 0.5, 0.0), (0.02, 0.5, 0.0), None])
+    out = _roll_on(disc, 1, 6.0, policy)
+    assert not out.through and out.arc == 0.0 and out.turned == pytest.approx(2 * 0.03)
+    assert disc.went == [(0.5, 0.0, 0.01), (0.0, 0.0, 0.0)] and disc.hand.pose == (0.0, 0.0, 0.0)
+    assert disc.state == ("settled", (0.0, 0.0, 0.0))
+    # through: the whole length rolled, the wheel stays there
+    disc = Disc([(0.01, 2.0, 0.0)] * 3)
+    out = _roll_on(disc, -1, 6.0, policy, through=True)
+    assert out.through and out.arc == pytest.approx(6.0) and disc.went == []
+
+
+def test_a_wheel_run_that_rolled_on_past_a_bump_is_located_again_with_its_mismatch(tmp_path, capsys):
+    """'locate' of a wheel's trace replays the last segment (the one beyond the bump, which did not read it): the
+    run's own finding is kept, and the ending says it and exits 2, as the run did."""
+    from driver.cli import main
+
+    world = tmp_path / "bump.toml"
+    world.write_text(
+        '[world]\ndefects = 1\ndefect_height_mm = 0.25\ndefect_length_mm = 7.9\ndefect_place = "start"\n'
+        "defect_near_mm = 0.5\n"
+    )
+    part, out = "bench/parts/tuning/filleted-03.json", str(tmp_path / "w.npz")
+    args = ["--jaw", "wheel:5", "--reactive", "--start", "192", "--world", str(world), "--engine", "kinematic"]
+    assert main(["simulate", part, *args, "--noise", "paper", "--seed", "1", "--out", out, "--json"]) == 2
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["stopped"] == "mismatch" and doc["error_mm"] < 0.3 and doc["mismatch"]["from_arc"] is not None
+    assert main(["locate", out, "--part", part, "--json"]) == 2
+    again = json.loads(capsys.readouterr().out)
+    assert again["mismatch"] == doc["mismatch"] and abs(again["estimate_arc"] - doc["estimate_arc"]) < 1e-6
+    assert main(["locate", out, "--part", part]) == 2
+    assert "MODEL MISMATCH near arc" in capsys.readouterr().out
