@@ -69,6 +69,9 @@ JUMP_FLOOR = math.radians(0.5)
 #: A step whose axle path and encoders disagree by more than this fraction of the step is a jump (slip
 #: is gradual: a rim that loses this much in one step has lost the contact).
 JUMP_MISMATCH = 0.25
+#: How far the hand lifts the wheel off the part along the contact normal to press it again (mm): clear of
+#: the wrist's give at the target force (about 1 mm) with room to zero the wrist.
+RESEAT_LIFT = 3.0
 
 
 @runtime_checkable
@@ -227,6 +230,16 @@ class WheelDisc:
         self.depth = pol.target / self.stiffness
         self.state = self.settled()
         return self.state
+
+    def press_again(self) -> tuple[float, float, float, float, float]:
+        """Lift the wheel :data:`RESEAT_LIFT` mm off the part along the contact normal and press it again there
+        (:meth:`begin`: the wrist zeroed, its stiffness measured afresh); the settled state. After rolling on
+        past what the model does not have: the first press may have been on it (on a bump's flank the wrist
+        reads a stiffness 6–18% off, and the axle's path then disagrees with rolling at every step)."""
+        x, y, phi = self.hand.pose
+        _, a = self._read()
+        beta = phi + a
+        return self.begin((x + RESEAT_LIFT * math.sin(beta), y - RESEAT_LIFT * math.cos(beta), beta))
 
     def _read(self) -> tuple[float, float]:
         """(|Δv| V, α rad) from the wrist."""

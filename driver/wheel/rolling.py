@@ -201,6 +201,8 @@ def localize_with_wheel(
         """Start the filter afresh where the wheel is, as a new segment; ``beyond``: having rolled on past what did
         not fit (the rim's slip is judged from here)."""
         nonlocal poses, segment_rotation, start, segment, blocked
+        if beyond:
+            disc.press_again()  # the wrist measured again, away from what the first press may have been on
         poses, segment_rotation = [disc.hand.pose], 0.0
         start, segment = disc.state, segment + 1
         flt.reset()

@@ -453,3 +453,18 @@ def test_a_wheel_run_that_rolled_on_past_a_bump_is_located_again_with_its_mismat
     assert again["mismatch"] == doc["mismatch"] and abs(again["estimate_arc"] - doc["estimate_arc"]) < 1e-6
     assert main(["locate", out, "--part", part]) == 2
     assert "MODEL MISMATCH near arc" in capsys.readouterr().out
+
+
+def test_after_rolling_over_a_bump_it_was_pressed_on_the_wheel_measures_its_wrist_again():
+    """Pressed on a 0.46 mm bump's flank, the wrist's stiffness reads 18% low (the give measured against a
+    slope), and after the wheel rolled over the bump its axle path disagreed with rolling by a steady 1.1% of
+    the arc, noise-free, until the rim-slip stop 11 mm on. Pressed again beyond the bump, the wrist reads true:
+    the rolling localizes there and ends "mismatch", never a slip."""
+    from sim2d import Defect, WorldChange
+
+    part = load_part("bench/parts/heldout-u/superellipse-13.json")
+    change = WorldChange(defects=(Defect(267.7, 0.46, 4.0),))
+    run, err = localize(part, WheelJaw(5.0), 266.5, noise="none", change=change)
+    assert run.stopped == "mismatch" and abs(err) < 0.3
+    assert run.depth == pytest.approx(1.0, rel=0.02)  # the simulated wrist gives 1 mm at the target force
+    assert abs(run.slip) < 0.02
