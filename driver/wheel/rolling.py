@@ -13,7 +13,8 @@ and the run ends "mismatch", the stretch that did not fit placed under the estim
 that place (:func:`driver.jaw.holds_place`). Likewise where it is stuck or enclosed by jumps (both ways at one
 place, or again where it jumped the same way) and no start of the model has a place it cannot roll over at every
 one of them (pressed onto a short bump, or into a dent, whose sides it cannot roll over as the model's curve):
-it rolls over this way, jumps and all, and localizes afresh beyond. A roll on
+it rolls over this way, jumps and all, and localizes afresh beyond. Beyond, the wheel is pressed again
+(:meth:`WheelDisc.press_again`): the first press may have been on what the model does not have. A roll on
 that cannot be made retraces its steps and the rolling stops "blocked" as it would have.
 """
 
