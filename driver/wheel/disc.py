@@ -233,13 +233,22 @@ class WheelDisc:
 
     def press_again(self) -> tuple[float, float, float, float, float]:
         """Lift the wheel :data:`RESEAT_LIFT` mm off the part along the contact normal and press it again there
-        (:meth:`begin`: the wrist zeroed, its stiffness measured afresh); the settled state. After rolling on
+        (:meth:`begin`: the wrist zeroed, its stiffness measured afresh; where the lifted wheel still touches, as it
+        was); the settled state. After rolling on
         past what the model does not have: the first press may have been on it (on a bump's flank the wrist
         reads a stiffness 6–18% off, and the axle's path then disagrees with rolling at every step)."""
         x, y, phi = self.hand.pose
         _, a = self._read()
         beta = phi + a
-        return self.begin((x + RESEAT_LIFT * math.sin(beta), y - RESEAT_LIFT * math.cos(beta), beta))
+        lifted = (x + RESEAT_LIFT * math.sin(beta), y - RESEAT_LIFT * math.cos(beta), beta)
+        self.hand.go(*lifted)
+        if self._read()[0] >= 0.1 * self.policy.target:
+            # still touching (a concavity too narrow to lift clear in): the wrist cannot be zeroed here; keep its
+            # zero and stiffness, and put the wheel back
+            self.hand.go(x, y, phi)
+            self.state = self.settled()
+            return self.state
+        return self.begin(lifted)
 
     def _read(self) -> tuple[float, float]:
         """(|Δv| V, α rad) from the wrist."""

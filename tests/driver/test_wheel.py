@@ -468,3 +468,33 @@ def test_after_rolling_over_a_bump_it_was_pressed_on_the_wheel_measures_its_wris
     assert run.stopped == "mismatch" and abs(err) < 0.3
     assert run.depth == pytest.approx(1.0, rel=0.02)  # the simulated wrist gives 1 mm at the target force
     assert abs(run.slip) < 0.02
+
+
+def test_the_wheel_is_pressed_again_only_where_it_lifts_clear():
+    """press_again lifts the wheel 3 mm along the contact normal: where it is clear there it zeroes the wrist and
+    presses afresh (begin); where it still touches (a concavity too narrow to lift clear in) it keeps the zero
+    it has and puts the wheel back where it was."""
+    from types import SimpleNamespace
+
+    from driver.wheel.disc import RESEAT_LIFT, WheelDisc
+
+    def stub(force_when_lifted):
+        s = SimpleNamespace(went=[], begun=[], policy=SimpleNamespace(target=0.4))
+        s.hand = SimpleNamespace(pose=(10.0, 20.0, 0.0))
+
+        def go(*pose):
+            s.went.append(pose)
+            s.hand.pose = pose
+
+        s.hand.go = go
+        s._read = lambda: (0.4, 0.0) if s.hand.pose == (10.0, 20.0, 0.0) else (force_when_lifted, 0.0)
+        s.settled = lambda: ("settled", s.hand.pose)
+        s.begin = lambda pose: s.begun.append(pose) or ("begun", pose)
+        return s
+
+    clear = stub(0.0)
+    lifted = (10.0, 20.0 - RESEAT_LIFT, 0.0)  # β = 0: the contact lies at +y from the axle, away from it is −y
+    assert WheelDisc.press_again(clear) == ("begun", lifted) and clear.begun == [lifted]
+    touching = stub(0.3)
+    assert WheelDisc.press_again(touching) == ("settled", (10.0, 20.0, 0.0))
+    assert touching.begun == [] and touching.went == [lifted, (10.0, 20.0, 0.0)]
