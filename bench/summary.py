@@ -95,7 +95,7 @@ def cell_number(text: Any) -> float:
 
 
 #: A run's reported mismatch interval is *near* a defect when it overlaps the defect's stretch (its centre ±
-#: half its length) or lies within this of it, mm (issue 29's target).
+#: half its length) or lies within this of it, mm (the model-mismatch target's 2 mm, docs/robustness.md).
 NEAR_DEFECT_MM = 2.0
 
 

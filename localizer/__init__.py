@@ -63,6 +63,7 @@ from .filters import (
     Mode,
     ParticleFilter,
     WheelFilter,
+    mass_within,
     most_probable,
 )
 from .geometry import (
@@ -158,6 +159,7 @@ __all__ = [
     "Belief",
     "Mode",
     "most_probable",
+    "mass_within",
     "ModeTracks",
     "tracks_for",
     "BRIDGE_EXCESS",

@@ -9,7 +9,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from localizer import Belief, Boundary, ContactFilter
+from localizer import Belief, Boundary, ContactFilter, mass_within
 
 from .reactive_policy import ReactivePolicy
 
@@ -58,8 +58,7 @@ def holds_place(part: Boundary, grid: npt.NDArray[np.float64], weights: npt.NDAr
     """Whether the belief ``weights`` over starts ``grid`` (model arc, mm; summing to 1) holds at least half its
     mass within :data:`PLACE_RADIUS` of start ``at`` (a grid index): which place is known, to place what a run
     met under it."""
-    near = np.abs(np.asarray(part.arc_offset(grid, float(grid[at])))) <= PLACE_RADIUS
-    return float(np.asarray(weights)[near].sum()) >= 0.5
+    return mass_within(part, grid, weights, float(grid[at]), PLACE_RADIUS) >= 0.5
 
 
 def takeoff_arc(part: Boundary, landing: float, direction: int, jump: float) -> float | None:

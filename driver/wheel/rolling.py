@@ -76,7 +76,8 @@ class WheelRun:
         The rim's slip summed over the steps the rolling judged (:mod:`driver.wheel.disc`, step 5; not over a
         roll on past what the model does not have).
     depth : float, mm
-        The wrist's give at the target force (measured at the first press).
+        The wrist's give at the target force (measured at the last press: the first, or the press again beyond
+        what the wheel rolled on past).
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
     lengths, turns, true_arcs : tuple of float
         Every reading's L (mm) and Ω (rad) since its segment's start, and the true contact (NaN on a
@@ -221,8 +222,7 @@ def localize_with_wheel(
         moved = disc.step(direction)
         if moved is None:
             margin = 1.0 + pol.step
-            flt.jumped(direction, margin=margin)
-            here = flt.explains_jump(direction, margin) & np.asarray(reach.touchable(flt.present()))
+            here = flt.jumped(direction, margin=margin) & np.asarray(reach.touchable(flt.present()))
             explained[:] = [here & explained[0] if explained else here]
             jumps += 1
             # a jump where the last one was (stuck), or where one the same way was before (the wheel enclosed

@@ -3,7 +3,7 @@ filter, the wheel's filter, the particle filter (the conventional peer), and the
 readings a belief must not rest on when the part is not its model.
 """
 
-from ._belief import Belief, Mode, most_probable
+from ._belief import Belief, Mode, mass_within, most_probable
 from ._contact_filter import ContactFilter
 from ._contact_settings import (
     BRIDGE_MISS,
@@ -32,6 +32,7 @@ __all__ = [
     "Belief",
     "Mode",
     "most_probable",
+    "mass_within",
     "BRIDGE_MISS",
     "CONTRADICTION",
     "ENCODER_SD",

@@ -11,7 +11,7 @@ import numpy as np
 from .._types import FloatArray, IntArray
 from ..geometry import check_grid
 
-__all__ = ["Belief", "Mode", "find_modes", "belief_flags", "flat_top", "most_probable", "FLAT_TOP"]
+__all__ = ["Belief", "Mode", "find_modes", "belief_flags", "flat_top", "most_probable", "mass_within", "FLAT_TOP"]
 
 
 @dataclass(frozen=True)
@@ -138,6 +138,23 @@ def most_probable(w: FloatArray, k: int) -> IntArray:
     chosen = np.concatenate([above, np.flatnonzero(w == kth)[: k - above.size]])
     out: IntArray = chosen[np.lexsort((chosen, -w[chosen]))]
     return out
+
+
+def mass_within(part: Any, arcs: FloatArray, weights: FloatArray, at: float, radius: float) -> float:
+    """The weight of the points ``arcs`` (mm along ``part``, each with its weight ``weights``) that lie within
+    ``radius`` mm of arc ``at``, either way round the part.
+
+    Examples
+    --------
+    >>> from localizer import part_from_points
+    >>> a = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    >>> circle = part_from_points(np.c_[30 * np.cos(a), 30 * np.sin(a)])
+    >>> arcs = np.array([1.0, 2.0, circle.perimeter - 0.5, 50.0])
+    >>> round(mass_within(circle, arcs, np.array([0.1, 0.2, 0.3, 0.4]), 0.5, 1.5), 6)
+    0.6
+    """
+    near = np.abs(np.asarray(part.arc_offset(arcs, at))) <= radius
+    return float(np.asarray(weights)[near].sum())
 
 
 #: Weights within this fraction of the most probable one are as probable: a flat top, whose middle is

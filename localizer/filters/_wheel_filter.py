@@ -67,7 +67,7 @@ from .._errors import QueryError
 from .._types import BoolArray, FloatArray
 from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, wheel_reach_for
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
-from ._belief import Belief, belief_flags, find_modes, flat_top, most_probable
+from ._belief import Belief, belief_flags, find_modes, flat_top, mass_within, most_probable
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
 
@@ -318,14 +318,16 @@ class WheelFilter:
         self._cholbuf[k, k] = math.sqrt(d2)
         self.L_used.append(L)
 
-    def jumped(self, direction: int, margin: float = 1.0) -> None:
+    def jumped(self, direction: int, margin: float = 1.0) -> BoolArray:
         """The wheel jumped (and was taken back) when rolling on from the present contact in
         ``direction`` (+1: counter-clockwise). The starts under which the wheel could still have rolled
         on for ``margin`` mm there are made :data:`~localizer.BRIDGE_MISS` times less likely (soft: a
-        jump may be read where there was none)."""
+        jump may be read where there was none); per start, whether it explains the jump (:meth:`explains_jump`)."""
         if direction not in (1, -1):
             raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
-        self._penalty += np.where(self.explains_jump(direction, margin), 0.0, math.log(BRIDGE_MISS))
+        explained = self.explains_jump(direction, margin)
+        self._penalty += np.where(explained, 0.0, math.log(BRIDGE_MISS))
+        return explained
 
     def explains_jump(self, direction: int, margin: float = 1.0) -> BoolArray:
         """Per start, whether the wheel rolling on from its present contact ``direction`` (+1: counter-clockwise)
@@ -377,8 +379,7 @@ class WheelFilter:
         mass = 1.0
         for f in self.noise_scales:
             wf = w if f == self.noise_scales[0] else self._posterior(f)
-            near = np.abs(np.asarray(self.part.arc_offset(present, map_arc))) <= radius
-            mass = min(mass, float(wf[near].sum()))
+            mass = min(mass, mass_within(self.part, present, wf, map_arc, radius))
         consistent = self.consistent()
         if not consistent:
             mass = 0.0
