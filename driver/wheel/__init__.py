@@ -15,7 +15,7 @@ from .disc import (
     corner_pivot,
     kappa_band,
 )
-from .rolling import MAX_RESTARTS, WheelRun, WheelSlip, localize_with_wheel
+from .rolling import MAX_RESTARTS, UNEXPLAINED_JUMP, WheelRun, WheelSlip, localize_with_wheel
 
 __all__ = [
     "CALIBRATION_LENGTH",
@@ -34,6 +34,7 @@ __all__ = [
     "corner_pivot",
     "kappa_band",
     "MAX_RESTARTS",
+    "UNEXPLAINED_JUMP",
     "WheelRun",
     "WheelSlip",
     "localize_with_wheel",

@@ -15,7 +15,10 @@ place, or again where it jumped the same way) and no start of the model has a pl
 one of them (pressed onto a short bump, or into a dent, whose sides it cannot roll over as the model's curve):
 it rolls over this way, jumps and all, and localizes afresh beyond. Beyond, the wheel is pressed again
 (:meth:`WheelDisc.press_again`): the first press may have been on what the model does not have. A roll on
-that cannot be made retraces its steps and the rolling stops "blocked" as it would have.
+that cannot be made retraces its steps and the rolling stops "blocked" as it would have. And where the readings
+fit the model but it jumped where no probable start has a place it cannot roll over (:data:`UNEXPLAINED_JUMP`: a
+dent it bridged, whose near edge read as a convex corner it pivots on), it retraces the segment to its start,
+is pressed again there, and localizes afresh the other way; the run ends "mismatch", the jump placed as above.
 """
 
 from __future__ import annotations
@@ -41,11 +44,15 @@ from .disc import (
     kappa_band,
 )
 
-__all__ = ["WheelRun", "WheelSlip", "localize_with_wheel", "MAX_RESTARTS"]
+__all__ = ["WheelRun", "WheelSlip", "localize_with_wheel", "MAX_RESTARTS", "UNEXPLAINED_JUMP"]
 
 #: Times the rolling may retrace and start afresh after nothing fit its readings, before it rolls on through
 #: (module notes).
 MAX_RESTARTS = 2
+#: A jump is one the model does not have when the belief before it gives less than this probability to the
+#: starts that explain it (:meth:`localizer.WheelFilter.explains_jump`) while the readings still fit some start
+#: under the largest of the filter's noise scales.
+UNEXPLAINED_JUMP = 1e-6
 
 
 class WheelSlip(RigError):
@@ -68,9 +75,9 @@ class WheelRun:
         "confident" (the final belief sure, whatever ended the rolling), "max_rotation", "max_arc", "blocked"
         (jumps both ways at one place, or again where the wheel jumped the same way before: enclosed) or
         "mismatch" (a stretch of the readings fits no probable place, or nothing fits after :data:`MAX_RESTARTS`
-        fresh starts, or the wheel rolled on through what did not fit (module notes): the part is not its model,
-        ``belief.mismatch`` says where when it can); slip beyond the policy's limit raises :class:`WheelSlip`
-        instead.
+        fresh starts, or the wheel rolled on through what did not fit, or jumped where the model has no place to
+        (module notes): the part is not its model, ``belief.mismatch`` says where when it can); slip beyond the
+        policy's limit raises :class:`WheelSlip` instead.
     reversals, jumps : int
     slip : float, mm
         The rim's slip summed over the steps the rolling judged (:mod:`driver.wheel.disc`, step 5; not over a
@@ -191,19 +198,20 @@ def localize_with_wheel(
     blocked: list[tuple[int, float]] = []  # (direction, L mm) of the jumps of this segment
     stopped = "max_rotation"
     met: tuple[float, float] | None = None  # what the wheel rolled on through (:func:`_roll_on`)
-    # the rim's slip (mm) and the arc (mm) it is judged over: since the wheel last started afresh beyond what the
-    # model does not have (rolling over a bump sharper than the rim reads as slip there)
+    bridged: tuple[float, float] | None = None  # where it jumped at what the model does not have
+    # the rim's slip (mm) and the arc (mm) it is judged over: since the wheel was last pressed again after meeting
+    # what the model does not have (rolling over a bump sharper than the rim reads as slip there)
     judged = [0.0, 0.0]
     # per start, whether every jump of this segment was where the model has a place the wheel cannot roll over,
     # at a contact it can touch (empty: no jump yet)
     explained: list[npt.NDArray[np.bool_]] = []
     reach = wheel_reach_for(part, wheel)
 
-    def afresh(beyond: bool) -> None:
-        """Start the filter afresh where the wheel is, as a new segment; ``beyond``: having rolled on past what did
+    def afresh(reseat: bool) -> None:
+        """Start the filter afresh where the wheel is, as a new segment; ``reseat``: having met what did
         not fit (the rim's slip is judged from here)."""
         nonlocal poses, segment_rotation, start, segment, blocked
-        if beyond:
+        if reseat:
             disc.press_again()  # the wrist measured again, away from what the first press may have been on
         poses, segment_rotation = [disc.hand.pose], 0.0
         start, segment = disc.state, segment + 1
@@ -215,16 +223,38 @@ def localize_with_wheel(
         segments.append(segment)
         blocked = []
         explained[:] = []
-        if beyond:
+        if reseat:
             judged[:] = [0.0, 0.0]
+
+    def retrace() -> None:
+        """Take the hand back through this segment's poses to where it started (a jam unwinds as it was wound)."""
+        nonlocal rotation
+        for pose in reversed(poses[:-1]):
+            disc.hand.go(*pose)
+        disc.state = disc.settled()
+        rotation += segment_rotation
 
     while True:
         moved = disc.step(direction)
         if moved is None:
             margin = 1.0 + pol.step
-            here = flt.jumped(direction, margin=margin) & np.asarray(reach.touchable(flt.present()))
+            before = flt.posterior()
+            explains = flt.jumped(direction, margin=margin)
+            here = explains & np.asarray(reach.touchable(flt.present()))
             explained[:] = [here & explained[0] if explained else here]
             jumps += 1
+            fits = flt.consistent(max(flt.noise_scales))
+            if met is None and bridged is None and fits and before[explains].sum() < UNEXPLAINED_JUMP:
+                # the readings fit the model at the noise the stated probability allows, and no probable place of it
+                # has what the wheel jumped at: it met what the model does not have (a dent it bridged reads as a
+                # convex corner it pivots on, then the jump no corner makes; a wheel wedged in a concave corner of
+                # the model reads as nothing fits instead). Retrace the segment to its start, and start afresh
+                # there away from it
+                bridged = (lengths[-1] - 1.0, lengths[-1] + 1.0)  # the segment's start is the next one's
+                retrace()
+                afresh(reseat=True)
+                direction, reversals = -direction, reversals + 1
+                continue
             # a jump where the last one was (stuck), or where one the same way was before (the wheel enclosed
             # between two places it cannot pass: rolling on reads the same ground again)
             near = [(d, L) for d, L in blocked if abs(lengths[-1] - L) < 2 * pol.step]
@@ -238,7 +268,7 @@ def localize_with_wheel(
                     arc += abs(rolled_on.arc)
                     if rolled_on.through:
                         met = (-rolled_on.arc - 1.0, -rolled_on.arc + 1.0)  # where it was blocked, from here
-                        afresh(beyond=True)
+                        afresh(reseat=True)
                         continue
                 stopped = "blocked"
                 break
@@ -300,16 +330,13 @@ def localize_with_wheel(
                     # what did not fit (every segment's readings, from that one start), from where the next starts
                     back = lengths[-1] + rolled_on.arc
                     met = (min(lengths) - back, max(lengths) - back)
-                    afresh(beyond=True)
+                    afresh(reseat=True)
                     continue
-                for pose in reversed(poses[:-1]):
-                    disc.hand.go(*pose)
-                disc.state = disc.settled()
-                rotation += segment_rotation
+                retrace()
                 # away from the segment's last jump (a jam wedges the disc at a mouth it then jumps across):
                 # the way the wheel turned to after that jump, which it keeps; without a jump, the other way
                 turn_round = not blocked
-                afresh(beyond=False)
+                afresh(reseat=False)
                 if turn_round:
                     direction, reversals = -direction, reversals + 1
         if rotation >= pol.max_rotation:
@@ -325,6 +352,7 @@ def localize_with_wheel(
         stopped = "confident"
     if stopped != "confident" and (final.mismatch is not None or not final.consistent):
         stopped = "mismatch"
+    met = met if met is not None else bridged
     if met is not None:
         # the wheel rolled on through what did not fit: the run met a part that is not its model, whatever it
         # found beyond; said where under the most probable start when something fits

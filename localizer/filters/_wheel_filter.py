@@ -489,11 +489,12 @@ class WheelFilter:
         hi = s0 + min(where[0] + w, float(rolled.max()))
         return (float(self.part.wrap_arc(lo)), float(self.part.wrap_arc(hi))), float(best[0])
 
-    def consistent(self) -> bool:
-        """Whether some start the wheel can touch fits the readings used, under :data:`WHEEL_FIT_SCALE`
-        times the error model (χ² test at :data:`~localizer.FIT_ALPHA`)."""
+    def consistent(self, scale: float = WHEEL_FIT_SCALE) -> bool:
+        """Whether some start the wheel can touch fits the readings used, under ``scale`` times the error model
+        (χ² test at :data:`~localizer.FIT_ALPHA`; by default :data:`WHEEL_FIT_SCALE`, the noisiest level the
+        filter is meant to be trusted at)."""
         k = len(self.L_used)
         if k == 0:
             return True
         best = float(np.min(np.where(self.prior > 0, self._quad, np.inf)))
-        return bool(chdtrc(k, best / WHEEL_FIT_SCALE**2) >= FIT_ALPHA)
+        return bool(chdtrc(k, best / scale**2) >= FIT_ALPHA)

@@ -380,14 +380,16 @@ def test_a_wheel_started_on_a_bump_rolls_on_through_it_localizes_beyond_and_says
 def test_a_wheel_pressed_onto_a_short_bump_rolls_over_it_and_says_where_it_was_blocked(noise):
     """A 0.39 mm bump 2.4 mm long on a tuning part, the wheel pressed onto its side: a step either way turns the
     hand beyond what rolling on the model's curve can, read as a jump both ways at once, which no place of the
-    model has. The wheel rolls over it instead and localizes beyond; the run ends "mismatch" (never sure), the
-    place where it was blocked said under the estimate, on the bump (blocked, nothing localized, before)."""
+    model has. The first jump, which no probable place of the model explains, turns the wheel round afresh; the
+    second, the other way, leaves it stuck. The wheel rolls over it instead and localizes beyond; the run ends
+    "mismatch" (never sure), the place where it was blocked said under the estimate, on the bump (blocked, nothing
+    localized, before)."""
     from sim2d import Defect, WorldChange
 
     part = load_part("bench/parts/tuning/superellipse-01.json")
     bump = Defect(211.35, 0.39, 2.36)
     run, err = localize(part, WheelJaw(5.0), 211.6, noise=noise, seed=1, change=WorldChange(defects=(bump,)))
-    assert run.jumps == 2 and run.restarts == 1 and run.stopped == "mismatch" and not run.belief.sure(0.95)
+    assert run.jumps == 3 and run.restarts == 2 and run.stopped == "mismatch" and not run.belief.sure(0.95)
     assert abs(err) < 0.3
     assert run.belief.mismatch is not None
     lo, hi = run.belief.mismatch
@@ -498,3 +500,25 @@ def test_the_wheel_is_pressed_again_only_where_it_lifts_clear():
     touching = stub(0.3)
     assert WheelDisc.press_again(touching) == ("settled", (10.0, 20.0, 0.0))
     assert touching.begun == [] and touching.went == [lifted, (10.0, 20.0, 0.0)]
+
+
+def test_a_dent_the_wheel_bridges_is_not_taken_for_a_corner_it_pivots_on():
+    """A 0.31 mm dent 2.4 mm long on the long face of a held-out drawing's plate, 3.8 mm ahead of the start:
+    the wheel tilts over the dent's near edge as it pivots on a convex corner (the hand turns, little arc is
+    rolled), then jumps to the far edge, which no corner does. Before, the readings fit only the plate's one
+    convex corner, 36 mm away along the same face, and the run was sure there (0.9999, 36 mm off). The jump is
+    one no probable place of the model has: the wheel starts afresh the other way, is found, and the run ends
+    "mismatch", the place of the jump said under the estimate, on the dent."""
+    from driver.wheel import WheelCalibration
+    from sim2d import Defect, WorldChange
+
+    part = load_part("bench/parts/cad-heldout-k/plate-04.dxf")
+    wheel, dent = WheelJaw(5.0), Defect(370.72, -0.31, 2.42)
+    rig = WheelRig(part, wheel, noise="paper", seed=1580335111, true_radius=4.982, change=WorldChange(defects=(dent,)))
+    cal = WheelCalibration(jaw="wheel:5", radius=4.982, direction_zero=-0.003, depth=1.0)
+    run = localize_with_wheel(rig, part, wheel, approach_pose=rig.approach_pose(366.91), calibration=cal)
+    assert run.stopped == "mismatch" and not run.belief.sure(0.95)
+    assert abs(part.arc_offset(run.estimate_arc, rig.truth()["contact_arc"])) < 0.3
+    assert run.belief.mismatch is not None
+    lo, hi = run.belief.mismatch
+    assert lo < dent.arc + dent.length / 2 and hi > dent.arc - dent.length / 2
