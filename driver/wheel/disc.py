@@ -216,8 +216,8 @@ class WheelDisc:
         self.kappa_band, self.pivot = kappa_band, float(pivot)
 
     def begin(self, approach_pose: Iterable[float]) -> tuple[float, float, float, float, float]:
-        """Zero the wrist clear of the part, press from ``approach_pose``, measure the wrist's stiffness;
-        the first settled state (φ, α, ψ_e, x, y)."""
+        """Zero the wrist clear of the part, press from ``approach_pose``, measure the wrist's stiffness along the
+        contact's normal; the first settled state (φ, α, ψ_e, x, y)."""
         pol = self.policy
         self.hand = Hand(self.rig, approach_pose)
         self.baseline = zero(self.rig)
@@ -227,6 +227,17 @@ class WheelDisc:
         lighter, _ = self._read()
         self.hand.press_by(0.2)
         self.stiffness = max((dv1 - lighter) / 0.2, 1e-3)
+        # and again along the contact's normal, once the servo has turned the hand to it: pressed on a slope (a
+        # bump's flank) the hand's axis is not the normal, and the give read along it was 6-33% off, which the
+        # axle's path then shows as the rim slipping wherever the hand turns
+        _, a = self._settle()
+        x, y, phi = self.hand.pose
+        beta = phi + a
+        self.hand.go(x + 0.2 * math.sin(beta), y - 0.2 * math.cos(beta), phi)
+        lighter, _ = self._read()
+        self.hand.go(x, y, phi)
+        pressed, _ = self._read()
+        self.stiffness = max((pressed - lighter) / 0.2, 1e-3)
         self.depth = pol.target / self.stiffness
         self.state = self.settled()
         return self.state
@@ -234,9 +245,7 @@ class WheelDisc:
     def press_again(self) -> tuple[float, float, float, float, float]:
         """Lift the wheel :data:`RESEAT_LIFT` mm off the part along the contact normal and press it again there
         (:meth:`begin`: the wrist zeroed, its stiffness measured afresh; where the lifted wheel still touches, as it
-        was); the settled state. After rolling on
-        past what the model does not have: the first press may have been on it (on a bump's flank the wrist
-        reads a stiffness 6–18% off, and the axle's path then disagrees with rolling at every step)."""
+        was); the settled state. After meeting what the model does not have: the first press may have been on it."""
         x, y, phi = self.hand.pose
         _, a = self._read()
         beta = phi + a

@@ -522,3 +522,26 @@ def test_a_dent_the_wheel_bridges_is_not_taken_for_a_corner_it_pivots_on():
     assert run.belief.mismatch is not None
     lo, hi = run.belief.mismatch
     assert lo < dent.arc + dent.length / 2 and hi > dent.arc - dent.length / 2
+
+
+@pytest.mark.parametrize("noise", ["none", "paper"])
+def test_pressed_on_a_bumps_flank_the_wheel_measures_the_wrists_give_along_the_contact_normal(noise):
+    """A 0.4 mm bump 2.2 mm long on a held-out drawn cam, the wheel pressed 1.2 mm before its crest: read along
+    the hand's axis, the wrist's give was 1.33 mm for its true 1.0, and the wheel, pivoting over the crest, read
+    the difference times the hand's turn as the rim slipping (a ``WheelSlip`` stop after 0.1 mm). Read along the
+    contact's normal once the servo has turned the hand to it, the give is true: the wheel localizes, and the run
+    ends "mismatch" with the bump placed."""
+    from driver.jaw import PRESS
+    from driver.wheel import WHEEL_POLICY, WheelDisc, kappa_band
+    from sim2d import Defect, WorldChange
+
+    part, wheel = load_part("bench/parts/cad-heldout-k/cam-05.svg"), WheelJaw(5.0)
+    bump = Defect(164.64, 0.40, 2.19)
+    rig = WheelRig(part, wheel, noise=noise, seed=1, change=WorldChange(defects=(bump,)))
+    disc = WheelDisc(rig, WheelCalibration.nominal(wheel), WHEEL_POLICY, PRESS, kappa_band(part, wheel))
+    disc.begin(rig.approach_pose(163.43))
+    assert disc.depth == pytest.approx(1.0, rel=0.01)  # the simulated wrist gives 1 mm at the target force
+    run, err = localize(part, wheel, 163.43, noise=noise, seed=1, change=WorldChange(defects=(bump,)))
+    assert run.stopped == "mismatch" and abs(err) < 0.3
+    lo, hi = run.belief.mismatch
+    assert lo < bump.arc + bump.length / 2 and hi > bump.arc - bump.length / 2
