@@ -46,8 +46,8 @@ from .disc import (
 
 __all__ = ["WheelRun", "WheelSlip", "localize_with_wheel", "MAX_RESTARTS", "UNEXPLAINED_JUMP"]
 
-#: Times the rolling may retrace and start afresh after nothing fit its readings, before it rolls on through
-#: (module notes).
+#: Times the rolling may retrace and start afresh (after nothing fit its readings, or from a jump the model does
+#: not have), before it rolls on through (module notes).
 MAX_RESTARTS = 2
 #: A jump is one the model does not have when the belief before it gives less than this probability to the
 #: starts that explain it (:meth:`localizer.WheelFilter.explains_jump`) while the readings still fit some start
@@ -83,8 +83,8 @@ class WheelRun:
         The rim's slip summed over the steps the rolling judged (:mod:`driver.wheel.disc`, step 5; not over a
         roll on past what the model does not have).
     depth : float, mm
-        The wrist's give at the target force (measured at the last press: the first, or the press again beyond
-        what the wheel rolled on past).
+        The wrist's give at the target force (measured at the last press: the first, or the press again after
+        meeting what the model does not have).
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
     lengths, turns, true_arcs : tuple of float
         Every reading's L (mm) and Ω (rad) since its segment's start, and the true contact (NaN on a
@@ -92,7 +92,7 @@ class WheelRun:
     segments : tuple of int
         Each reading's segment: the rolling retraces the last segment and starts afresh (a new
         segment, from (0, 0)) when nothing on the part fits its readings
-        (:attr:`localizer.Belief.consistent`).
+        (:attr:`localizer.Belief.consistent`), and after meeting what the model does not have (module notes).
     """
 
     belief: Belief
@@ -212,7 +212,7 @@ def localize_with_wheel(
         not fit (the rim's slip is judged from here)."""
         nonlocal poses, segment_rotation, start, segment, blocked
         if reseat:
-            disc.press_again()  # the wrist measured again, away from what the first press may have been on
+            disc.press_again()  # the wrist zeroed and measured again: the first press may have been on what was met
         poses, segment_rotation = [disc.hand.pose], 0.0
         start, segment = disc.state, segment + 1
         flt.reset()
@@ -354,8 +354,8 @@ def localize_with_wheel(
         stopped = "mismatch"
     met = met if met is not None else bridged
     if met is not None:
-        # the wheel rolled on through what did not fit: the run met a part that is not its model, whatever it
-        # found beyond; said where under the most probable start when something fits
+        # the wheel rolled on or over what did not fit, or jumped at it: the run met a part that is not its model,
+        # whatever it found since; said where under the most probable start when something fits
         stopped = "mismatch"
         if final.mismatch is None:
             ends = (math.nan, math.nan)
