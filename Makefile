@@ -2,7 +2,7 @@
 #             reactively on the bracket drawn in CAD, a 5 mm wheel from inside the kidney's concave waist, and the
 #             straight jaw over a burr the kidney's model does not have (plots in out/)
 # make test : set up .venv; lint (ruff), type-check (mypy), run the tests and the doctests (two processes, a test
-#             file to each at a time) and the benchmark smoke run
+#             file to each at a time) and the benchmark smoke run (two processes too)
 PYTHON ?= python3.11
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -35,7 +35,7 @@ test: $(STAMP)
 	$(VENV)/bin/ruff format --check $(CODE)
 	$(VENV)/bin/mypy
 	$(PY) -m pytest -q -n 2 --dist loadfile tests localizer passivity sim2d driver
-	$(PY) -m pytest -q bench --benchmark-disable -p no:cacheprovider
+	$(PY) -m pytest -q -n 2 bench --benchmark-disable -p no:cacheprovider
 
 # Regression runs against the committed baseline (bench/baseline/<machine>/0001_baseline.json), on
 # the fastest round of each benchmark. BENCH_FAIL is the allowed slow-down: this 2-core machine's
