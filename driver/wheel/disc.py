@@ -232,8 +232,7 @@ class WheelDisc:
         # axle's path then shows as the rim slipping wherever the hand turns
         _, a = self._settle()
         x, y, phi = self.hand.pose
-        beta = phi + a
-        self.hand.go(x + 0.2 * math.sin(beta), y - 0.2 * math.cos(beta), phi)
+        self.hand.go(*self._off_part(0.2, a), phi)
         lighter, _ = self._read()
         self.hand.go(x, y, phi)
         pressed, _ = self._read()
@@ -248,8 +247,7 @@ class WheelDisc:
         was); the settled state. After meeting what the model does not have: the first press may have been on it."""
         x, y, phi = self.hand.pose
         _, a = self._read()
-        beta = phi + a
-        lifted = (x + RESEAT_LIFT * math.sin(beta), y - RESEAT_LIFT * math.cos(beta), beta)
+        lifted = (*self._off_part(RESEAT_LIFT, a), phi + a)
         self.hand.go(*lifted)
         if self._read()[0] >= 0.1 * self.policy.target:
             # still touching (a concavity too narrow to lift clear in): the wrist cannot be zeroed here; keep its
@@ -258,6 +256,13 @@ class WheelDisc:
             self.state = self.settled()
             return self.state
         return self.begin(lifted)
+
+    def _off_part(self, distance: float, a: float) -> tuple[float, float]:
+        """The axle's place ``distance`` mm farther off the part along the contact's normal (the wrist's force ``a``
+        rad off the hand's axis), mm."""
+        x, y, phi = self.hand.pose
+        beta = phi + a
+        return x + distance * math.sin(beta), y - distance * math.cos(beta)
 
     def _read(self) -> tuple[float, float]:
         """(|Δv| V, α rad) from the wrist."""

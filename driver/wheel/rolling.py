@@ -140,10 +140,16 @@ def _roll_on(disc: WheelDisc, direction: int, length: float, policy: WheelPolicy
         poses.append(disc.hand.pose)
         if abs(d_len) >= length:
             return _RolledOn(turned, d_len, True)
+    _retrace(disc, poses)
+    return _RolledOn(2 * turned, 0.0, False)
+
+
+def _retrace(disc: WheelDisc, poses: list[tuple[float, ...]]) -> None:
+    """Take the hand back through ``poses`` (the settled poses since a start, the last where it is) to the first,
+    last first: a jam unwinds as it was wound."""
     for pose in reversed(poses[:-1]):
         disc.hand.go(*pose)
     disc.state = disc.settled()
-    return _RolledOn(2 * turned, 0.0, False)
 
 
 def localize_with_wheel(
@@ -227,24 +233,27 @@ def localize_with_wheel(
             judged[:] = [0.0, 0.0]
 
     def retrace() -> None:
-        """Take the hand back through this segment's poses to where it started (a jam unwinds as it was wound)."""
+        """Take the hand back to where this segment started, its turning counted."""
         nonlocal rotation
-        for pose in reversed(poses[:-1]):
-            disc.hand.go(*pose)
-        disc.state = disc.settled()
+        _retrace(disc, poses)
         rotation += segment_rotation
 
     while True:
         moved = disc.step(direction)
         if moved is None:
-            margin = 1.0 + pol.step
-            before = flt.posterior()
-            explains = flt.jumped(direction, margin=margin)
-            here = explains & np.asarray(reach.touchable(flt.present()))
-            explained[:] = [here & explained[0] if explained else here]
+            # what the model says of the jump is asked only until the run has met what the model does not have
+            asked = met is None and bridged is None
+            before = flt.posterior() if asked else None
+            explains = flt.jumped(direction, margin=1.0 + pol.step)
+            if met is None:
+                here = explains & np.asarray(reach.touchable(flt.present()))
+                explained[:] = [here & explained[0] if explained else here]
             jumps += 1
-            fits = flt.consistent(max(flt.noise_scales))
-            if met is None and bridged is None and fits and before[explains].sum() < UNEXPLAINED_JUMP:
+            if (
+                before is not None
+                and before[explains].sum() < UNEXPLAINED_JUMP
+                and flt.consistent(max(flt.noise_scales))
+            ):
                 # the readings fit the model at the noise the stated probability allows, and no probable place of it
                 # has what the wheel jumped at: it met what the model does not have (a dent it bridged reads as a
                 # convex corner it pivots on, then the jump no corner makes; a wheel wedged in a concave corner of

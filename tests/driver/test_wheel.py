@@ -492,6 +492,7 @@ def test_the_wheel_is_pressed_again_only_where_it_lifts_clear():
         s._read = lambda: (0.4, 0.0) if s.hand.pose == (10.0, 20.0, 0.0) else (force_when_lifted, 0.0)
         s.settled = lambda: ("settled", s.hand.pose)
         s.begin = lambda pose: s.begun.append(pose) or ("begun", pose)
+        s._off_part = lambda distance, a: WheelDisc._off_part(s, distance, a)
         return s
 
     clear = stub(0.0)
