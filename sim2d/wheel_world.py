@@ -15,8 +15,6 @@ of an outline, or where the disc straddles a pocket it cannot enter and the cont
 side, no arc of the part is rolled: the disc pivots about the contact with the axle, ψ turning with
 the direction alone. The axle encoder reads ψ − φ (relative to the hand).
 
-The arc rolled is the real part's (a part made larger than its model rolls more under the same
-model arc): the contacts are reported in the model's arc positions, the disc turns by the real ones.
 ``slip`` makes the disc lose that fraction of the rolled arc (a slipping rim), which the rolling
 procedure must report.
 """
@@ -94,9 +92,6 @@ class WheelWorld:
         self._spline: Part | None = None
         if isinstance(part, SampledPart):
             self._xy, self._arc = np.asarray(part.xy, dtype=float), np.asarray(part.arcs, dtype=float)
-            chords = np.hypot(*(np.roll(self._xy, -1, axis=0) - self._xy).T)
-            real = np.concatenate(([0.0], np.cumsum(chords[:-1]))) + self._arc[0]
-            self.real_perimeter = float(chords.sum())
         elif isinstance(part, Part):
             n = max(256, int(math.ceil(part.perimeter / SAMPLE_STEP)))
             check_grid(part, "wheel world", SAMPLE_STEP, n)
@@ -104,15 +99,9 @@ class WheelWorld:
             self._xy = np.asarray(part.point(self._t), dtype=float)
             # the machined spline's parameters are the model's (sim2d.machining.machined_part)
             self._arc = np.asarray(model.wrap_arc(model.arc_at_param(self._t)), dtype=float)
-            real = np.asarray(part.arc_at_param(self._t), dtype=float)
-            self.real_perimeter = float(part.perimeter)
             self._spline, self._model = part, model
         else:
             raise SimError(f"a wheel world needs a Part or a SampledPart, not {type(part).__name__}")
-        # the real arc at a model arc a is k·a plus a periodic offset (0 at the first sample), interpolated
-        self._k = self.real_perimeter / self.perimeter
-        turns = np.round((real / self._k - self._arc) / self.perimeter)  # a model arc wrapped past the real one's
-        self._offset = real - self._k * (self._arc + turns * self.perimeter)
         self._tree = cKDTree(self._xy)
         self.hand: tuple[float, float, float] | None = None
         # (arc, contact, disc centre, depth) of the disc as set_hand seated it: contact() reads it
@@ -121,10 +110,6 @@ class WheelWorld:
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None  # (arc, point, axle) of the last contact
 
     # ----------------------------------------------------------- geometry
-    def _real_arc(self, arc: float) -> float:
-        """The real part's arc (mm) at the model's arc ``arc``."""
-        return self._k * arc + float(np.interp(arc, self._arc, self._offset, period=self.perimeter))
-
     def nearest(self, c: np.ndarray) -> tuple[float, np.ndarray, float]:
         """(model arc mm, point, distance mm) of the boundary point nearest to ``c``."""
         _, k = self._tree.query(c)
@@ -196,8 +181,7 @@ class WheelWorld:
             arc0, p0, c0 = self._last
             turn = _angle(centre - p) - _angle(c0 - p0)
             turn = (turn + math.pi) % (2 * math.pi) - math.pi
-            period = self.real_perimeter
-            along = (self._real_arc(arc) - self._real_arc(arc0) + period / 2) % period - period / 2
+            along = (arc - arc0 + self.perimeter / 2) % self.perimeter - self.perimeter / 2
             rolled = abs(along) <= float(np.hypot(*(p - p0))) + JUMP_EXCESS
             self.psi += turn + (along * (1.0 - self.slip) / self.radius if rolled else 0.0)
         self._last = (arc, p, centre)
