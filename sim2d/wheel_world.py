@@ -15,6 +15,13 @@ of an outline, or where the disc straddles a pocket it cannot enter and the cont
 side, no arc of the part is rolled: the disc pivots about the contact with the axle, ψ turning with
 the direction alone. The axle encoder reads ψ − φ (relative to the hand).
 
+The arc rolled is the real part's: a part made 2% larger than its model rolls 2% more arc between two
+contacts the model places alike (the contacts are reported in the model's arc positions, the disc
+turns by the real ones). Boundary that stands for no arc of the model, the round a drawing's
+machining leaves at a corner (:func:`sim2d.offset.offset_boundary` tags it with the corner's one
+arc), is pivoted over as the model's sharp corner is: its few µm of rolling are not modelled (a
+real part's edge break is: left to a part file of its own).
+
 ``slip`` makes the disc lose that fraction of the rolled arc (a slipping rim), which the rolling
 procedure must report.
 """
@@ -92,6 +99,7 @@ class WheelWorld:
         self._spline: Part | None = None
         if isinstance(part, SampledPart):
             self._xy, self._arc = np.asarray(part.xy, dtype=float), np.asarray(part.arcs, dtype=float)
+            rolled = np.hypot(*(np.roll(self._xy, -1, axis=0) - self._xy).T)  # each sample chord's real arc
         elif isinstance(part, Part):
             n = max(256, int(math.ceil(part.perimeter / SAMPLE_STEP)))
             check_grid(part, "wheel world", SAMPLE_STEP, n)
@@ -100,8 +108,11 @@ class WheelWorld:
             # the machined spline's parameters are the model's (sim2d.machining.machined_part)
             self._arc = np.asarray(model.wrap_arc(model.arc_at_param(self._t)), dtype=float)
             self._spline, self._model = part, model
+            rolled = np.full(n, part.perimeter / n)
         else:
             raise SimError(f"a wheel world needs a Part or a SampledPart, not {type(part).__name__}")
+        self._model_arc, self._real_arc = _arc_map(self._arc, rolled, self.perimeter)
+        self.real_perimeter = float(self._real_arc[-1])
         self._tree = cKDTree(self._xy)
         self.hand: tuple[float, float, float] | None = None
         # (arc, contact, disc centre, depth) of the disc as set_hand seated it: contact() reads it
@@ -110,6 +121,11 @@ class WheelWorld:
         self._last: tuple[float, np.ndarray, np.ndarray] | None = None  # (arc, point, axle) of the last contact
 
     # ----------------------------------------------------------- geometry
+    def real_arc(self, arc: float) -> float:
+        """The real part's arc (mm from its first sample) at the model's arc ``arc`` (mm)."""
+        a0 = float(self._model_arc[0])
+        return float(np.interp((arc - a0) % self.perimeter + a0, self._model_arc, self._real_arc))
+
     def nearest(self, c: np.ndarray) -> tuple[float, np.ndarray, float]:
         """(model arc mm, point, distance mm) of the boundary point nearest to ``c``."""
         _, k = self._tree.query(c)
@@ -181,7 +197,8 @@ class WheelWorld:
             arc0, p0, c0 = self._last
             turn = _angle(centre - p) - _angle(c0 - p0)
             turn = (turn + math.pi) % (2 * math.pi) - math.pi
-            along = (arc - arc0 + self.perimeter / 2) % self.perimeter - self.perimeter / 2
+            period = self.real_perimeter
+            along = (self.real_arc(arc) - self.real_arc(arc0) + period / 2) % period - period / 2
             rolled = abs(along) <= float(np.hypot(*(p - p0))) + JUMP_EXCESS
             self.psi += turn + (along * (1.0 - self.slip) / self.radius if rolled else 0.0)
         self._last = (arc, p, centre)
@@ -201,6 +218,21 @@ class WheelWorld:
     def encoder(self) -> float:
         """The disc's angle relative to the hand, rad (unwrapped, as an incremental encoder counts)."""
         return self.psi - (self.hand[2] if self.hand else 0.0)
+
+
+def _arc_map(arcs: np.ndarray, rolled: np.ndarray, perimeter: float) -> tuple[np.ndarray, np.ndarray]:
+    """The real arc as a function of the model's: (model arc, real arc) at each sample and once round.
+
+    ``arcs`` are the samples' model arcs in order round the part (mm, wrapping once), ``rolled`` the real
+    arc from each sample to the next (mm). A step that advances no model arc (a corner's round, or a
+    registered scan's sample that steps back) adds no real arc: it is pivoted over."""
+    step = (np.roll(arcs, -1) - arcs + perimeter / 2) % perimeter - perimeter / 2
+    advances = step > 1e-12
+    model = arcs[0] + np.concatenate(([0.0], np.cumsum(np.where(advances, step, 0.0))))
+    model = np.minimum(np.maximum.accumulate(model), arcs[0] + perimeter)
+    model[-1] = arcs[0] + perimeter
+    real = np.concatenate(([0.0], np.cumsum(np.where(advances, rolled, 0.0))))
+    return model, real
 
 
 def _angle(v: np.ndarray) -> float:

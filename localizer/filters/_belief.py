@@ -7,11 +7,22 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.special import ndtr
 
 from .._types import FloatArray, IntArray
 from ..geometry import check_grid
 
-__all__ = ["Belief", "Mode", "find_modes", "belief_flags", "flat_top", "most_probable", "mass_within", "FLAT_TOP"]
+__all__ = [
+    "Belief",
+    "Mode",
+    "find_modes",
+    "belief_flags",
+    "flat_top",
+    "most_probable",
+    "mass_within",
+    "within",
+    "FLAT_TOP",
+]
 
 
 @dataclass(frozen=True)
@@ -140,9 +151,12 @@ def most_probable(w: FloatArray, k: int) -> IntArray:
     return out
 
 
-def mass_within(part: Any, arcs: FloatArray, weights: FloatArray, at: float, radius: float) -> float:
+def mass_within(
+    part: Any, arcs: FloatArray, weights: FloatArray, at: float, radius: float, sd: FloatArray | None = None
+) -> float:
     """The weight of the points ``arcs`` (mm along ``part``, each with its weight ``weights``) that lie within
-    ``radius`` mm of arc ``at``, either way round the part.
+    ``radius`` mm of arc ``at``, either way round the part; each point N(arc, ``sd``²) along the part where
+    ``sd`` (mm) is given (:func:`within`).
 
     Examples
     --------
@@ -153,8 +167,21 @@ def mass_within(part: Any, arcs: FloatArray, weights: FloatArray, at: float, rad
     >>> round(mass_within(circle, arcs, np.array([0.1, 0.2, 0.3, 0.4]), 0.5, 1.5), 6)
     0.6
     """
+    if sd is not None:
+        return float(np.sum(np.asarray(weights) * within(part, arcs, sd, at, radius)))
     near = np.abs(np.asarray(part.arc_offset(arcs, at))) <= radius
     return float(np.asarray(weights)[near].sum())
+
+
+def within(part: Any, arcs: FloatArray, sd: FloatArray, at: float, radius: float) -> FloatArray:
+    """Probability that a contact N(``arcs``, ``sd``²) along the ``part`` (mm) is within ``radius`` mm of arc
+    ``at``, each point's (1 or 0 where its ``sd`` is 0)."""
+    off = np.asarray(part.arc_offset(arcs, at))
+    spread = np.where(sd > 0, sd, 1.0)
+    inside: FloatArray = np.where(
+        sd > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius
+    )
+    return inside
 
 
 #: Weights within this fraction of the most probable one are as probable: a flat top, whose middle is

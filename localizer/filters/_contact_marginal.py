@@ -8,11 +8,10 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.special import ndtr
 
 from .._errors import QueryError
 from .._types import FloatArray, IntArray
-from ._belief import Mode, find_modes
+from ._belief import Mode, find_modes, within
 from ._contact_settings import (
     FACE_SLOPES,
     RHO_MAX,
@@ -289,12 +288,7 @@ class ContactMarginal(ContactState):
 
     def _inside(self, present: FloatArray, sd: FloatArray, arc: float, radius: float) -> FloatArray:
         """Probability that a contact N(``present``, ``sd``²) along the part is within ``radius`` mm of ``arc``."""
-        off = np.asarray(self.part.arc_offset(present, arc))
-        spread = np.where(sd > 0, sd, 1.0)
-        inside: FloatArray = np.where(
-            sd > 0, ndtr((radius - off) / spread) - ndtr((-radius - off) / spread), np.abs(off) <= radius
-        )
-        return inside
+        return within(self.part, present, sd, arc, radius)
 
     def _modes(self, w: FloatArray, present: FloatArray, radius: float) -> list[Mode]:
         """Connected groups of probable present contacts, binned at ``radius``."""

@@ -122,3 +122,61 @@ def test_the_pymunk_disc_rolls_as_the_kinematic_one():
     assert turned[-1] - turned[0] == pytest.approx(0.0, abs=2e-3)  # rad, after a 20 mm roll of 4 rad
     with pytest.raises(SimError, match="slip is the kinematic"):
         WheelRig(part, wheel, engine="pymunk", slip=0.1)
+
+
+def test_a_disc_turns_by_the_real_parts_arc_where_the_part_is_larger_than_its_model():
+    """Round a coin of radius 10.2 mm whose model is 10 mm, a 10 mm disc turns by 2π + 2π·10.2/10 (the arc it
+    rolled on the real coin over its radius), its contacts still reported in the model's arc positions. Counted
+    in the model's arc it would turn by 4π: a part 2% large would read as the rim slipping 2%."""
+    real, model = circle(10.2), circle(10.0)
+    world = WheelWorld(real, model, 10.0)
+    arcs = np.linspace(0.0, real.perimeter, 2000)
+    psi, reported = [], []
+    for s in arcs:
+        p = np.asarray(real.point_at_arc(s % real.perimeter))
+        th = float(real.tangent_angle_at_arc(s % real.perimeter))
+        c = p + 9.5 * np.array([math.sin(th), -math.cos(th)])
+        world.set_hand(c[0], c[1], th)
+        psi.append(world.psi)
+        reported.append(world.contact().arc)
+    assert psi[-1] - psi[0] == pytest.approx(2 * math.pi * (1 + 10.2 / 10.0), rel=2e-3)
+    assert max(reported) < model.perimeter and reported[len(arcs) // 2] == pytest.approx(model.perimeter / 2, abs=0.1)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1.02])
+def test_on_a_drawing_the_disc_rolls_the_real_faces_arc_and_pivots_on_its_corners(scale):
+    """The bracket drawing (scaled ``scale`` about its centroid, not machined), a 3 mm disc rolled from 4 mm
+    before a convex corner, round it, to 4 mm after: the disc turns by the hand's turn plus the real faces' arc
+    over its radius, the model's arc between the first and last contacts times ``scale``, and pivots on the
+    corner. (Machined, a corner moved inwards loses 2·d·tan(jump/2) of the faces' arc to its neighbours, a
+    corner moved outwards gains a round of radius d that is pivoted over, d a few µm.)"""
+    from localizer import load_outline
+    from sim2d import PRESETS, WorldChange, world_part
+
+    model = load_outline("parts/bracket.dxf")
+    real = world_part(model, WorldChange(scale=scale), PRESETS["none"], np.random.default_rng(3))
+    corner = next(c for c in model.corners if c.angle > 0.3)
+    world = WheelWorld(real, model, 3.0)
+    centroid = np.mean(np.asarray(model.point_at_arc(np.linspace(0, model.perimeter, 4000, endpoint=False))), axis=0)
+
+    def press(s: float, th: float) -> None:
+        p = centroid + scale * (np.asarray(model.point_at_arc(model.wrap_arc(s))) - centroid)
+        c = p + 2.8 * np.array([math.sin(th), -math.cos(th)])
+        world.set_hand(c[0], c[1], th)
+
+    before = float(model.tangent_angle_at_arc(model.wrap_arc(corner.arc - 1.0)))
+    psi0, normal0, arc0 = None, math.nan, math.nan
+    for s in np.linspace(corner.arc - 4.0, corner.arc - 1e-6, 400):
+        press(s, float(model.tangent_angle_at_arc(model.wrap_arc(s))))
+        if psi0 is None:
+            psi0, normal0, arc0 = world.psi, world.contact().normal, world.contact().arc
+    for th in np.linspace(before, before + corner.angle, 200):  # the pivot: the axle circles the corner
+        press(corner.arc, th)
+    for s in np.linspace(corner.arc + 1e-6, corner.arc + 4.0, 400):
+        press(s, float(model.tangent_angle_at_arc(model.wrap_arc(s))))
+    assert psi0 is not None
+    turn = (world.contact().normal - normal0 - corner.angle + math.pi) % (2 * math.pi) - math.pi + corner.angle
+    assert abs(turn - corner.angle) < 0.01
+    travelled = float(model.arc_offset(world.contact().arc, arc0))  # the model's arc, where the contacts were
+    assert travelled == pytest.approx(8.0, abs=0.05)
+    assert world.psi - psi0 == pytest.approx(turn + scale * travelled / 3.0, abs=3e-4)  # rad: 1 µm of arc
