@@ -27,8 +27,11 @@ from ._wheel_filter import (
     WHEEL_SLOPE_LENGTH,
     WheelFilter,
 )
+from ._wheel_state import OFF_SCALE, Spread
 
 __all__ = [
+    "OFF_SCALE",
+    "Spread",
     "Belief",
     "Mode",
     "most_probable",

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.stats import multivariate_normal
 
-from localizer import QueryError, WheelFilter, WheelJaw, load_part, part_from_points
+from localizer import OFF_SCALE, QueryError, WheelFilter, WheelJaw, load_part, part_from_points
 from localizer.contact._wheel_rolling import free_runs
 
 from .test_wheel import peanut
@@ -46,9 +46,12 @@ def test_the_readings_kept_are_bounded_and_a_reading_past_the_bound_is_refused_b
     from localizer import MAX_ARRAY_BYTES
 
     part = load_part(KIDNEY)
+    for off, numbers in ((0.0, 3), (OFF_SCALE, 6)):  # a start's numbers a reading: three, six with the scale
+        g = WheelFilter(part, WheelJaw(5.0), off_scale=off)
+        n, k = g.grid.size, g.max_readings
+        per = 8 * numbers * n
+        assert per * k + 8 * k * k <= MAX_ARRAY_BYTES < per * (k + 1) + 8 * (k + 1) ** 2
     f = WheelFilter(part, WheelJaw(5.0))
-    n, k = f.grid.size, f.max_readings
-    assert 24 * n * k + 8 * k * k <= MAX_ARRAY_BYTES < 24 * n * (k + 1) + 8 * (k + 1) ** 2
     f.max_readings = 70  # as on a part 50 times larger: past the first doubling, to the bound
     for i in range(70):
         f.update(float(i + 1), 0.0)
@@ -267,3 +270,65 @@ def test_the_shifted_grid_of_a_drawing_is_the_drawings_own_evaluation():
         x = table.grid + L
         assert np.array_equal(got_theta, part.tangent_angle_at_arc(x))
         assert np.array_equal(got_kappa, part.curvature_at_arc(part.wrap_arc(x)))
+
+
+def scaled_readings(part, start: float, scale: float, lengths):
+    """(L, Ω) of a noise-free roll from model arc ``start`` on the part made ``scale`` times its model's size:
+    the real arc L is ``scale`` times the model's."""
+    return [(float(L), float(theta(part, start + L / scale) - theta(part, start))) for L in lengths]
+
+
+def test_a_part_two_percent_large_is_never_sure_and_wrong_with_its_scale():
+    """Rolls of 40 mm on the kidney made 2% larger than its model, from six starts. With the scale's prior (off
+    its model's size with probability OFF_SCALE, then by N(0, 1%²)) no belief is sure and wrong, four or more
+    are within the success radius, and where one is, the scale's posterior given its start says the part is
+    off its size and larger (u = 1/1.02 − 1 = −0.0196, shrunk towards 0 by the prior). On the kidney's
+    near-circular stretches a start and a scale explain the readings alike: the belief is then not sure.
+    The same rolls on the part at its model's size: the belief within 0.01 mm of the truth, the part
+    taken to be off its size with probability under 0.05."""
+    part = load_part(KIDNEY)
+    lengths = np.arange(0.5, 40.01, 0.5)
+    right = wrong_and_sure = 0
+    for s in np.linspace(0.0, part.perimeter, 6, endpoint=False) + 7.0:
+        for scale in (1.02, 1.0):
+            f = WheelFilter(part, WheelJaw(5.0), off_scale=OFF_SCALE)
+            for L, om in scaled_readings(part, s, scale, lengths):
+                f.update(L, om)
+            b = f.belief()
+            off = abs(float(part.arc_offset(b.map_arc, s + lengths[-1] / scale)))
+            mean, _, _, p_off = f._scale_posterior(temper=1.0)
+            i = int(np.argmax(f.posterior()))
+            if scale == 1.0:
+                assert off < 0.01 and p_off[i] < 0.05
+                continue
+            right += off < 0.3
+            wrong_and_sure += b.mass >= 0.95 and off >= 0.3
+            if off < 0.3:
+                assert p_off[i] > 0.9 and -0.0196 - 0.002 < mean[i] < -0.012
+    assert wrong_and_sure == 0 and right >= 4
+
+
+def test_after_a_corner_the_scale_spreads_the_present_contact_by_the_arc_rolled_since():
+    """On the pentagon (straight faces: nothing tells the scale), the present contact's spread off the model's
+    size is the arc rolled since the last corner the start's contact pivoted on, times the scale's prior (1%),
+    and the stated mass is what the two sizes leave within the radius, each by its probability (nothing tells
+    them apart either: the prior's OFF_SCALE)."""
+    from scipy.special import ndtr
+
+    from localizer import Line, outline_from_pieces
+
+    pieces = [Line(PENTAGON[i], PENTAGON[(i + 1) % 5]) for i in range(5)]
+    outline = outline_from_pieces(pieces, name="pentagon")
+    c = outline.corners[1].arc
+    start = float(outline.wrap_arc(c - 15.22))
+    f = WheelFilter(outline, WheelJaw(5.0), thin=0.2, off_scale=OFF_SCALE)
+    readings = pivoting_readings(PENTAGON, start, 40.0, 1)  # the next corner is 29.2 mm past the first
+    for L, om in readings:
+        f.update(L, om)
+    i = int(np.argmax(f.posterior()))
+    spread = f.present_spread()
+    assert spread.sd[i] == pytest.approx((40.0 - 15.22) * 0.01, rel=0.05)  # 24.8 mm past the corner
+    p = spread.p_off[i]
+    assert p == pytest.approx(OFF_SCALE, rel=0.1)
+    b = f.belief()
+    assert b.mass == pytest.approx(1 - p + p * (2 * ndtr(0.3 / spread.sd[i]) - 1), abs=0.01)

@@ -1,0 +1,420 @@
+"""The wheel's filter, its state: the readings used, each start's whitened residuals (and their derivatives
+in the part's scale), and what they say of each start, the part's scale and the present contact. The
+model is written down in :mod:`localizer.filters._wheel_filter`; the belief and the fit tests are there.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from scipy.linalg import solve_triangular
+
+from .._defaults import CONFIDENCE, PART_SCALE_SD, SUCCESS_RADIUS
+from .._errors import QueryError
+from .._types import BoolArray, FloatArray
+from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, wheel_reach_for
+from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
+from ._belief import within
+from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
+
+__all__ = [
+    "WheelState",
+    "Spread",
+    "WHEEL_SD_TURN",
+    "WHEEL_SD_SLOPE",
+    "WHEEL_SLOPE_LENGTH",
+    "WHEEL_NOISE_SCALES",
+    "OFF_SCALE",
+]
+
+#: One reading's independent angle error (rad): the arm encoder's 0.03° step (0.009° rms) and the wrist's
+#: residual direction after the servo (0.02°, docs/wheel.md), rounded up.
+WHEEL_SD_TURN = math.radians(0.025)
+#: The machined part's slope error (rad rms): the straight jaw's reactive studies' measured 0.8e-3 to 1.9e-3.
+WHEEL_SD_SLOPE = 0.002
+#: Its correlation length along the arc (mm): the machining's shortest wavelength, 20 mm, over 2π.
+WHEEL_SLOPE_LENGTH = 20.0 / (2 * math.pi)
+#: The prior probability that a part is off its model's size by more than its machining (made to another
+#: revision's drawing, scaled on export): its scale is then N(1, ``sd_part_scale``²); else its model's
+#: (docs/robustness.md, "The wheel on a part off its model's size"). Not yet the filter's default
+#: (``off_scale`` 0: the part is its model's size): on the bracket's notch wall a wedged wheel then ends
+#: ``mismatch`` where it was sure and right (tests/driver/test_wheel.py).
+OFF_SCALE = 0.05
+#: Noise scales under which a stated probability must hold (its least is stated).
+WHEEL_NOISE_SCALES = (1.0, 2.0)
+
+
+class Spread(NamedTuple):
+    """Each start's present contact (mm along the part): at the model's size, and off it.
+
+    Attributes
+    ----------
+    nominal : ndarray, mm
+        The present contact if the part is its model's size.
+    off : ndarray, mm
+        Its mean if the part is off its model's size (u's posterior mean given the start).
+    sd : ndarray, mm
+        Its standard deviation then.
+    p_off : ndarray
+        The posterior probability, given the start, that the part is off its model's size.
+    """
+
+    nominal: FloatArray
+    off: FloatArray
+    sd: FloatArray
+    p_off: FloatArray
+
+    def mass(self, part: Part | Outline, w: FloatArray, at: float, radius: float) -> float:
+        """The probability, the starts weighed by ``w``, that the present contact is within ``radius`` mm of
+        arc ``at``."""
+        zero = np.zeros_like(self.sd)
+        inside = (1.0 - self.p_off) * within(part, self.nominal, zero, at, radius)
+        inside += self.p_off * within(part, self.off, self.sd, at, radius)
+        return float(np.sum(w * inside))
+
+    @property
+    def mean(self) -> FloatArray:
+        """The present contact's posterior mean given each start, mm (unwrapped about the nominal one)."""
+        out: FloatArray = self.nominal + self.p_off * (self.off - self.nominal)
+        return out
+
+
+class WheelState:
+    """The readings a :class:`~localizer.WheelFilter` used and each start's sums (its parameters are the
+    filter's)."""
+
+    def __init__(
+        self,
+        part: Part | Outline,
+        wheel: WheelJaw,
+        *,
+        spacing: float = 0.02,
+        sd_turn: float = WHEEL_SD_TURN,
+        sd_slope: float = WHEEL_SD_SLOPE,
+        slope_length: float = WHEEL_SLOPE_LENGTH,
+        sd_length: float = 0.005,
+        sd_scale: float = 2e-4,
+        sd_part_scale: float = PART_SCALE_SD,
+        off_scale: float = 0.0,
+        thin: float = 1.0,
+        radius: float = SUCCESS_RADIUS,
+        confidence: float = CONFIDENCE,
+        mode_floor: float = 0.05,
+        noise_scales: tuple[float, ...] = WHEEL_NOISE_SCALES,
+    ) -> None:
+        if not isinstance(part, (Part, Outline)):
+            raise QueryError(f"the wheel's filter takes a Part or an Outline, not {type(part).__name__}")
+        for name, v in (("spacing", spacing), ("slope_length", slope_length), ("thin", thin), ("radius", radius)):
+            if not (math.isfinite(v) and v > 0):
+                raise QueryError(f"{name}={v!r} mm must be a positive number")
+        for name, v in (
+            ("sd_turn", sd_turn),
+            ("sd_slope", sd_slope),
+            ("sd_length", sd_length),
+            ("sd_scale", sd_scale),
+            ("sd_part_scale", sd_part_scale),
+        ):
+            if not (math.isfinite(v) and v >= 0):
+                raise QueryError(f"{name}={v!r} must be ≥ 0")
+        if sd_turn <= 0:
+            raise QueryError(f"sd_turn={sd_turn!r} rad must be positive (it keeps the covariance invertible)")
+        if not noise_scales or not all(math.isfinite(f) and f >= 1 for f in noise_scales):
+            raise QueryError(f"noise_scales={noise_scales!r}: give factors ≥ 1")
+        self.part, self.wheel = part, wheel
+        self.sd_turn, self.sd_slope, self.slope_length = float(sd_turn), float(sd_slope), float(slope_length)
+        self.sd_length, self.sd_scale, self.thin = float(sd_length), float(sd_scale), float(thin)
+        self.sd_part_scale = float(sd_part_scale)
+        if not (math.isfinite(off_scale) and 0 <= off_scale < 1):
+            raise QueryError(f"off_scale={off_scale!r} is a probability: give it in [0, 1)")
+        self.off_scale = float(off_scale)
+        self.radius, self.confidence, self.mode_floor = float(radius), float(confidence), float(mode_floor)
+        self.noise_scales = tuple(float(f) for f in noise_scales)
+        P = float(part.perimeter)
+        n = max(64, int(math.ceil(P / spacing)))
+        check_grid(part, "wheel filter", spacing, n)
+        self._angles = ShiftedGrid(part, n)
+        self.h = self._angles.h
+        self.grid: FloatArray = self._angles.grid
+        self._theta0 = self._angles.theta
+        reach = wheel_reach_for(part, wheel)
+        touch = reach.touchable(self.grid)
+        self.prior: FloatArray = np.asarray(touch, dtype=float)
+        if not touch.any():
+            raise QueryError(f"a {wheel} touches {part.name} nowhere")
+        self._ahead, self._behind = free_runs(touch, self.h)
+        self._ahead_jump, self._behind_jump = jump_runs(part, wheel, self.grid, self._ahead, self._behind)
+        # each reading used keeps three numbers a start (six with the part's scale) and a row of the Cholesky
+        # factor: 24·n·k + 8·k² bytes (48·n·k + 8·k²) for k readings stay within MAX_ARRAY_BYTES (a 1000 mm
+        # part: 443 readings at thin=1; 222 with the scale)
+        self._terms = (
+            2 if self.sd_part_scale > 0 and self.off_scale > 0 else 1
+        )  # residuals, and their derivatives in the scale
+        self._per_reading = 24.0 * self._terms * n
+        b = self._per_reading
+        self.max_readings = int((math.sqrt(b * b + 32.0 * MAX_ARRAY_BYTES) - b) / 16.0)
+        self.reset()
+
+    # ------------------------------------------------------------- readings
+    def reset(self) -> None:
+        """Forget every reading (a new roll from a new start)."""
+        self.L_used: list[float] = []
+        # the readings' arrays, grown by doubling up to max_readings: the first k rows (columns of _zbuf,
+        # each start's whitened residuals and below them, with the part's scale, their derivatives in it, kept
+        # contiguous per reading) are those of the readings used
+        n = self.grid.size
+        self._cholbuf = np.zeros((0, 0))
+        self._zbuf = np.zeros((self._terms * n, 0), order="F")
+        self._zzbuf = np.zeros((0, n))
+        self._lvbuf = np.zeros((0, n))
+        self._zgbuf = np.zeros((0, n))
+        self._ggbuf = np.zeros((0, n))
+        self._quad = np.zeros(n)
+        self._zg = np.zeros(n)  # Σ z·g and Σ g²: each start's whitened residuals against their scale derivatives
+        self._gg = np.zeros(n)
+        self._logdet = np.zeros(self.grid.size)
+        self._penalty = np.zeros(self.grid.size)
+        self.current = 0.0
+        self.span = (0.0, 0.0)
+        self.steps = 0
+        self._misfit: tuple[tuple[float, float], float] | None = None  # (stretch on the model, p-value)
+        self._fit_at = 0  # readings used at the last fit test
+
+    @property
+    def _chol(self) -> FloatArray:
+        k = len(self.L_used)
+        out: FloatArray = self._cholbuf[:k, :k]
+        return out
+
+    @property
+    def _z(self) -> FloatArray:
+        out: FloatArray = self._zbuf[:, : len(self.L_used)]
+        return out
+
+    @property
+    def _zg_each(self) -> FloatArray:
+        """Each reading's whitened misfit times its scale derivative under each start, (readings, starts)."""
+        out: FloatArray = self._zgbuf[: len(self.L_used)]
+        return out
+
+    @property
+    def _gg_each(self) -> FloatArray:
+        """Each reading's squared whitened scale derivative under each start, (readings, starts)."""
+        out: FloatArray = self._ggbuf[: len(self.L_used)]
+        return out
+
+    @property
+    def _zz(self) -> FloatArray:
+        """Each reading's squared whitened misfit under each start, shape (readings, starts)."""
+        out: FloatArray = self._zzbuf[: len(self.L_used)]
+        return out
+
+    @property
+    def _logvar(self) -> FloatArray:
+        """Each reading's log variance under each start, shape (readings, starts)."""
+        out: FloatArray = self._lvbuf[: len(self.L_used)]
+        return out
+
+    def _make_room(self) -> None:
+        """Room for one more reading: the buffers doubled, up to :attr:`max_readings`; refused beyond."""
+        k, n = len(self.L_used), self.grid.size
+        if k < self._zzbuf.shape[0]:
+            return
+        if k >= self.max_readings:
+            raise QueryError(
+                f"the wheel's filter holds {k} readings of {n} starts on {self.part.name!r} "
+                f"({bytes_text(self._per_reading * k + 8.0 * k * k)}): one more passes the "
+                f"{bytes_text(MAX_ARRAY_BYTES)} limit. It keeps a reading every thin={self.thin:g} mm rolled: give a "
+                "larger thin, or roll less from one start (WheelPolicy.max_arc)"
+            )
+        cap = min(max(64, 2 * k), self.max_readings)
+        chol = np.zeros((cap, cap))
+        chol[:k, :k] = self._chol
+        z = np.zeros((self._terms * n, cap), order="F")
+        z[:, :k] = self._z
+        zz, lv = np.zeros((cap, n)), np.zeros((cap, n))
+        zz[:k], lv[:k] = self._zz, self._logvar
+        self._cholbuf, self._zbuf, self._zzbuf, self._lvbuf = chol, z, zz, lv
+        if self._terms > 1:
+            zg, gg = np.zeros((cap, n)), np.zeros((cap, n))
+            zg[:k], gg[:k] = self._zg_each, self._gg_each
+            self._zgbuf, self._ggbuf = zg, gg
+
+    def _cov(self, a: FloatArray, b: FloatArray) -> FloatArray:
+        """Covariance of the shared errors of residuals at arcs ``a`` and ``b`` (mm) rolled from the start."""
+        a, b = np.asarray(a, dtype=float)[:, None], np.asarray(b, dtype=float)[None, :]
+        ell2 = 2 * self.slope_length**2
+        slope = self.sd_slope**2 * (
+            np.exp(-((a - b) ** 2) / ell2) - np.exp(-(a**2) / ell2) - np.exp(-(b**2) / ell2) + 1.0
+        )
+        # the start's independent reading error: in every residual
+        out: FloatArray = slope + self.sd_turn**2 * (1.0 + (a == b))
+        return out
+
+    def corner_window(self, length: float) -> float:
+        """How near a convex corner (mm) a start's contact after rolling ``length`` mm may be for the wheel
+        to be pivoting on it: three standard errors of L (the encoder's and the calibrated radius's) under
+        the largest of :attr:`noise_scales` (the stated probability holds under it), and one grid step (the
+        true start lies between two of the grid's)."""
+        return self.h + 3.0 * max(self.noise_scales) * math.hypot(self.sd_length, float(length) * self.sd_scale)
+
+    def predicted_turn(self, length: float, turn: float) -> FloatArray:
+        """Each start's model turn (rad) after rolling ``length`` mm, the nearest to the reading ``turn`` (rad)
+        the model allows: Θ(s + L) − Θ(s), or, within :meth:`corner_window` of a convex corner, any angle
+        between the model's there and across the corner's jump (the wheel pivoting on it)."""
+        return self._model_at(length, turn)[0]
+
+    def _model_at(self, length: float, turn: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:meth:`predicted_turn`, each start's curvature (1/mm) at its contact after ``length`` mm, and the
+        predicted turn's derivative in the part's scale u (rad): κ·L, 0 where the wheel pivots on a corner."""
+        theta, kappa = self._angles.at(length)
+        x, window = self.grid + float(length), self.corner_window(length)
+        smooth = theta - self._theta0
+        model = pivot_turn(self.part, x, self._theta0, smooth, float(turn), window)
+        slope: FloatArray = np.where(model == smooth, kappa * float(length), 0.0)
+        return model, kappa, slope
+
+    def update(self, length: float, turn: float) -> None:
+        """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
+        clockwise), and the hand's net turn since the start, ``turn`` rad."""
+        L, om = float(length), float(turn)
+        if not (math.isfinite(L) and math.isfinite(om)):
+            raise QueryError(f"reading (length={length!r} mm, turn={turn!r} rad) must be finite")
+        self.current = L
+        self.span = (min(self.span[0], L), max(self.span[1], L))
+        self.steps += 1
+        last = self.L_used[-1] if self.L_used else 0.0
+        if abs(L - last) < self.thin:
+            return
+        used = np.array(self.L_used)
+        c_new = self._cov(used, np.array([L]))[:, 0] if used.size else np.zeros(0)
+        c_nn = float(self._cov(np.array([L]), np.array([L]))[0, 0])
+        ell = solve_triangular(self._chol, c_new, lower=True) if used.size else np.zeros(0)
+        d2 = max(c_nn - float(ell @ ell), 1e-18)
+        model, kappa, slope = self._model_at(L, om)
+        extra = kappa**2 * (self.sd_length**2 + (L * self.sd_scale) ** 2)
+        rho = om - model
+        var = d2 + extra
+        n = self.grid.size
+        past = self._z @ ell
+        root = np.sqrt(var)
+        z = (rho - past[:n]) / root
+        self._make_room()
+        k = used.size
+        if self._terms > 1:
+            # the residual falls by slope·u: whitened as the residual is (the same linear map per start)
+            zg = (slope - past[n:]) / root
+            self._zbuf[n:, k] = zg * np.sqrt(var / d2)
+            self._zgbuf[k], self._ggbuf[k] = z * zg, zg**2
+            self._zg += self._zgbuf[k]
+            self._gg += self._ggbuf[k]
+        self._quad += z**2
+        self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
+        self._lvbuf[k] = np.log(var)
+        self._logdet += self._lvbuf[k]
+        self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
+        self._zbuf[:n, k] = z * np.sqrt(var / d2)  # whitened by the shared part alone
+        self._cholbuf[k, :k] = ell
+        self._cholbuf[k, k] = math.sqrt(d2)
+        self.L_used.append(L)
+
+    def jumped(self, direction: int, margin: float = 1.0) -> BoolArray:
+        """The wheel jumped (and was taken back) when rolling on from the present contact in
+        ``direction`` (+1: counter-clockwise). The starts under which the wheel could still have rolled
+        on for ``margin`` mm there are made :data:`~localizer.BRIDGE_MISS` times less likely (soft: a
+        jump may be read where there was none); per start, whether it explains the jump (:meth:`explains_jump`)."""
+        if direction not in (1, -1):
+            raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
+        explained = self.explains_jump(direction, margin)
+        self._penalty += np.where(explained, 0.0, math.log(BRIDGE_MISS))
+        return explained
+
+    def explains_jump(self, direction: int, margin: float = 1.0) -> BoolArray:
+        """Per start, whether the wheel rolling on from its present contact ``direction`` (+1: counter-clockwise)
+        meets within ``margin`` mm a place it cannot roll over (it would jump there)."""
+        here = np.rint(self.present() / self.h).astype(np.intp) % self.grid.size
+        out: BoolArray = (self._ahead_jump if direction > 0 else self._behind_jump)[here] <= margin
+        return out
+
+    # --------------------------------------------------------------- belief
+    def _clear(self) -> BoolArray:
+        """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
+        lo, hi = self.span
+        tol = 2 * self.h
+        mean, _, _, p_off = self._scale_posterior()
+        stretch = 1.0 + p_off * mean  # the model's arc rolled per arc read
+        ok: BoolArray = (self._ahead + tol >= hi * stretch) & (self._behind + tol >= -lo * stretch)
+        return ok
+
+    def _scale_posterior(
+        self, factor: float = 1.0, zg: FloatArray | None = None, gg: FloatArray | None = None, temper: float = TEMPER
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Per start: the part's scale u given the start and that the part is off its model's size (its mean
+        and standard deviation), the log of the factor weighing the scale out puts on the start's likelihood
+        (both sizes, by their prior :attr:`off_scale`), and the probability that the part is off its size;
+        under the readings' likelihood raised to ``temper`` with the error model times ``factor``, from the
+        sums Σ z·g and Σ g² (default: every reading used's). Without the scale: zeros."""
+        n = self.grid.size
+        if self._terms == 1:
+            zero = np.zeros(n)
+            return zero, zero, zero, zero
+        zg = (self._zg if zg is None else zg) * (temper / factor**2)
+        gg = (self._gg if gg is None else gg) * (temper / factor**2)
+        prec = 1.0 / self.sd_part_scale**2 + gg
+        mean = zg / prec
+        off = math.log(self.off_scale) + 0.5 * zg * mean - 0.5 * np.log1p(gg * self.sd_part_scale**2)
+        log_factor = np.logaddexp(math.log1p(-self.off_scale), off)
+        return mean, 1.0 / np.sqrt(prec), log_factor, np.exp(off - log_factor)
+
+    def _posterior(self, factor: float) -> FloatArray:
+        ll = TEMPER * (-0.5 * self._quad / factor**2 - 0.5 * self._logdet) + self._penalty
+        ll = ll + self._scale_posterior(factor)[2]
+        ll = np.where(self.prior > 0, ll, -np.inf)
+        top = ll.max()
+        if not np.isfinite(top):
+            raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
+        w = np.exp(ll - top)
+        out: FloatArray = w / w.sum()
+        return out
+
+    def posterior(self) -> FloatArray:
+        """Posterior probability of each start on :attr:`grid` (sums to 1)."""
+        return self._posterior(self.noise_scales[0])
+
+    def present(self) -> FloatArray:
+        """Each start's present contact, mm: its posterior mean given the start over the part's scale
+        (:meth:`present_spread`)."""
+        out: FloatArray = self.part.wrap_arc(self.present_spread().mean)
+        return out
+
+    def present_spread(self, factor: float = 1.0) -> Spread:
+        """Each start's present contact at the model's size and off it (:class:`Spread`), under the error
+        model times ``factor``."""
+        mean, sd, _, p_off = self._scale_posterior(factor)
+        return self._spread(mean, sd, p_off)
+
+    def _spread(self, mean: FloatArray, sd: FloatArray, p_off: FloatArray) -> Spread:
+        """Each start's present contact for the part's scale u given the start, off the model's size
+        N(``mean``, ``sd``²) with probability ``p_off``: the arc read since the last convex corner the start's
+        contact pivoted on (the pivot placed it there whatever the scale), or since the start, stretched by
+        1 + u."""
+        lever = self._lever()
+        nominal = self.grid + self.current
+        return Spread(nominal, nominal + lever * mean, np.abs(lever) * sd, p_off)
+
+    def _lever(self) -> FloatArray:
+        """Per start, the arc read (mm) since its contact was last on a convex corner of a drawing within the
+        rolled span (nearest the present one), or since the start."""
+        lever = np.full(self.grid.size, self.current)
+        if self._terms == 1 or not isinstance(self.part, Outline):
+            return lever
+        lo, hi = self.span
+        P = float(self.part.perimeter)
+        for c in self.part.corners:
+            if c.angle <= 0:
+                continue
+            reached = np.mod(c.arc - self.grid - lo, P) + lo  # the arc read when the contact is on the corner
+            since = np.where(reached <= hi, self.current - reached, np.inf)
+            lever = np.where(np.abs(since) < np.abs(lever), since, lever)
+        return lever
