@@ -50,7 +50,7 @@ CHECKING = (
     "localizer.contact._tracks",
     "localizer.contact._reach",
     "localizer.contact._wheel",
-    "localizer.filters._wheel_filter",
+    "localizer.filters._wheel_state",
     "localizer.chain._outline_chain",
     "localizer.solve._outline_solver",
     "localizer.solve._table",
