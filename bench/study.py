@@ -56,6 +56,8 @@ Several methods on the same trials (instead of ``method``)::
                                          #   mass (default localizer.STRETCH_WEIGHT; 1: the least)
     seek = true                          # optional: the information-seeking direction rule (default:
                                          #   driver.jaw.ReactivePolicy's)
+    off_scale = 0.05                     # optional, the wheel: the prior probability that the part is
+                                         #   off its model's size (localizer.OFF_SCALE; default 0)
 
     [world]                              # optional: how each trial's world differs from the model
     defects = 1                          #   (sim2d.world_part): defects near the start, or anywhere,
@@ -462,6 +464,11 @@ def _options(path: Path, table: object, cls: type[_Options], name: str) -> _Opti
         if key == "stretch_weight":
             if type(value) not in (int, float) or not 0 <= value <= 1:
                 raise StudyError(f"study {path}: [{name}] stretch_weight={value!r} must be a probability in [0, 1]")
+            values[key] = float(value)
+            continue
+        if key == "off_scale":
+            if type(value) not in (int, float) or not 0 <= value < 1:
+                raise StudyError(f"study {path}: [{name}] off_scale={value!r} must be a probability in [0, 1)")
             values[key] = float(value)
             continue
         if key in ("defect_window", "lookalike_slope") and type(value) in (int, float) and value == 0:

@@ -49,7 +49,7 @@ class WheelRoll(NamedTuple):
 def roll_wheel(ctx: TrialContext) -> WheelRoll:
     """One wheel trial's rolling (module notes). Never raises: a failure is the roll's ``failure``."""
     from driver.wheel import WheelPolicy, calibrate_wheel, localize_with_wheel, wheel_calibration_arc
-    from localizer import WheelJaw, parse_jaw, wheel_reach_for
+    from localizer import WheelFilter, WheelJaw, parse_jaw, wheel_reach_for
     from sim2d import WheelRig
 
     s, rng, part, noise = ctx.study, ctx.rng, ctx.part, ctx.noise
@@ -79,7 +79,13 @@ def roll_wheel(ctx: TrialContext) -> WheelRoll:
         rig = WheelRig(part, wheel, noise=noise, seed=rig_seed, true_radius=true_radius, change=change)
         policy = WheelPolicy(confidence=s.reactive.confidence, max_rotation=math.radians(s.reactive.max_rotation_deg))
         run = localize_with_wheel(
-            rig, part, wheel, approach_pose=rig.approach_pose(start), calibration=cal, policy=policy
+            rig,
+            part,
+            wheel,
+            approach_pose=rig.approach_pose(start),
+            calibration=cal,
+            policy=policy,
+            filter=WheelFilter(part, wheel, off_scale=s.reactive.off_scale),
         )
     except Exception as exc:  # noqa: BLE001 - the trial's failure is its result
         return WheelRoll(cells, finger, None, math.nan, change, "", f"{type(exc).__name__}: {exc}"[:200])

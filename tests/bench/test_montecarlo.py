@@ -128,6 +128,10 @@ def test_dask_local_cluster_gives_the_same_table(reference):
             "stretch_weight=True must be a probability",
         ),
         (
+            'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\noff_scale = 1.0',
+            r"off_scale=1.0 must be a probability in \[0, 1\)",
+        ),
+        (
             'parts = ["{cam}"]\nrolls_deg = [20.0]\nmethods = ["reactive"]\n[reactive]\ncheck_every = 2.5',
             "check_every=2.5 must be a whole number",
         ),
