@@ -160,6 +160,28 @@ def test_wheel_filter_roll(benchmark: BenchmarkFixture) -> None:
     per_second(benchmark, "readings_per_second", lengths.size)
 
 
+def test_wheel_filter_roll_off_size(benchmark: BenchmarkFixture) -> None:
+    """:func:`test_wheel_filter_roll` with the part's scale carried (``off_scale`` = localizer.OFF_SCALE): each
+    used reading whitens the residuals' derivatives in the scale too, and a belief weighs the two sizes."""
+    from localizer import OFF_SCALE
+
+    part, _, lengths, turns = _kidney_wheel_roll(0.25)
+    flt = WheelFilter(part, WheelJaw(5.0), off_scale=OFF_SCALE)
+
+    def roll() -> Belief:
+        flt.reset()
+        for k, (L, om) in enumerate(zip(lengths, turns)):
+            flt.update(float(L), float(om))
+            if k % 4 == 3:
+                b = flt.belief()
+        return b
+
+    b: Belief = benchmark.pedantic(roll, rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
+    assert abs(float(part.arc_offset(b.map_arc, WHEEL_START + lengths[-1]))) < 0.3
+    benchmark.extra_info.update({"starts": int(flt.grid.size), "readings": int(lengths.size)})
+    per_second(benchmark, "readings_per_second", lengths.size)
+
+
 def test_wheel_filter_used_reading(benchmark: BenchmarkFixture) -> None:
     """One reading the wheel's likelihood uses (the 20th of a roll on the kidney, its start grid 11724 wide),
     and in the same run the cost of the model's angles at every start evaluated on the spline itself (what

@@ -342,8 +342,10 @@ class WheelState:
         """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
         lo, hi = self.span
         tol = 2 * self.h
-        mean, _, _, p_off = self._scale_posterior()
-        stretch = 1.0 + p_off * mean  # the model's arc rolled per arc read
+        # the model's arc rolled per arc read is 1 + u: a part off its size may have rolled up to the scale's
+        # prior's three standard deviations less of the model than was read (a wheel rolled up to a place it
+        # cannot pass on a part 2% large reads 2% past it)
+        stretch = 1.0 - 3.0 * self.sd_part_scale if self._terms > 1 else 1.0
         ok: BoolArray = (self._ahead + tol >= hi * stretch) & (self._behind + tol >= -lo * stretch)
         return ok
 

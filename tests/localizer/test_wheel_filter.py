@@ -94,6 +94,24 @@ def test_a_start_whose_roll_runs_over_what_the_wheel_cannot_touch_is_unlikely_no
     assert np.all(f._penalty[clear] == 0)
 
 
+def test_with_the_part_off_its_size_a_roll_read_up_to_three_scale_sds_past_a_place_it_cannot_pass_is_clear():
+    """A part 2% large reads 2% more arc than its model rolls: a wheel rolled up to the peanut's waist on it
+    reads past the waist. With the scale carried, a start whose free run is 30 mm is clear after 30.8 mm read
+    and not after 31 (past the 1% prior's three standard deviations); at the model's size, after 29.9 and not
+    after 30.2."""
+    outline, _ = peanut()
+    dense = np.asarray(outline.point_at_arc(np.linspace(0, outline.perimeter, 400, endpoint=False)))
+    part = part_from_points(dense, name="peanut")
+    for off, clear_at, blocked_at in ((OFF_SCALE, 30.8, 31.0), (0.0, 29.9, 30.2)):
+        f = WheelFilter(part, WheelJaw(12.0), off_scale=off)
+        j = int(np.argmin(np.where(f._ahead > 0, np.abs(f._ahead - 30.0), np.inf)))
+        run = float(f._ahead[j])
+        f.span = (0.0, clear_at * run / 30.0)
+        assert f._clear()[j]
+        f.span = (0.0, blocked_at * run / 30.0)
+        assert not f._clear()[j]
+
+
 def test_free_runs_count_the_arc_to_the_next_untouchable_point_both_ways():
     touch = np.array([True, True, False, True, True, True, False, True])
     ahead, behind = free_runs(touch, 0.5)
