@@ -350,3 +350,14 @@ def test_after_a_corner_the_scale_spreads_the_present_contact_by_the_arc_rolled_
     assert p == pytest.approx(OFF_SCALE, rel=0.1)
     b = f.belief()
     assert b.mass == pytest.approx(1 - p + p * (2 * ndtr(0.3 / spread.sd[i]) - 1), abs=0.01)
+
+
+@pytest.mark.parametrize("off", [0.0, OFF_SCALE, 0.5, 0.99])
+def test_a_reading_that_fits_is_consistent_whatever_the_prior_odds_of_the_part_being_off_its_size(off):
+    """The fit test's deviance with the scale counts the prior's odds against a part off its size only where
+    they are against it: at 0.99 (the part all but surely off its size) a bonus would make it negative, which
+    the χ² test reads as no fit at all."""
+    part = load_part(KIDNEY)
+    f = WheelFilter(part, WheelJaw(5.0), off_scale=off)
+    f.update(1.0, float(theta(part, 31.0) - theta(part, 30.0)))
+    assert f.consistent() and f.consistent(1.0)
