@@ -15,7 +15,7 @@ from .._defaults import CONFIDENCE, PART_SCALE_SD, SUCCESS_RADIUS
 from .._errors import QueryError
 from .._types import BoolArray, FloatArray
 from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, wheel_reach_for
-from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
+from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid, nearest_corner
 from ._belief import within
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
 
@@ -265,15 +265,26 @@ class WheelState:
         between the model's there and across the corner's jump (the wheel pivoting on it)."""
         return self._model_at(length, turn)[0]
 
-    def _model_at(self, length: float, turn: float) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """:meth:`predicted_turn`, each start's curvature (1/mm) at its contact after ``length`` mm, and the
-        predicted turn's derivative in the part's scale u (rad): κ·L, 0 where the wheel pivots on a corner."""
+    def _model_at(self, length: float, turn: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """:meth:`predicted_turn`, each start's curvature (1/mm) at its contact after ``length`` mm, the
+        predicted turn's derivative in the part's scale u (rad): κ·L, 0 where the wheel pivots on a corner,
+        and where it pivots with the part's scale carried, how far the corner is ahead of its contact (mm; NaN
+        elsewhere): a pivot places the contact on the corner, s + L(1 + u) = c, which within the corner window
+        widened by the scale's prior is a reading of u (:meth:`update`)."""
         theta, kappa = self._angles.at(length)
         x, window = self.grid + float(length), self.corner_window(length)
         smooth = theta - self._theta0
+        corners = [c.arc for c in self.part.corners if c.angle > 0] if isinstance(self.part, Outline) else []
+        if self._terms > 1 and corners:
+            window += 3.0 * self.sd_part_scale * abs(float(length))
         model = pivot_turn(self.part, x, self._theta0, smooth, float(turn), window)
-        slope: FloatArray = np.where(model == smooth, kappa * float(length), 0.0)
-        return model, kappa, slope
+        pivoting = model != smooth
+        slope: FloatArray = np.where(pivoting, 0.0, kappa * float(length))
+        ahead = np.full(x.size, math.nan)
+        if self._terms > 1 and corners and pivoting.any():
+            P = float(self.part.perimeter)
+            ahead[pivoting] = -nearest_corner(np.array(corners), P, np.mod(x[pivoting], P))[1]
+        return model, kappa, slope, ahead
 
     def update(self, length: float, turn: float) -> None:
         """Add a reading: the arc rolled since the start, ``length`` mm (signed: negative rolling
@@ -292,7 +303,7 @@ class WheelState:
         c_nn = float(self._cov(np.array([L]), np.array([L]))[0, 0])
         ell = solve_triangular(self._chol, c_new, lower=True) if used.size else np.zeros(0)
         d2 = max(c_nn - float(ell @ ell), 1e-18)
-        model, kappa, slope = self._model_at(L, om)
+        model, kappa, slope, ahead = self._model_at(L, om)
         extra = kappa**2 * (self.sd_length**2 + (L * self.sd_scale) ** 2)
         rho = om - model
         var = d2 + extra
@@ -309,6 +320,17 @@ class WheelState:
             self._zgbuf[k], self._ggbuf[k] = z * zg, zg**2
             self._zg += self._zgbuf[k]
             self._gg += self._ggbuf[k]
+            pivoting = np.isfinite(ahead)
+            if pivoting.any():
+                # the pivot's place: the corner ahead by c − x − L·u, within the unwidened window's third (the
+                # pivot's turn is 0 misfit there): an independent reading of u and the start. Kept out of the
+                # per-reading terms, as what a reading tells through the later ones' conditioning is at the
+                # model's size: a stretch left out leaves the corner's place
+                sd = self.corner_window(L) / 3.0
+                zp, zgp = ahead[pivoting] / sd, L / sd
+                self._quad[pivoting] += zp**2
+                self._zg[pivoting] += zp * zgp
+                self._gg[pivoting] += zgp**2
         self._quad += z**2
         self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
         self._lvbuf[k] = np.log(var)
@@ -398,25 +420,8 @@ class WheelState:
 
     def _spread(self, mean: FloatArray, sd: FloatArray, p_off: FloatArray) -> Spread:
         """Each start's present contact for the part's scale u given the start, off the model's size
-        N(``mean``, ``sd``²) with probability ``p_off``: the arc read since the last convex corner the start's
-        contact pivoted on (the pivot placed it there whatever the scale), or since the start, stretched by
-        1 + u."""
-        lever = self._lever()
+        N(``mean``, ``sd``²) with probability ``p_off``: the arc read since the start stretched by 1 + u. (On a
+        drawing a pivot on a corner ties u to the start, s + L(1 + u) = c: the starts then spread the present
+        contact by the arc read since the corner times u's prior, each start itself little.)"""
         nominal = self.grid + self.current
-        return Spread(nominal, nominal + lever * mean, np.abs(lever) * sd, p_off)
-
-    def _lever(self) -> FloatArray:
-        """Per start, the arc read (mm) since its contact was last on a convex corner of a drawing within the
-        rolled span (nearest the present one), or since the start."""
-        lever = np.full(self.grid.size, self.current)
-        if self._terms == 1 or not isinstance(self.part, Outline):
-            return lever
-        lo, hi = self.span
-        P = float(self.part.perimeter)
-        for c in self.part.corners:
-            if c.angle <= 0:
-                continue
-            reached = np.mod(c.arc - self.grid - lo, P) + lo  # the arc read when the contact is on the corner
-            since = np.where(reached <= hi, self.current - reached, np.inf)
-            lever = np.where(np.abs(since) < np.abs(lever), since, lever)
-        return lever
+        return Spread(nominal, nominal + self.current * mean, abs(self.current) * sd, p_off)

@@ -326,30 +326,35 @@ def test_a_part_two_percent_large_is_never_sure_and_wrong_with_its_scale():
     assert wrong_and_sure == 0 and right >= 4
 
 
-def test_after_a_corner_the_scale_spreads_the_present_contact_by_the_arc_rolled_since():
-    """On the pentagon (straight faces: nothing tells the scale), the present contact's spread off the model's
-    size is the arc rolled since the last corner the start's contact pivoted on, times the scale's prior (1%),
-    and the stated mass is what the two sizes leave within the radius, each by its probability (nothing tells
-    them apart either: the prior's OFF_SCALE)."""
-    from scipy.special import ndtr
-
+@pytest.mark.parametrize("scale", [1.0, 1.02])
+def test_on_a_drawing_two_corners_pivoted_on_tell_the_parts_scale(scale):
+    """On the pentagon (straight faces: only its corners tell the scale) made ``scale`` times its model's size,
+    noise-free rolls over one corner (40 mm) and over two (50 mm), with the scale carried. As its model: sure
+    and right either way, the part taken to be off its size with probability under 0.01. Two percent large:
+    over two corners the arc read between their pivots is 2% more than the model's, and the belief is right
+    with the part taken to be off its size; at the model's size, nothing fits (the second pivot is 0.6 mm
+    from where the first puts it). One corner cannot tell a scale from a start: not asserted."""
     from localizer import Line, outline_from_pieces
 
     pieces = [Line(PENTAGON[i], PENTAGON[(i + 1) % 5]) for i in range(5)]
-    outline = outline_from_pieces(pieces, name="pentagon")
-    c = outline.corners[1].arc
-    start = float(outline.wrap_arc(c - 15.22))
-    f = WheelFilter(outline, WheelJaw(5.0), thin=0.2, off_scale=OFF_SCALE)
-    readings = pivoting_readings(PENTAGON, start, 40.0, 1)  # the next corner is 29.2 mm past the first
-    for L, om in readings:
-        f.update(L, om)
-    i = int(np.argmax(f.posterior()))
-    spread = f.present_spread()
-    assert spread.sd[i] == pytest.approx((40.0 - 15.22) * 0.01, rel=0.05)  # 24.8 mm past the corner
-    p = spread.p_off[i]
-    assert p == pytest.approx(OFF_SCALE, rel=0.1)
-    b = f.belief()
-    assert b.mass == pytest.approx(1 - p + p * (2 * ndtr(0.3 / spread.sd[i]) - 1), abs=0.01)
+    model = outline_from_pieces(pieces, name="pentagon")
+    start = float(model.wrap_arc(model.corners[1].arc - 15.22))
+    real = [(x * scale, y * scale) for x, y in PENTAGON]
+    for length in (40.0, 50.0):  # the second corner is 29.2 mm past the first
+        readings = pivoting_readings(real, start * scale, length, 1)
+        truth = float(model.wrap_arc(start + readings[-1][0] / scale))
+        f, told = (WheelFilter(model, WheelJaw(5.0), thin=0.2, off_scale=off) for off in (OFF_SCALE, 0.0))
+        for L, om in readings:
+            f.update(L, om)
+            told.update(L, om)
+        b, i = f.belief(), int(np.argmax(f.posterior()))
+        p_off = f.present_spread().p_off[i]
+        off = abs(float(model.arc_offset(b.map_arc, truth)))
+        if scale == 1.0:
+            assert off < 0.05 and b.mass >= 0.95 and p_off < 0.01
+        elif length == 50.0:
+            assert off < 0.3 and p_off > 0.9
+            assert not told.belief().consistent
 
 
 @pytest.mark.parametrize("off", [0.0, OFF_SCALE, 0.5, 0.99])
