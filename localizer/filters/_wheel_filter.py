@@ -284,14 +284,17 @@ class WheelFilter(WheelState):
         quad = self._quad / scale**2
         if self._terms > 1:
             # or off its size, by the deviance of the scale weighed out (−2 log of its factor on the likelihood):
-            # the misfit with the scale fitted and its prior's u²/σ² at its own size (not widened by ``scale`` as
-            # the readings' errors are), the prior's width against what the readings tell of u, and the prior's
-            # odds against a part off its size where they are against it (a wheel wedged in a corner reads as
-            # rolling a concave arc, which a scale 3.5σ off explains over the three readings before it jumps:
-            # 15 against 79 at the model's size)
-            u = self._scale_posterior(scale, temper=1.0)[0]
-            fit = (self._quad - self._zg * u) / scale**2
-            occam = np.log1p(self._gg * self.sd_part_scale**2 / scale**2)
+            # the misfit with the scale fitted and its prior's u²/σ² at its own size (not widened as the readings'
+            # errors are), the prior's width against what the readings tell of u, and the prior's odds against a
+            # part off its size where they are against it; under the error model times ``scale`` but at most
+            # the noisiest the stated probability allows (the largest of ``noise_scales``): a wheel wedged on the
+            # bracket's notch wall reads as rolling a concave arc, which a scale 2.7σ off explains at four times
+            # the noise over the four readings before it turns round (18.5 against 31 at the model's size) and
+            # not at twice
+            f = min(scale, max(self.noise_scales))
+            u = self._scale_posterior(f, temper=1.0)[0]
+            fit = (self._quad - self._zg * u) / f**2
+            occam = np.log1p(self._gg * self.sd_part_scale**2 / f**2)
             off = fit + occam + 2.0 * max(0.0, math.log((1.0 - self.off_scale) / self.off_scale))
             quad = np.minimum(quad, off)
         best = float(np.min(np.where(self.prior > 0, quad, np.inf)))
