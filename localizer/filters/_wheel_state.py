@@ -14,7 +14,7 @@ from scipy.linalg import solve_triangular
 from .._defaults import CONFIDENCE, PART_SCALE_SD, SUCCESS_RADIUS
 from .._errors import QueryError
 from .._types import BoolArray, FloatArray
-from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, wheel_reach_for
+from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, unwrapped_angle, wheel_reach_for
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid, nearest_corner
 from ._belief import within
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
@@ -282,8 +282,17 @@ class WheelState:
         slope: FloatArray = np.where(pivoting, 0.0, kappa * float(length))
         ahead = np.full(x.size, math.nan)
         if self._terms > 1 and corners and pivoting.any():
+            # the place only where the turn is inside the corner's jump beyond its faces' angles (the error of
+            # a reading's turn and the faces' machined slope, at the noisiest the stated probability allows):
+            # a wheel still on the face before it, or already on the one after, reads a face's angle anywhere
             P = float(self.part.perimeter)
-            ahead[pivoting] = -nearest_corner(np.array(corners), P, np.mod(x[pivoting], P))[1]
+            i = np.flatnonzero(pivoting)
+            j, d, _ = nearest_corner(np.array(corners), P, np.mod(x[i], P))
+            after = unwrapped_angle(self.part, x[i] - d) - self._theta0[i]
+            before = after - np.array([c.angle for c in self.part.corners if c.angle > 0])[j]
+            margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
+            inside = (float(turn) > before + margin) & (float(turn) < after - margin)
+            ahead[i[inside]] = -d[inside]
         return model, kappa, slope, ahead
 
     def update(self, length: float, turn: float) -> None:
