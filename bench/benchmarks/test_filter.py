@@ -135,20 +135,22 @@ def _kidney_wheel_roll(step: float) -> tuple[Part, WheelFilter, FloatArray, Floa
     return part, WheelFilter(part, WheelJaw(5.0)), lengths, cast("FloatArray", theta[1:] - theta[0])
 
 
+def _filtered_roll(flt: WheelFilter, lengths: FloatArray, turns: FloatArray) -> Belief:
+    """The roll's readings through ``flt`` from a reset, a belief every 4 (as
+    :func:`driver.wheel.localize_with_wheel`): the last belief."""
+    flt.reset()
+    for k, (L, om) in enumerate(zip(lengths, turns)):
+        flt.update(float(L), float(om))
+        if k % 4 == 3:
+            b = flt.belief()
+    return b
+
+
 def test_wheel_filter_roll(benchmark: BenchmarkFixture) -> None:
     """A 5 mm wheel's filter over a 20 mm roll from inside the kidney's waist: 80 readings 0.25 mm apart
     (one a millimetre used by the likelihood), a belief every 4, as :func:`driver.wheel.localize_with_wheel`."""
     part, flt, lengths, turns = _kidney_wheel_roll(0.25)
-
-    def roll() -> Belief:
-        flt.reset()
-        for k, (L, om) in enumerate(zip(lengths, turns)):
-            flt.update(float(L), float(om))
-            if k % 4 == 3:
-                b = flt.belief()
-        return b
-
-    b: Belief = benchmark.pedantic(roll, rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
+    b: Belief = benchmark.pedantic(_filtered_roll, args=(flt, lengths, turns), rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(float(part.arc_offset(b.map_arc, WHEEL_START + lengths[-1]))) < 0.3
     benchmark.extra_info.update(
         {
@@ -167,16 +169,7 @@ def test_wheel_filter_roll_off_size(benchmark: BenchmarkFixture) -> None:
 
     part, _, lengths, turns = _kidney_wheel_roll(0.25)
     flt = WheelFilter(part, WheelJaw(5.0), off_scale=OFF_SCALE)
-
-    def roll() -> Belief:
-        flt.reset()
-        for k, (L, om) in enumerate(zip(lengths, turns)):
-            flt.update(float(L), float(om))
-            if k % 4 == 3:
-                b = flt.belief()
-        return b
-
-    b: Belief = benchmark.pedantic(roll, rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
+    b: Belief = benchmark.pedantic(_filtered_roll, args=(flt, lengths, turns), rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(float(part.arc_offset(b.map_arc, WHEEL_START + lengths[-1]))) < 0.3
     benchmark.extra_info.update({"starts": int(flt.grid.size), "readings": int(lengths.size)})
     per_second(benchmark, "readings_per_second", lengths.size)
