@@ -21,10 +21,14 @@ and the residuals ρ_k = Ω_k − Ω̂(s, L_k) of the readings of one roll share
 and one error common to the roll that depends on the start: the part's **scale** against its model (a
 part made 2% large, its drawing an older revision's). The wheel rolls the real arc, so after L the
 contact under a start s is at s + L·(1 + u), u = 1/b − 1 for a part b times its model's size, and the
-model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + κ(s + L)·L·u. With u ~ N(0, ``sd_part_scale``²) it is
-weighed out in closed form per start (the residuals are linear in it), and each start's present contact
-is s + L(1 + û) with the spread L·σ_u of u's posterior given that start (the straight jaw carries its
-scale alike: docs/robustness.md, "A part that is not its model").
+model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + κ(s + L)·L·u; on a drawing a pivot on a convex corner
+(the turn inside its jump) places the contact on it, s + L(1 + u) = c. The prior is a spike and a slab:
+the part is its model's size (u = 0) but with probability ``off_scale`` (default 0: the scale is not
+carried; :data:`~localizer.OFF_SCALE` is the stated one), then u ~ N(0, ``sd_part_scale``²). Given a
+start both are weighed out in closed form (the residuals are linear in u), and the start's present contact
+is s + L at the model's size, N(s + L(1 + û), (L·σ_u)²) off it (:class:`~localizer.Spread`). Only
+curvature and corners tell a scale: on a face, a near-circular stretch or a short roll the prior decides
+(docs/robustness.md, "The wheel on a part off its model's size").
 
 The first three depend on the readings' L only, the same for every start: their covariance is
 factored once, a row per reading (a Cholesky factor grown by one row), and every start's residuals

@@ -39,8 +39,9 @@ WHEEL_SLOPE_LENGTH = 20.0 / (2 * math.pi)
 #: The prior probability that a part is off its model's size by more than its machining (made to another
 #: revision's drawing, scaled on export): its scale is then N(1, ``sd_part_scale``²); else its model's
 #: (docs/robustness.md, "The wheel on a part off its model's size"). Not yet the filter's default
-#: (``off_scale`` 0: the part is its model's size): on the bracket's notch wall a wedged wheel then ends
-#: ``mismatch`` where it was sure and right (tests/driver/test_wheel.py).
+#: (``off_scale`` 0: the part is its model's size): with it, a wheel enclosed in the bracket's notch and
+#: noise-free rolls on the kidney's concave stretches stop short of sure (tests/driver/test_wheel.py,
+#: tests/localizer/test_wheel_filter.py).
 OFF_SCALE = 0.05
 #: Noise scales under which a stated probability must hold (its least is stated).
 WHEEL_NOISE_SCALES = (1.0, 2.0)
