@@ -176,6 +176,9 @@ class WheelState:
         self._gg = np.zeros(n)
         self._logdet = np.zeros(self.grid.size)
         self._penalty = np.zeros(self.grid.size)
+        # what a part off its size takes back of the contradictions of a roll over what the wheel cannot pass
+        # (in _penalty, at the model's size): it may have rolled less of the model than was read
+        self._penalty_off = np.zeros(self.grid.size)
         self.current = 0.0
         self.span = (0.0, 0.0)
         self.steps = 0
@@ -345,7 +348,11 @@ class WheelState:
         self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
         self._lvbuf[k] = np.log(var)
         self._logdet += self._lvbuf[k]
-        self._penalty += np.where(self._clear(), 0.0, math.log(CONTRADICTION))
+        clear = self._clear()
+        self._penalty += np.where(clear, 0.0, math.log(CONTRADICTION))
+        if self._terms > 1:
+            relaxed = self._clear(1.0 - 3.0 * self.sd_part_scale)
+            self._penalty_off += np.where(relaxed & ~clear, -math.log(CONTRADICTION), 0.0)
         self._zbuf[:n, k] = z * np.sqrt(var / d2)  # whitened by the shared part alone
         self._cholbuf[k, :k] = ell
         self._cholbuf[k, k] = math.sqrt(d2)
@@ -370,14 +377,12 @@ class WheelState:
         return out
 
     # --------------------------------------------------------------- belief
-    def _clear(self) -> BoolArray:
-        """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
+    def _clear(self, stretch: float = 1.0) -> BoolArray:
+        """Starts from which the arc rolled so far, both ways, runs over touchable points only; the model's arc
+        taken as ``stretch`` times the arc read (off its size, the scale prior's three standard deviations
+        less: a wheel rolled up to a place it cannot pass on a part 2% large reads 2% past it)."""
         lo, hi = self.span
         tol = 2 * self.h
-        # the model's arc rolled per arc read is 1 + u: a part off its size may have rolled up to the scale's
-        # prior's three standard deviations less of the model than was read (a wheel rolled up to a place it
-        # cannot pass on a part 2% large reads 2% past it)
-        stretch = 1.0 - 3.0 * self.sd_part_scale if self._terms > 1 else 1.0
         ok: BoolArray = (self._ahead + tol >= hi * stretch) & (self._behind + tol >= -lo * stretch)
         return ok
 
@@ -398,6 +403,7 @@ class WheelState:
         prec = 1.0 / self.sd_part_scale**2 + gg
         mean = zg / prec
         off = math.log(self.off_scale) + 0.5 * zg * mean - 0.5 * np.log1p(gg * self.sd_part_scale**2)
+        off = off + self._penalty_off
         log_factor = np.logaddexp(math.log1p(-self.off_scale), off)
         return mean, 1.0 / np.sqrt(prec), log_factor, np.exp(off - log_factor)
 
