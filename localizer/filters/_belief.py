@@ -151,12 +151,9 @@ def most_probable(w: FloatArray, k: int) -> IntArray:
     return out
 
 
-def mass_within(
-    part: Any, arcs: FloatArray, weights: FloatArray, at: float, radius: float, sd: FloatArray | None = None
-) -> float:
+def mass_within(part: Any, arcs: FloatArray, weights: FloatArray, at: float, radius: float) -> float:
     """The weight of the points ``arcs`` (mm along ``part``, each with its weight ``weights``) that lie within
-    ``radius`` mm of arc ``at``, either way round the part; each point N(arc, ``sd``²) along the part where
-    ``sd`` (mm) is given (:func:`within`).
+    ``radius`` mm of arc ``at``, either way round the part.
 
     Examples
     --------
@@ -167,8 +164,6 @@ def mass_within(
     >>> round(mass_within(circle, arcs, np.array([0.1, 0.2, 0.3, 0.4]), 0.5, 1.5), 6)
     0.6
     """
-    if sd is not None:
-        return float(np.sum(np.asarray(weights) * within(part, arcs, sd, at, radius)))
     near = np.abs(np.asarray(part.arc_offset(arcs, at))) <= radius
     return float(np.asarray(weights)[near].sum())
 

@@ -145,6 +145,9 @@ class WheelState:
         if not touch.any():
             raise QueryError(f"a {wheel} touches {part.name} nowhere")
         self._ahead, self._behind = free_runs(touch, self.h)
+        convex = [c for c in part.corners if c.angle > 0] if isinstance(part, Outline) else []
+        # a drawing's convex corners: their arcs (mm) and jumps (rad), for the pivots' readings of the scale
+        self._convex = (np.array([c.arc for c in convex]), np.array([c.angle for c in convex]))
         self._ahead_jump, self._behind_jump = jump_runs(part, wheel, self.grid, self._ahead, self._behind)
         # each reading used keeps three numbers a start (six with the part's scale) and a row of the Cholesky
         # factor: 24·n·k + 8·k² bytes (48·n·k + 8·k²) for k readings stay within MAX_ARRAY_BYTES (a 1000 mm
@@ -278,22 +281,22 @@ class WheelState:
         theta, kappa = self._angles.at(length)
         x, window = self.grid + float(length), self.corner_window(length)
         smooth = theta - self._theta0
-        corners = [c.arc for c in self.part.corners if c.angle > 0] if isinstance(self.part, Outline) else []
-        if self._terms > 1 and corners:
+        corners, jumps = self._convex
+        if self._terms > 1 and corners.size:
             window += 3.0 * self.sd_part_scale * abs(float(length))
         model = pivot_turn(self.part, x, self._theta0, smooth, float(turn), window)
         pivoting = model != smooth
         slope: FloatArray = np.where(pivoting, 0.0, kappa * float(length))
         ahead = np.full(x.size, math.nan)
-        if self._terms > 1 and corners and pivoting.any():
+        if self._terms > 1 and corners.size and pivoting.any():
             # the place only where the turn is inside the corner's jump beyond its faces' angles (the error of
             # a reading's turn and the faces' machined slope, at the noisiest the stated probability allows):
             # a wheel still on the face before it, or already on the one after, reads a face's angle anywhere
             P = float(self.part.perimeter)
             i = np.flatnonzero(pivoting)
-            j, d, _ = nearest_corner(np.array(corners), P, np.mod(x[i], P))
+            j, d, _ = nearest_corner(corners, P, np.mod(x[i], P))
             after = unwrapped_angle(self.part, x[i] - d) - self._theta0[i]
-            before = after - np.array([c.angle for c in self.part.corners if c.angle > 0])[j]
+            before = after - jumps[j]
             margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
             inside = (float(turn) > before + margin) & (float(turn) < after - margin)
             ahead[i[inside]] = -d[inside]
