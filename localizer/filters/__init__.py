@@ -27,10 +27,11 @@ from ._wheel_filter import (
     WHEEL_SLOPE_LENGTH,
     WheelFilter,
 )
-from ._wheel_state import OFF_SCALE, Spread
+from ._wheel_state import OFF_SCALE, OFF_SCALE_DOUBT, Spread
 
 __all__ = [
     "OFF_SCALE",
+    "OFF_SCALE_DOUBT",
     "Spread",
     "Belief",
     "Mode",

@@ -46,7 +46,9 @@ the reach does not rule out the truth.
 Trust, as the straight jaw's filter (docs/filter.md, "Trust"): the readings' likelihood is raised to the
 power :data:`~localizer.TEMPER`, and a stated probability is the least over ``noise_scales`` (the
 covariance times each factor squared), so that readings noisier than the filter was told lower it
-instead of making it confidently wrong. And a belief is only stated when some start fits at all: when
+instead of making it confidently wrong; with the scale carried, the least also over the prior
+probabilities ``off_scale`` and ``off_scale_doubt`` that the part is off its size, so that where the
+readings cannot tell the size, the prior's odds do not make the belief sure. And a belief is only stated when some start fits at all: when
 the best start's residuals are beyond the χ² test at :data:`~localizer.FIT_ALPHA` even under
 :data:`WHEEL_FIT_SCALE` times the error model, nothing fits (a wheel jammed between two walls reads
 exactly as rolling in a concave arc of its own radius, docs/wheel.md), and the belief's mass is 0,
@@ -116,6 +118,9 @@ class WheelFilter(WheelState):
     off_scale : float
         Prior probability that the part is off its model's size (:data:`~localizer.OFF_SCALE` is the
         stated one; default 0: the part is its model's size, as before the scale was carried).
+    off_scale_doubt : float
+        With the scale carried, the stated mass is the least also under this prior probability that the part
+        is off its size (:data:`~localizer.OFF_SCALE_DOUBT`; not below ``off_scale``).
     thin : float, mm
         Arc between two readings the likelihood uses.
     radius : float, mm
@@ -158,9 +163,10 @@ class WheelFilter(WheelState):
         map_arc = float(present[i])
         mass = 1.0
         for f in self.noise_scales:
-            first = f == self.noise_scales[0]
-            wf, sf = (w, spread) if first else (self._posterior(f), self.present_spread(f))
-            mass = min(mass, sf.mass(self.part, wf, map_arc, radius))
+            for odds in self.off_scales:
+                first = f == self.noise_scales[0] and odds == self.off_scale
+                wf, sf = (w, spread) if first else (self._posterior(f, odds), self.present_spread(f, odds))
+                mass = min(mass, sf.mass(self.part, wf, map_arc, radius))
         consistent = self.consistent()
         if not consistent:
             mass = 0.0
@@ -222,11 +228,13 @@ class WheelFilter(WheelState):
                 zg = self._zg - self._zg_each[inside].sum(axis=0)
                 gg = self._gg - self._gg_each[inside].sum(axis=0)
             for f in self.noise_scales:
-                mean, sd, scale_ll, p_off = self._scale_posterior(f, zg, gg)
-                ll = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty + scale_ll
-                ll = np.where(allowed, ll, -np.inf)
-                wts = np.exp(ll - ll.max())
-                worst = min(worst, self._spread(mean, sd, p_off).mass(self.part, wts / wts.sum(), arc, radius))
+                for odds in self.off_scales:
+                    mean, sd, scale_ll, p_off = self._scale_posterior(f, zg, gg, odds=odds)
+                    ll = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty + scale_ll
+                    ll = np.where(allowed, ll, -np.inf)
+                    wts = np.exp(ll - ll.max())
+                    spread = self._spread(mean, sd, p_off)
+                    worst = min(worst, spread.mass(self.part, wts / wts.sum(), arc, radius))
             if worst < self.confidence:
                 break
         return worst

@@ -27,6 +27,7 @@ __all__ = [
     "WHEEL_SLOPE_LENGTH",
     "WHEEL_NOISE_SCALES",
     "OFF_SCALE",
+    "OFF_SCALE_DOUBT",
 ]
 
 #: One reading's independent angle error (rad): the arm encoder's 0.03° step (0.009° rms) and the wrist's
@@ -43,6 +44,11 @@ WHEEL_SLOPE_LENGTH = 20.0 / (2 * math.pi)
 #: noise-free rolls on the kidney's concave stretches stop short of sure (tests/driver/test_wheel.py,
 #: tests/localizer/test_wheel_filter.py).
 OFF_SCALE = 0.05
+#: The stated probability holds also if the part were off its size with this prior probability (the least
+#: under the two is stated, as under the noise scales): where the readings cannot tell the part's size (a
+#: face, a near-circular stretch, a short roll) it is the prior's odds that would make the belief sure, and
+#: a part that is off its size is sure and wrong there (docs/robustness.md).
+OFF_SCALE_DOUBT = 0.5
 #: Noise scales under which a stated probability must hold (its least is stated).
 WHEEL_NOISE_SCALES = (1.0, 2.0)
 
@@ -99,6 +105,7 @@ class WheelState:
         sd_scale: float = 2e-4,
         sd_part_scale: float = PART_SCALE_SD,
         off_scale: float = 0.0,
+        off_scale_doubt: float = OFF_SCALE_DOUBT,
         thin: float = 1.0,
         radius: float = SUCCESS_RADIUS,
         confidence: float = CONFIDENCE,
@@ -130,6 +137,8 @@ class WheelState:
         if not (math.isfinite(off_scale) and 0 <= off_scale < 1):
             raise QueryError(f"off_scale={off_scale!r} is a probability: give it in [0, 1)")
         self.off_scale = float(off_scale)
+        if not (math.isfinite(off_scale_doubt) and 0 <= off_scale_doubt < 1):
+            raise QueryError(f"off_scale_doubt={off_scale_doubt!r} is a probability: give it in [0, 1)")
         self.radius, self.confidence, self.mode_floor = float(radius), float(confidence), float(mode_floor)
         self.noise_scales = tuple(float(f) for f in noise_scales)
         P = float(part.perimeter)
@@ -155,6 +164,11 @@ class WheelState:
         self._terms = (
             2 if self.sd_part_scale > 0 and self.off_scale > 0 else 1
         )  # residuals, and their derivatives in the scale
+        # the prior probabilities of a part off its size the stated probability is the least under (the first
+        # is the belief's)
+        self.off_scales: tuple[float, ...] = (self.off_scale,)
+        if self._terms > 1 and off_scale_doubt > self.off_scale:
+            self.off_scales += (float(off_scale_doubt),)
         self._per_reading = 24.0 * self._terms * n
         b = self._per_reading
         self.max_readings = int((math.sqrt(b * b + 32.0 * MAX_ARRAY_BYTES) - b) / 16.0)
@@ -184,6 +198,7 @@ class WheelState:
         self._penalty_off = np.zeros(self.grid.size)
         self.current = 0.0
         self.span = (0.0, 0.0)
+        self._last: tuple[float, float] | None = None  # the last reading, used or not
         self.steps = 0
         self._misfit: tuple[tuple[float, float], float] | None = None  # (stretch on the model, p-value)
         self._fit_at = 0  # readings used at the last fit test
@@ -312,7 +327,8 @@ class WheelState:
         self.span = (min(self.span[0], L), max(self.span[1], L))
         self.steps += 1
         last = self.L_used[-1] if self.L_used else 0.0
-        if abs(L - last) < self.thin:
+        before, self._last = self._last, (L, om)
+        if abs(L - last) < self.thin and not self._pivot(L, om, before):
             return
         used = np.array(self.L_used)
         c_new = self._cov(used, np.array([L]))[:, 0] if used.size else np.zeros(0)
@@ -336,17 +352,7 @@ class WheelState:
             self._zgbuf[k], self._ggbuf[k] = z * zg, zg**2
             self._zg += self._zgbuf[k]
             self._gg += self._ggbuf[k]
-            pivoting = np.isfinite(ahead)
-            if pivoting.any():
-                # the pivot's place: the corner ahead by c − x − L·u, within the unwidened window's third (the
-                # pivot's turn is 0 misfit there): an independent reading of u and the start. Kept out of the
-                # per-reading terms, as what a reading tells through the later ones' conditioning is at the
-                # model's size: a stretch left out leaves the corner's place
-                sd = self.corner_window(L) / 3.0
-                zp, zgp = ahead[pivoting] / sd, L / sd
-                self._quad[pivoting] += zp**2
-                self._zg[pivoting] += zp * zgp
-                self._gg[pivoting] += zgp**2
+            self._place(L, ahead)
         self._quad += z**2
         self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
         self._lvbuf[k] = np.log(var)
@@ -360,6 +366,32 @@ class WheelState:
         self._cholbuf[k, :k] = ell
         self._cholbuf[k, k] = math.sqrt(d2)
         self.L_used.append(L)
+
+    def _place(self, length: float, ahead: FloatArray) -> None:
+        """A pivot's place, where ``ahead`` is finite (:meth:`_model_at`): the corner ahead by c − x − L·u, within
+        the unwidened window's third (the pivot's turn is 0 misfit there), an independent reading of u and the
+        start. Kept out of the per-reading terms, as what a reading tells through the later ones' conditioning
+        is at the model's size: a stretch left out leaves the corner's place."""
+        pivoting = np.isfinite(ahead)
+        if not pivoting.any():
+            return
+        sd = self.corner_window(length) / 3.0
+        zp, zgp = ahead[pivoting] / sd, length / sd
+        self._quad[pivoting] += zp**2
+        self._zg[pivoting] += zp * zgp
+        self._gg[pivoting] += zgp**2
+
+    def _pivot(self, length: float, turn: float, before: tuple[float, float] | None) -> bool:
+        """Whether a reading within ``thin`` of the last one used is used all the same, with the part's scale
+        carried on a drawing: the first of a pivot on a corner (the arc stood still since the reading
+        ``before`` and since the last one used, and the hand turned beyond a reading's error), whose place is
+        a reading of the scale (:meth:`_place`). The readings used are spaced in arc, so a pivot, all at one
+        arc, is seldom one of them otherwise, and its place read for the starts at the corner but its turn
+        not for the rest would favour these."""
+        if self._terms == 1 or not self._convex[0].size or before is None or not self.L_used:
+            return False
+        margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
+        return abs(length - before[0]) < self.h <= abs(length - self.L_used[-1]) and abs(turn - before[1]) > margin
 
     def jumped(self, direction: int, margin: float = 1.0) -> BoolArray:
         """The wheel jumped (and was taken back) when rolling on from the present contact in
@@ -390,13 +422,18 @@ class WheelState:
         return ok
 
     def _scale_posterior(
-        self, factor: float = 1.0, zg: FloatArray | None = None, gg: FloatArray | None = None, temper: float = TEMPER
+        self,
+        factor: float = 1.0,
+        zg: FloatArray | None = None,
+        gg: FloatArray | None = None,
+        temper: float = TEMPER,
+        odds: float | None = None,
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Per start: the part's scale u given the start and that the part is off its model's size (its mean
         and standard deviation), the log of the factor weighing the scale out puts on the start's likelihood
-        (both sizes, by their prior :attr:`off_scale`), and the probability that the part is off its size;
-        under the readings' likelihood raised to ``temper`` with the error model times ``factor``, from the
-        sums Σ z·g and Σ g² (default: every reading used's). Without the scale: zeros."""
+        (both sizes, by their prior ``odds``, default :attr:`off_scale`), and the probability that the part is
+        off its size; under the readings' likelihood raised to ``temper`` with the error model times
+        ``factor``, from the sums Σ z·g and Σ g² (default: every reading used's). Without the scale: zeros."""
         n = self.grid.size
         if self._terms == 1:
             zero = np.zeros(n)
@@ -405,14 +442,15 @@ class WheelState:
         gg = (self._gg if gg is None else gg) * (temper / factor**2)
         prec = 1.0 / self.sd_part_scale**2 + gg
         mean = zg / prec
-        off = math.log(self.off_scale) + 0.5 * zg * mean - 0.5 * np.log1p(gg * self.sd_part_scale**2)
+        pi = self.off_scale if odds is None else odds
+        off = math.log(pi) + 0.5 * zg * mean - 0.5 * np.log1p(gg * self.sd_part_scale**2)
         off = off + self._penalty_off
-        log_factor = np.logaddexp(math.log1p(-self.off_scale), off)
+        log_factor = np.logaddexp(math.log1p(-pi), off)
         return mean, 1.0 / np.sqrt(prec), log_factor, np.exp(off - log_factor)
 
-    def _posterior(self, factor: float) -> FloatArray:
+    def _posterior(self, factor: float, odds: float | None = None) -> FloatArray:
         ll = TEMPER * (-0.5 * self._quad / factor**2 - 0.5 * self._logdet) + self._penalty
-        ll = ll + self._scale_posterior(factor)[2]
+        ll = ll + self._scale_posterior(factor, odds=odds)[2]
         ll = np.where(self.prior > 0, ll, -np.inf)
         top = ll.max()
         if not np.isfinite(top):
@@ -431,10 +469,11 @@ class WheelState:
         out: FloatArray = self.part.wrap_arc(self.present_spread().mean)
         return out
 
-    def present_spread(self, factor: float = 1.0) -> Spread:
+    def present_spread(self, factor: float = 1.0, odds: float | None = None) -> Spread:
         """Each start's present contact at the model's size and off it (:class:`Spread`), under the error
-        model times ``factor``."""
-        mean, sd, _, p_off = self._scale_posterior(factor)
+        model times ``factor`` and the prior probability ``odds`` (default :attr:`off_scale`) that the part is
+        off its size."""
+        mean, sd, _, p_off = self._scale_posterior(factor, odds=odds)
         return self._spread(mean, sd, p_off)
 
     def _spread(self, mean: FloatArray, sd: FloatArray, p_off: FloatArray) -> Spread:
