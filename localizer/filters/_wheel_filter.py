@@ -48,11 +48,11 @@ power :data:`~localizer.TEMPER`, and a stated probability is the least over ``no
 covariance times each factor squared), so that readings noisier than the filter was told lower it
 instead of making it confidently wrong; with the scale carried, the least also over the prior
 probabilities ``off_scale`` and ``off_scale_doubt`` that the part is off its size, so that where the
-readings cannot tell the size, the prior's odds do not make the belief sure. And a belief is only stated when some start fits at all: when
-the best start's residuals are beyond the χ² test at :data:`~localizer.FIT_ALPHA` even under
-:data:`WHEEL_FIT_SCALE` times the error model, nothing fits (a wheel jammed between two walls reads
-exactly as rolling in a concave arc of its own radius, docs/wheel.md), and the belief's mass is 0,
-``consistent`` False.
+readings cannot tell the size, the prior's odds do not make the belief sure. And a belief is only stated
+when some start fits at all: when the best start's residuals are beyond the χ² test at
+:data:`~localizer.FIT_ALPHA` even under :data:`WHEEL_FIT_SCALE` times the error model, nothing fits (a
+wheel jammed between two walls reads exactly as rolling in a concave arc of its own radius,
+docs/wheel.md), and the belief's mass is 0, ``consistent`` False.
 
 On a drawing (:class:`~localizer.Outline`) the wheel pivots on each convex corner it reaches: its
 centre circles the corner, the hand turns through the corner's jump and the rim does not roll, so Ω

@@ -398,9 +398,8 @@ def test_the_stated_probability_is_the_least_under_either_prior_odds_of_the_part
     start = float(model.wrap_arc(model.corners[1].arc - 15.22))
     readings = pivoting_readings(PENTAGON, start, length, 1)
     f = WheelFilter(model, WheelJaw(5.0), thin=0.2, off_scale=OFF_SCALE)
-    alone = [
-        WheelFilter(model, WheelJaw(5.0), thin=0.2, off_scale=off, off_scale_doubt=off) for off in (OFF_SCALE, OFF_SCALE_DOUBT)
-    ]
+    odds = (OFF_SCALE, OFF_SCALE_DOUBT)
+    alone = [WheelFilter(model, WheelJaw(5.0), thin=0.2, off_scale=off, off_scale_doubt=off) for off in odds]
     for L, om in readings:
         for g in (f, *alone):
             g.update(L, om)
