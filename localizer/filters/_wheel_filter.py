@@ -156,16 +156,15 @@ class WheelFilter(WheelState):
             The mass is taken within this of the estimate (default: the filter's).
         """
         radius = self.radius if radius is None else float(radius)
-        spread = self.present_spread()
+        w, spread = self._weighed(self.noise_scales[0])
         present = self.part.wrap_arc(spread.mean)
-        w = self.posterior()
         i = flat_top(w)
         map_arc = float(present[i])
         mass = 1.0
         for f in self.noise_scales:
             for odds in self.off_scales:
                 first = f == self.noise_scales[0] and odds == self.off_scale
-                wf, sf = (w, spread) if first else (self._posterior(f, odds), self.present_spread(f, odds))
+                wf, sf = (w, spread) if first else self._weighed(f, odds)
                 mass = min(mass, sf.mass(self.part, wf, map_arc, radius))
         consistent = self.consistent()
         if not consistent:
