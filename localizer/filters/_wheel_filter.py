@@ -21,7 +21,9 @@ and the residuals ρ_k = Ω_k − Ω̂(s, L_k) of the readings of one roll share
 and one error common to the roll that depends on the start: the part's **scale** against its model (a
 part made 2% large, its drawing an older revision's). The wheel rolls the real arc, so after L the
 contact under a start s is at s + L·(1 + u), u = 1/b − 1 for a part b times its model's size, and the
-model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + κ(s + L)·L·u; on a drawing a pivot on a convex corner
+model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + g·u, g the turn's slope across the prior's ±1σ of u (κ(s + L)·L
+where the curvature is even over it; a secant, so that a face's end at an arc's start within it is read as such);
+on a drawing a pivot on a convex corner
 (the turn inside its jump) places the contact on it, s + L(1 + u) = c. The prior is a spike and a slab:
 the part is its model's size (u = 0) but with probability ``off_scale`` (default 0: the scale is not
 carried; :data:`~localizer.OFF_SCALE` is the stated one), then u ~ N(0, ``sd_part_scale``²). Given a

@@ -165,6 +165,8 @@ class WheelState:
         convex = [c for c in part.corners if c.angle > 0] if isinstance(part, Outline) else []
         # a drawing's convex corners: their arcs (mm) and jumps (rad), for the pivots' readings of the scale
         self._convex = (np.array([c.arc for c in convex]), np.array([c.angle for c in convex]))
+        every = list(part.corners) if isinstance(part, Outline) else []
+        self._steps = (np.array([c.arc for c in every]), np.array([c.angle for c in every]))  # and every corner's
         self._ahead_jump, self._behind_jump = jump_runs(part, wheel, self.grid, self._ahead, self._behind)
         # each reading used keeps three numbers a start (six with the part's scale) and a row of the Cholesky
         # factor: 24·n·k + 8·k² bytes (48·n·k + 8·k²) for k readings stay within MAX_ARRAY_BYTES (a 1000 mm
@@ -300,7 +302,8 @@ class WheelState:
 
     def _model_at(self, length: float, turn: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """:meth:`predicted_turn`, each start's curvature (1/mm) at its contact after ``length`` mm, the
-        predicted turn's derivative in the part's scale u (rad): κ·L, 0 where the wheel pivots on a corner,
+        predicted turn's slope in the part's scale u (rad): across u's prior ±1σ, [Θ(x + Lσ) − Θ(x − Lσ)]/2σ
+        with x = s + L (κ·L where the turn is smooth over it), 0 where the wheel pivots on a corner,
         and where it pivots with the part's scale carried, how far the corner is ahead of its contact (mm; NaN
         elsewhere): a pivot places the contact on the corner, s + L(1 + u) = c, which within the corner window
         widened by the scale's prior is a reading of u (:meth:`update`)."""
@@ -312,17 +315,37 @@ class WheelState:
             window += 3.0 * self.sd_part_scale * abs(float(length))
         model = pivot_turn(self.part, x, self._theta0, smooth, float(turn), window)
         pivoting = model != smooth
-        slope: FloatArray = np.where(pivoting, 0.0, kappa * float(length))
+        if self._terms > 1:
+            # the turn's slope in u across the prior's ±1σ (a secant, not κ·L at u = 0): the readings' u is then
+            # judged over the stretch a part off its size puts the contact on, not at a point, which past a
+            # face's end at an arc's start (κ stepping) would read a few σ of u as nothing
+            step = self.sd_part_scale * float(length)
+            ahead_angle, behind_angle = self._angles.at(length + step)[0], self._angles.at(length - step)[0]
+            rise = ahead_angle - behind_angle
+            arcs, steps = self._steps
+            if arcs.size:
+                # a corner within the span is the pivot's to read, not a rise of the faces': its jump is taken out
+                j, d, _ = nearest_corner(arcs, float(self.part.perimeter), np.mod(x, float(self.part.perimeter)))
+                rise = rise - np.where(np.abs(d) < step, steps[j], 0.0)
+            secant = rise / (2.0 * self.sd_part_scale)
+        else:
+            secant = kappa * float(length)
+        slope: FloatArray = np.where(pivoting, 0.0, secant)
         ahead = np.full(x.size, math.nan)
         if self._terms > 1 and corners.size and pivoting.any():
-            # the place only where the turn is inside the corner's jump beyond its faces' angles (the error of
-            # a reading's turn and the faces' machined slope, at the noisiest the stated probability allows):
-            # a wheel still on the face before it, or already on the one after, reads a face's angle anywhere
+            # the place only where the turn is inside the corner's jump beyond its faces' angles over the window
+            # (the error of a reading's turn and the faces' machined slope, at the noisiest the stated probability
+            # allows): a wheel still on the face before it, or already on the one after, reads a face's angle
+            # anywhere, and a face that bends the jump's way towards the corner (a concave arc into it) reads
+            # within the jump a few millimetres before it. The faces' angles at the window's ends stand for their
+            # extremes over it
             P = float(self.part.perimeter)
             i = np.flatnonzero(pivoting)
             j, d, _ = nearest_corner(corners, P, np.mod(x[i], P))
             after = unwrapped_angle(self.part, x[i] - d) - self._theta0[i]
             before = after - jumps[j]
+            before = np.maximum(before, unwrapped_angle(self.part, x[i] - window) - self._theta0[i])
+            after = np.minimum(after, unwrapped_angle(self.part, x[i] + window) - self._theta0[i])
             margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
             inside = (float(turn) > before + margin) & (float(turn) < after - margin)
             ahead[i[inside]] = -d[inside]
