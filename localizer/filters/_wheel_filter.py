@@ -21,23 +21,25 @@ and the residuals ρ_k = Ω_k − Ω̂(s, L_k) of the readings of one roll share
 and one error common to the roll that depends on the start: the part's **scale** against its model (a
 part made 2% large, its drawing an older revision's). The wheel rolls the real arc, so after L the
 contact under a start s is at s + L·(1 + u), u = 1/b − 1 for a part b times its model's size, and the
-model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + g·u, g the turn's slope across the prior's ±1σ of u (κ(s + L)·L
-where the curvature is even over it; a secant, so that a face's end at an arc's start within it is read as such);
-on a drawing a pivot on a convex corner
-(the turn inside its jump) places the contact on it, s + L(1 + u) = c. The prior is a spike and a slab:
-the part is its model's size (u = 0) but with probability ``off_scale`` (default 0: the scale is not
-carried; :data:`~localizer.OFF_SCALE` is the stated one), then u ~ N(0, ``sd_part_scale``²). Given a
-start both are weighed out in closed form (the residuals are linear in u), and the start's present contact
-is s + L at the model's size, N(s + L(1 + û), (L·σ_u)²) off it (:class:`~localizer.Spread`). Only
-curvature and corners tell a scale: on a face, a near-circular stretch or a short roll the prior decides
-(docs/robustness.md, "The wheel on a part off its model's size").
+model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + g·u, g the turn's slope across the prior's ±1σ of u
+(κ(s + L)·L where the curvature is even over it; a secant, so that a face's end at an arc's start within
+it is read as such); on a drawing a pivot on a convex corner (the turn inside its jump) places the
+contact on it, s + L(1 + u) = c. The prior is a spike and a slab: the part is its model's size (u = 0)
+but with probability ``off_scale`` (default 0: the scale is not carried; :data:`~localizer.OFF_SCALE` is
+the stated one), then u ~ N(0, ``sd_part_scale``²). Given a start both are weighed out in closed form
+(the residuals are linear in u), and the start's present contact is s + L at the model's size,
+N(s + L(1 + û), (L·σ_u)²) off it (:class:`~localizer.Spread`). Only curvature and corners tell a scale: on a face,
+a near-circular stretch or a short roll the prior decides, and the stated probability, the least also
+under a part as likely off its size as not (``off_scale_doubt``), is not sure there (docs/robustness.md,
+"The wheel on a part off its model's size").
 
 The first three depend on the readings' L only, the same for every start: their covariance is
 factored once, a row per reading (a Cholesky factor grown by one row), and every start's residuals
 are whitened against it, so the log-likelihood is exact for them at O(starts × readings) per
 reading; the last term is added to each start's innovation variance. Readings closer than ``thin``
-mm of arc to the last one used only move the present contact (their errors are not independent of
-the last one's: the arm encoder's quantization is a function of the angle).
+mm of arc to the last one used only move the present contact (their errors are not independent of the
+last one's: the arm encoder's quantization is a function of the angle), but with the scale carried on a
+drawing, a pivot's first reading beyond a reading's error is used: its place is a reading of the scale.
 
 Where the wheel reaches (:class:`~localizer.WheelReach`) is the prior. A start from which the arc
 rolled so far, either way, runs over a point the wheel cannot touch (it would have jumped there,
