@@ -27,7 +27,7 @@ from ._wheel_filter import (
     WHEEL_SLOPE_LENGTH,
     WheelFilter,
 )
-from ._wheel_state import OFF_SCALE, OFF_SCALE_DOUBT, Spread
+from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, Spread
 
 __all__ = [
     "OFF_SCALE",

@@ -6,7 +6,6 @@ model is written down in :mod:`localizer.filters._wheel_filter`; the belief and 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from scipy.linalg import solve_triangular
@@ -16,18 +15,15 @@ from .._errors import QueryError
 from .._types import BoolArray, FloatArray
 from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, unwrapped_angle, wheel_reach_for
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid, nearest_corner
-from ._belief import within
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
+from ._wheel_scale import OFF_SCALE_DOUBT, Spread, weigh_odds, weigh_scale
 
 __all__ = [
     "WheelState",
-    "Spread",
     "WHEEL_SD_TURN",
     "WHEEL_SD_SLOPE",
     "WHEEL_SLOPE_LENGTH",
     "WHEEL_NOISE_SCALES",
-    "OFF_SCALE",
-    "OFF_SCALE_DOUBT",
 ]
 
 #: One reading's independent angle error (rad): the arm encoder's 0.03° step (0.009° rms) and the wrist's
@@ -37,63 +33,8 @@ WHEEL_SD_TURN = math.radians(0.025)
 WHEEL_SD_SLOPE = 0.002
 #: Its correlation length along the arc (mm): the machining's shortest wavelength, 20 mm, over 2π.
 WHEEL_SLOPE_LENGTH = 20.0 / (2 * math.pi)
-#: The prior probability that a part is off its model's size by more than its machining (made to another
-#: revision's drawing, scaled on export): its scale is then N(1, ``sd_part_scale``²); else its model's
-#: (docs/robustness.md, "The wheel on a part off its model's size"). Not yet the filter's default
-#: (``off_scale`` 0: the part is its model's size): with it, a wheel enclosed in the bracket's notch and
-#: noise-free rolls on the kidney's concave stretches stop short of sure (tests/driver/test_wheel.py,
-#: tests/localizer/test_wheel_filter.py).
-OFF_SCALE = 0.05
-#: The stated probability holds also if the part were off its size with this prior probability (the least
-#: under the two is stated, as under the noise scales): where the readings cannot tell the part's size (a
-#: face, a near-circular stretch, a short roll) it is the prior's odds that would make the belief sure, and
-#: a part that is off its size is sure and wrong there (docs/robustness.md).
-OFF_SCALE_DOUBT = 0.5
-#: A start weighing less than this times the most probable one adds nothing a stated mass could show (11724
-#: starts on the kidney: 1.2e-8 at most, all told).
-NEGLIGIBLE = 1e-12
 #: Noise scales under which a stated probability must hold (its least is stated).
 WHEEL_NOISE_SCALES = (1.0, 2.0)
-
-
-class Spread(NamedTuple):
-    """Each start's present contact (mm along the part): at the model's size, and off it.
-
-    Attributes
-    ----------
-    nominal : ndarray, mm
-        The present contact if the part is its model's size.
-    off : ndarray, mm
-        Its mean if the part is off its model's size (u's posterior mean given the start).
-    sd : ndarray, mm
-        Its standard deviation then.
-    p_off : ndarray
-        The posterior probability, given the start, that the part is off its model's size.
-    """
-
-    nominal: FloatArray
-    off: FloatArray
-    sd: FloatArray
-    p_off: FloatArray
-
-    def mass(self, part: Part | Outline, w: FloatArray, at: float, radius: float) -> float:
-        """The probability, the starts weighed by ``w``, that the present contact is within ``radius`` mm of
-        arc ``at``. Starts weighing less than :data:`NEGLIGIBLE` times the most probable one are left out: the
-        mass is then low by no more than their number times that."""
-        top = float(w.max()) if w.size else 0.0
-        if not (math.isfinite(top) and top > 0):
-            return 0.0
-        k = np.flatnonzero(w > NEGLIGIBLE * top)
-        zero = np.zeros(k.size)
-        inside = (1.0 - self.p_off[k]) * within(part, self.nominal[k], zero, at, radius)
-        inside += self.p_off[k] * within(part, self.off[k], self.sd[k], at, radius)
-        return float(np.sum(w[k] * inside))
-
-    @property
-    def mean(self) -> FloatArray:
-        """The present contact's posterior mean given each start, mm (unwrapped about the nominal one)."""
-        out: FloatArray = self.nominal + self.p_off * (self.off - self.nominal)
-        return out
 
 
 class WheelState:
@@ -480,17 +421,11 @@ class WheelState:
         else:
             zg = (self._zg if zg is None else zg) * (temper / factor**2)
             gg = (self._gg if gg is None else gg) * (temper / factor**2)
-            prec = 1.0 / self.sd_part_scale**2 + gg
-            mean = zg / prec
-            sd = 1.0 / np.sqrt(prec)
-            # the log of the readings' factor off the model's size against at it, before the prior's odds
-            evidence = 0.5 * zg * mean - 0.5 * np.log1p(gg * self.sd_part_scale**2) + self._penalty_off
+            mean, sd, evidence = weigh_scale(zg, gg, self.sd_part_scale, self._penalty_off)
             if own:
                 self._scale_cache[key] = (mean, sd, evidence)
-        pi = self.off_scale if odds is None else odds
-        off = math.log(pi) + evidence
-        log_factor = np.logaddexp(math.log1p(-pi), off)
-        return mean, sd, log_factor, np.exp(off - log_factor)
+        log_factor, p_off = weigh_odds(evidence, self.off_scale if odds is None else odds)
+        return mean, sd, log_factor, p_off
 
     def _posterior(self, factor: float, odds: float | None = None) -> FloatArray:
         return self._weights(factor, self._scale_posterior(factor, odds=odds)[2])

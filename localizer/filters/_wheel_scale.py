@@ -1,0 +1,99 @@
+"""The part's scale against its model, weighed out per start by the wheel's filter: the prior (a spike at the
+model's size and a slab off it), u's posterior given a start, and each start's present contact at both sizes
+(the model: :mod:`localizer.filters._wheel_filter`; docs/robustness.md, "The wheel on a part off its model's
+size").
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .._types import FloatArray
+from ..geometry import Outline, Part
+from ._belief import within
+
+__all__ = ["Spread", "OFF_SCALE", "OFF_SCALE_DOUBT", "weigh_scale", "weigh_odds"]
+
+#: The prior probability that a part is off its model's size by more than its machining (made to another
+#: revision's drawing, scaled on export): its scale is then N(1, ``sd_part_scale``²); else its model's
+#: (docs/robustness.md, "The wheel on a part off its model's size"). Not yet the filter's default
+#: (``off_scale`` 0: the part is its model's size): with it, a wheel enclosed in the bracket's notch and
+#: noise-free rolls on the kidney's concave stretches stop short of sure (tests/driver/test_wheel.py,
+#: tests/localizer/test_wheel_filter.py).
+OFF_SCALE = 0.05
+#: The stated probability holds also if the part were off its size with this prior probability (the least
+#: under the two is stated, as under the noise scales): where the readings cannot tell the part's size (a
+#: face, a near-circular stretch, a short roll) it is the prior's odds that would make the belief sure, and
+#: a part that is off its size is sure and wrong there (docs/robustness.md).
+OFF_SCALE_DOUBT = 0.5
+#: A start weighing less than this times the most probable one adds nothing a stated mass could show (11724
+#: starts on the kidney: 1.2e-8 at most, all told).
+NEGLIGIBLE = 1e-12
+
+
+class Spread(NamedTuple):
+    """Each start's present contact (mm along the part): at the model's size, and off it.
+
+    Attributes
+    ----------
+    nominal : ndarray, mm
+        The present contact if the part is its model's size.
+    off : ndarray, mm
+        Its mean if the part is off its model's size (u's posterior mean given the start).
+    sd : ndarray, mm
+        Its standard deviation then.
+    p_off : ndarray
+        The posterior probability, given the start, that the part is off its model's size.
+    """
+
+    nominal: FloatArray
+    off: FloatArray
+    sd: FloatArray
+    p_off: FloatArray
+
+    def mass(self, part: Part | Outline, w: FloatArray, at: float, radius: float) -> float:
+        """The probability, the starts weighed by ``w``, that the present contact is within ``radius`` mm of
+        arc ``at``. Starts weighing less than :data:`NEGLIGIBLE` times the most probable one are left out: the
+        mass is then low by no more than their number times that."""
+        top = float(w.max()) if w.size else 0.0
+        if not (math.isfinite(top) and top > 0):
+            return 0.0
+        k = np.flatnonzero(w > NEGLIGIBLE * top)
+        zero = np.zeros(k.size)
+        inside = (1.0 - self.p_off[k]) * within(part, self.nominal[k], zero, at, radius)
+        inside += self.p_off[k] * within(part, self.off[k], self.sd[k], at, radius)
+        return float(np.sum(w[k] * inside))
+
+    @property
+    def mean(self) -> FloatArray:
+        """The present contact's posterior mean given each start, mm (unwrapped about the nominal one)."""
+        out: FloatArray = self.nominal + self.p_off * (self.off - self.nominal)
+        return out
+
+
+def weigh_scale(
+    zg: FloatArray, gg: FloatArray, sd_part_scale: float, penalty_off: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Per start, from the sums Σ z·g and Σ g² of its whitened residuals z and their slopes g in the scale u
+    (already tempered and scaled by the noise factor): u's posterior mean and standard deviation given that the
+    part is off its model's size (prior N(0, ``sd_part_scale``²)), and the log of the readings' factor off the
+    model's size against at it, before the prior's odds (with ``penalty_off``, what off its size takes back of
+    the contradictions)."""
+    prec = 1.0 / sd_part_scale**2 + gg
+    mean: FloatArray = zg / prec
+    sd: FloatArray = 1.0 / np.sqrt(prec)
+    evidence: FloatArray = 0.5 * zg * mean - 0.5 * np.log1p(gg * sd_part_scale**2) + penalty_off
+    return mean, sd, evidence
+
+
+def weigh_odds(evidence: FloatArray, odds: float) -> tuple[FloatArray, FloatArray]:
+    """Per start, under the prior probability ``odds`` that the part is off its size: the log of the factor
+    the scale weighed out puts on the start's likelihood (both sizes), and the probability that the part is
+    off its size given the start."""
+    off = math.log(odds) + evidence
+    log_factor: FloatArray = np.logaddexp(math.log1p(-odds), off)
+    p_off: FloatArray = np.exp(off - log_factor)
+    return log_factor, p_off
