@@ -358,13 +358,13 @@ class WheelState:
         self._gg[pivoting] += zgp**2
 
     def _pivot(self, length: float, turn: float, before: tuple[float, float] | None) -> bool:
-        """Whether a reading within ``thin`` of the last one used is used all the same, on a drawing: the first
-        of a pivot on a corner (the arc stood still since the reading ``before`` and since the last one used,
-        and the hand turned beyond a reading's error). The readings used are spaced in arc, so a pivot, all at
-        one arc, is seldom one of them otherwise: its turn, which only a start at a corner explains, went
-        unread, and with the part's scale carried its place (:meth:`_place`, a reading of the scale) read for
-        the starts at the corner but its turn not for the rest would favour these."""
-        if not self._convex[0].size or before is None or not self.L_used:
+        """Whether a reading within ``thin`` of the last one used is used all the same, with the part's scale
+        carried on a drawing: the first of a pivot on a corner (the arc stood still since the reading
+        ``before`` and since the last one used, and the hand turned beyond a reading's error), whose place is
+        a reading of the scale (:meth:`_place`). The readings used are spaced in arc, so a pivot, all at one
+        arc, is seldom one of them otherwise, and its place read for the starts at the corner but its turn
+        not for the rest would favour these."""
+        if self._terms == 1 or not self._convex[0].size or before is None or not self.L_used:
             return False
         margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
         return abs(length - before[0]) < self.h <= abs(length - self.L_used[-1]) and abs(turn - before[1]) > margin
