@@ -231,10 +231,9 @@ class WheelFilter(WheelState):
                 zg = self._zg - self._zg_each[inside].sum(axis=0)
                 gg = self._gg - self._gg_each[inside].sum(axis=0)
             for f in self.noise_scales:
-                for odds in self.off_scales:
-                    mean, sd, scale_ll, p_off = self._scale_posterior(f, zg, gg, odds=odds)
-                    ll = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty + scale_ll
-                    ll = np.where(allowed, ll, -np.inf)
+                base = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty
+                for mean, sd, scale_ll, p_off in self._by_odds(f, zg, gg):
+                    ll = np.where(allowed, base + scale_ll, -np.inf)
                     wts = np.exp(ll - ll.max())
                     spread = self._spread(mean, sd, p_off)
                     worst = min(worst, spread.mass(self.part, wts / wts.sum(), arc, radius))

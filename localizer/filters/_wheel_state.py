@@ -103,11 +103,15 @@ class WheelState:
         if not touch.any():
             raise QueryError(f"a {wheel} touches {part.name} nowhere")
         self._ahead, self._behind = free_runs(touch, self.h)
-        convex = [c for c in part.corners if c.angle > 0] if isinstance(part, Outline) else []
-        # a drawing's convex corners: their arcs (mm) and jumps (rad), for the pivots' readings of the scale
-        self._convex = (np.array([c.arc for c in convex]), np.array([c.angle for c in convex]))
-        every = list(part.corners) if isinstance(part, Outline) else []
-        self._steps = (np.array([c.arc for c in every]), np.array([c.angle for c in every]))  # and every corner's
+        # a drawing's corners, their arcs (mm) and jumps (rad): every one's for the scale's secant, the convex
+        # ones' for the pivots
+        corners = list(part.corners) if isinstance(part, Outline) else []
+        self._steps = (np.array([c.arc for c in corners]), np.array([c.angle for c in corners]))
+        convex = self._steps[1] > 0
+        self._convex = (self._steps[0][convex], self._steps[1][convex])
+        # a turn beyond this (rad) from a face's angle is not the face's: a reading's error and the faces'
+        # machined slope, at the noisiest the stated probability allows
+        self._turn_margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
         self._ahead_jump, self._behind_jump = jump_runs(part, wheel, self.grid, self._ahead, self._behind)
         # each reading used keeps three numbers a start (six with the part's scale) and a row of the Cholesky
         # factor: 24·n·k + 8·k² bytes (48·n·k + 8·k²) for k readings stay within MAX_ARRAY_BYTES (a 1000 mm
@@ -287,7 +291,7 @@ class WheelState:
             before = after - jumps[j]
             before = np.maximum(before, unwrapped_angle(self.part, x[i] - window) - self._theta0[i])
             after = np.minimum(after, unwrapped_angle(self.part, x[i] + window) - self._theta0[i])
-            margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
+            margin = self._turn_margin
             inside = (float(turn) > before + margin) & (float(turn) < after - margin)
             ahead[i[inside]] = -d[inside]
         return model, kappa, slope, ahead
@@ -366,8 +370,8 @@ class WheelState:
         not for the rest would favour these."""
         if self._terms == 1 or not self._convex[0].size or before is None or not self.L_used:
             return False
-        margin = 3.0 * max(self.noise_scales) * math.hypot(self.sd_turn, self.sd_slope)
-        return abs(length - before[0]) < self.h <= abs(length - self.L_used[-1]) and abs(turn - before[1]) > margin
+        still = abs(length - before[0]) < self.h <= abs(length - self.L_used[-1])
+        return still and abs(turn - before[1]) > self._turn_margin
 
     def jumped(self, direction: int, margin: float = 1.0) -> BoolArray:
         """The wheel jumped (and was taken back) when rolling on from the present contact in
@@ -410,22 +414,37 @@ class WheelState:
         (both sizes, by their prior ``odds``, default :attr:`off_scale`), and the probability that the part is
         off its size; under the readings' likelihood raised to ``temper`` with the error model times
         ``factor``, from the sums Σ z·g and Σ g² (default: every reading used's). Without the scale: zeros."""
-        n = self.grid.size
         if self._terms == 1:
-            zero = np.zeros(n)
+            zero = np.zeros(self.grid.size)
             return zero, zero, zero, zero
+        mean, sd, evidence = self._scale_evidence(factor, zg, gg, temper)
+        log_factor, p_off = weigh_odds(evidence, self.off_scale if odds is None else odds)
+        return mean, sd, log_factor, p_off
+
+    def _by_odds(
+        self, factor: float, zg: FloatArray | None = None, gg: FloatArray | None = None
+    ) -> list[tuple[FloatArray, FloatArray, FloatArray, FloatArray]]:
+        """:meth:`_scale_posterior` under each of :attr:`off_scales`, the scale weighed out once for all."""
+        if self._terms == 1:
+            return [self._scale_posterior(factor, zg, gg)]
+        mean, sd, evidence = self._scale_evidence(factor, zg, gg, TEMPER)
+        return [(mean, sd, *weigh_odds(evidence, odds)) for odds in self.off_scales]
+
+    def _scale_evidence(
+        self, factor: float, zg: FloatArray | None, gg: FloatArray | None, temper: float
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:func:`~localizer.filters._wheel_scale.weigh_scale` of the sums (default every reading used's, kept
+        until the next reading used), as :meth:`_scale_posterior` takes them: before any prior odds."""
         key = (factor, temper)
         own = zg is None and gg is None
         if own and key in self._scale_cache:
-            mean, sd, evidence = self._scale_cache[key]
-        else:
-            zg = (self._zg if zg is None else zg) * (temper / factor**2)
-            gg = (self._gg if gg is None else gg) * (temper / factor**2)
-            mean, sd, evidence = weigh_scale(zg, gg, self.sd_part_scale, self._penalty_off)
-            if own:
-                self._scale_cache[key] = (mean, sd, evidence)
-        log_factor, p_off = weigh_odds(evidence, self.off_scale if odds is None else odds)
-        return mean, sd, log_factor, p_off
+            return self._scale_cache[key]
+        zg = (self._zg if zg is None else zg) * (temper / factor**2)
+        gg = (self._gg if gg is None else gg) * (temper / factor**2)
+        out = weigh_scale(zg, gg, self.sd_part_scale, self._penalty_off)
+        if own:
+            self._scale_cache[key] = out
+        return out
 
     def _posterior(self, factor: float, odds: float | None = None) -> FloatArray:
         return self._weights(factor, self._scale_posterior(factor, odds=odds)[2])
