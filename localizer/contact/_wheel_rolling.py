@@ -62,6 +62,10 @@ class ShiftedGrid:
         self.theta: FloatArray = unwrapped_angle(part, self.grid)
         self.kappa: FloatArray = np.asarray(part.curvature_at_arc(self.grid), dtype=float)
         self._exact = exact or isinstance(part, Outline)
+        # two laps and a node of Θ, κ and the lap, so that the grid shifted by whole steps is a slice of them
+        self._theta2 = np.concatenate([self.theta, self.theta, self.theta[:1]])
+        self._kappa2 = np.concatenate([self.kappa, self.kappa, self.kappa[:1]])
+        self._lap2 = np.repeat(np.arange(3), [n, n, 1])
 
     def at(self, length: float) -> tuple[FloatArray, FloatArray]:
         """Θ (rad, unwrapped: Θ(σ + P) = Θ(σ) + 2π) and κ (1/mm) at every start plus ``length`` mm."""
@@ -73,14 +77,14 @@ class ShiftedGrid:
         q = float(length) / self.h
         m = math.floor(q)
         f = q - m
-        i0 = np.arange(m, m + n)
-        j0, j1 = i0 % n, (i0 + 1) % n
-        t0 = self.theta[j0] + 2 * math.pi * (i0 // n)
-        t1 = self.theta[j1] + 2 * math.pi * ((i0 + 1) // n)
-        d0, d1 = self.kappa[j0] * self.h, self.kappa[j1] * self.h
+        laps, m0 = divmod(m, n)
+        t0 = self._theta2[m0 : m0 + n] + 2 * math.pi * (self._lap2[m0 : m0 + n] + laps)
+        t1 = self._theta2[m0 + 1 : m0 + n + 1] + 2 * math.pi * (self._lap2[m0 + 1 : m0 + n + 1] + laps)
+        k0, k1 = self._kappa2[m0 : m0 + n], self._kappa2[m0 + 1 : m0 + n + 1]
+        d0, d1 = k0 * self.h, k1 * self.h
         f2, f3 = f * f, f * f * f
         theta = (2 * f3 - 3 * f2 + 1) * t0 + (f3 - 2 * f2 + f) * d0 + (3 * f2 - 2 * f3) * t1 + (f3 - f2) * d1
-        kappa = (1 - f) * self.kappa[j0] + f * self.kappa[j1]
+        kappa = (1 - f) * k0 + f * k1
         return theta, kappa
 
 
