@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from driver.jaw import MAX_ROTATION
 from localizer import (
     CONFIDENCE,
+    OFF_SCALE,
 )
 
 __all__ = ["ReactiveOptions", "ParticleOptions"]
@@ -35,7 +36,7 @@ class ReactiveOptions:
     lookalike_slope: float | None = None  # None: localizer.LOOKALIKE_SLOPE; 0: no look-alike check
     corner_ends: bool | None = None  # None: the filter's default (True); false: the uniform prior over a corner
     stretch_weight: float | None = None  # None: localizer.STRETCH_WEIGHT; 1: the least of the checks
-    off_scale: float = 0.0  # the wheel: prior probability the part is off its model's size (localizer.OFF_SCALE)
+    off_scale: float = OFF_SCALE  # the wheel: prior probability the part is off its model's size; 0: its model's
 
 
 @dataclass(frozen=True)

@@ -57,7 +57,8 @@ Several methods on the same trials (instead of ``method``)::
     seek = true                          # optional: the information-seeking direction rule (default:
                                          #   driver.jaw.ReactivePolicy's)
     off_scale = 0.05                     # optional, the wheel: the prior probability that the part is
-                                         #   off its model's size (localizer.OFF_SCALE; default 0)
+                                         #   off its model's size (default localizer.OFF_SCALE; 0: the
+                                         #   part is its model's size)
 
     [world]                              # optional: how each trial's world differs from the model
     defects = 1                          #   (sim2d.world_part): defects near the start, or anywhere,

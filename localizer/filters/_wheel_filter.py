@@ -25,8 +25,8 @@ model's turn Θ(s + L(1 + u)) − Θ(s) ≈ Ω̂(s, L) + g·u, g the turn's slop
 (κ(s + L)·L where the curvature is even over it; a secant, so that a face's end at an arc's start within
 it is read as such); on a drawing a pivot on a convex corner (the turn inside its jump) places the
 contact on it, s + L(1 + u) = c. The prior is a spike and a slab: the part is its model's size (u = 0)
-but with probability ``off_scale`` (default 0: the scale is not carried; :data:`~localizer.OFF_SCALE` is
-the stated one), then u ~ N(0, ``sd_part_scale``²). Given a start both are weighed out in closed form
+but with probability ``off_scale`` (default :data:`~localizer.OFF_SCALE`; 0: the scale is not carried),
+then u ~ N(0, ``sd_part_scale``²). Given a start both are weighed out in closed form
 (the residuals are linear in u), and the start's present contact is s + L at the model's size,
 N(s + L(1 + û), (L·σ_u)²) off it (:class:`~localizer.Spread`). Only curvature and corners tell a scale: on a face,
 a near-circular stretch or a short roll the prior decides, and the stated probability, the least also
@@ -45,7 +45,9 @@ Where the wheel reaches (:class:`~localizer.WheelReach`) is the prior. A start f
 rolled so far, either way, runs over a point the wheel cannot touch (it would have jumped there,
 which the rolling procedure detects and undoes instead) is made :data:`~localizer.CONTRADICTION`
 times less likely at each reading used: soft, as the straight jaw's reach is, so that a model error in
-the reach does not rule out the truth.
+the reach does not rule out the truth. Off its model's size the roll is L(1 + u) of the model, clear of such
+points for u up to a bound per start: a part a little large explains a roll a little past a free run, with
+the probability its scale's posterior gives u below the bound (:func:`~localizer.filters._wheel_scale.weigh_scale`).
 
 Trust, as the straight jaw's filter (docs/filter.md, "Trust"): the readings' likelihood is raised to the
 power :data:`~localizer.TEMPER`, and a stated probability is the least over ``noise_scales`` (the
@@ -83,6 +85,7 @@ from .._defaults import FIT_ALPHA
 from ._belief import Belief, belief_flags, find_modes, flat_top, most_probable
 from ._contact_settings import TEMPER
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
+from ._wheel_scale import relative_weights
 from ._wheel_state import WHEEL_NOISE_SCALES, WHEEL_SD_SLOPE, WHEEL_SD_TURN, WHEEL_SLOPE_LENGTH, WheelState
 
 __all__ = [
@@ -120,8 +123,8 @@ class WheelFilter(WheelState):
         Prior standard deviation of the part's scale against its model, common to the roll, when the part
         is off its model's size (module notes).
     off_scale : float
-        Prior probability that the part is off its model's size (:data:`~localizer.OFF_SCALE` is the
-        stated one; default 0: the part is its model's size, as before the scale was carried).
+        Prior probability that the part is off its model's size (default :data:`~localizer.OFF_SCALE`; 0:
+        the part is its model's size, the scale not carried).
     off_scale_doubt : float
         With the scale carried, the stated mass is the least also under this prior probability that the part
         is off its size (:data:`~localizer.OFF_SCALE_DOUBT`; not below ``off_scale``).
@@ -234,7 +237,7 @@ class WheelFilter(WheelState):
                 base = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty
                 for mean, sd, scale_ll, p_off in self._by_odds(f, zg, gg):
                     ll = np.where(allowed, base + scale_ll, -np.inf)
-                    wts = np.exp(ll - ll.max())
+                    wts = relative_weights(ll, float(ll.max()))
                     spread = self._spread(mean, sd, p_off)
                     worst = min(worst, spread.mass(self.part, wts / wts.sum(), arc, radius))
             if worst < self.confidence:

@@ -10,6 +10,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from scipy.special import log_ndtr
 
 from .._types import FloatArray
 from ..geometry import Outline, Part
@@ -19,10 +20,10 @@ __all__ = ["Spread", "OFF_SCALE", "OFF_SCALE_DOUBT", "weigh_scale", "weigh_odds"
 
 #: The prior probability that a part is off its model's size by more than its machining (made to another
 #: revision's drawing, scaled on export): its scale is then N(1, ``sd_part_scale``²); else its model's
-#: (docs/robustness.md, "The wheel on a part off its model's size"). Not yet the filter's default
-#: (``off_scale`` 0: the part is its model's size): with it, a wheel enclosed in the bracket's notch and
-#: noise-free rolls on the kidney's concave stretches stop short of sure (tests/driver/test_wheel.py,
-#: tests/localizer/test_wheel_filter.py).
+#: (docs/robustness.md, "The wheel on a part off its model's size"). The filter's default: it costs rolling
+#: where only the size is left to tell (a wheel enclosed in the bracket's notch is not sure; noise-free rolls
+#: on the kidney's concave stretches are sure some 15 mm later); ``off_scale`` 0 takes the part for its
+#: model's size.
 OFF_SCALE = 0.05
 #: The stated probability holds also if the part were off its size with this prior probability (the least
 #: under the two is stated, as under the noise scales): where the readings cannot tell the part's size (a
@@ -75,18 +76,49 @@ class Spread(NamedTuple):
 
 
 def weigh_scale(
-    zg: FloatArray, gg: FloatArray, sd_part_scale: float, penalty_off: FloatArray
+    zg: FloatArray, gg: FloatArray, sd_part_scale: float, u_max: FloatArray, penalty_run: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Per start, from the sums Σ z·g and Σ g² of its whitened residuals z and their slopes g in the scale u
     (already tempered and scaled by the noise factor): u's posterior mean and standard deviation given that the
     part is off its model's size (prior N(0, ``sd_part_scale``²)), and the log of the readings' factor off the
-    model's size against at it, before the prior's odds (with ``penalty_off``, what off its size takes back of
-    the contradictions)."""
+    model's size against at it, before the prior's odds.
+
+    The arc rolled either way is a reading of u too: a part off its size by u puts the roll on L(1 + u) of the
+    model, which runs over no point the wheel cannot pass for u ≤ ``u_max`` (per start). With probability
+    Φ((u_max − û)/σ_u) under u's posterior the start's roll is clear, and the model's size's contradictions
+    (``penalty_run``, a log ≤ 0, what the model's size counts for the roll running over such points) are
+    taken back; else they stand. A part a little large explains a roll a little past a free run, a part far
+    off its size (in the prior's tail) hardly more than the model's size does."""
     prec = 1.0 / sd_part_scale**2 + gg
     mean: FloatArray = zg / prec
     sd: FloatArray = 1.0 / np.sqrt(prec)
-    evidence: FloatArray = 0.5 * zg * mean - 0.5 * np.log1p(gg * sd_part_scale**2) + penalty_off
+    evidence: FloatArray = 0.5 * zg * mean - 0.5 * np.log1p(gg * sd_part_scale**2)
+    k = np.flatnonzero(penalty_run < 0)  # elsewhere the roll is clear at the model's size: nothing to take back
+    if k.size:
+        clear = log_ndtr((u_max[k] - mean[k]) / sd[k])
+        evidence[k] += log_add_exp(clear - penalty_run[k], log_ndtr((mean[k] - u_max[k]) / sd[k]))
     return mean, sd, evidence
+
+
+#: Below this log-weight against the best, a start's weight is taken as 0: e^−700 ≈ 1e-304, nothing a sum or
+#: a stated mass could show, where numpy's exp takes its slow path for subnormal results (ten times the
+#: cost on a belief of the kidney's 11724 starts).
+LOG_NEGLIGIBLE = -700.0
+
+
+def relative_weights(log_w: FloatArray, top: float | FloatArray) -> FloatArray:
+    """e^(log_w − top) elementwise (``top`` at least ``log_w``), 0 below :data:`LOG_NEGLIGIBLE`."""
+    x = np.subtract(log_w, top)
+    out: FloatArray = np.zeros(x.shape)
+    np.exp(x, out=out, where=x > LOG_NEGLIGIBLE)
+    return out
+
+
+def log_add_exp(a: FloatArray | float, b: FloatArray) -> FloatArray:
+    """log(eᵃ + eᵇ) elementwise, one of ``a`` and ``b`` finite: :func:`numpy.logaddexp` at a third of its cost
+    on this machine."""
+    out: FloatArray = np.maximum(a, b) + np.log1p(relative_weights(-np.abs(np.subtract(a, b)), 0.0))
+    return out
 
 
 def weigh_odds(evidence: FloatArray, odds: float) -> tuple[FloatArray, FloatArray]:
@@ -94,6 +126,6 @@ def weigh_odds(evidence: FloatArray, odds: float) -> tuple[FloatArray, FloatArra
     the scale weighed out puts on the start's likelihood (both sizes), and the probability that the part is
     off its size given the start."""
     off = math.log(odds) + evidence
-    log_factor: FloatArray = np.logaddexp(math.log1p(-odds), off)
-    p_off: FloatArray = np.exp(off - log_factor)
+    log_factor = log_add_exp(math.log1p(-odds), off)
+    p_off = relative_weights(off, log_factor)
     return log_factor, p_off

@@ -16,7 +16,7 @@ from .._types import BoolArray, FloatArray
 from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, pivot_turn, unwrapped_angle, wheel_reach_for
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid, nearest_corner
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
-from ._wheel_scale import OFF_SCALE_DOUBT, Spread, weigh_odds, weigh_scale
+from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, Spread, relative_weights, weigh_odds, weigh_scale
 
 __all__ = [
     "WheelState",
@@ -53,7 +53,7 @@ class WheelState:
         sd_length: float = 0.005,
         sd_scale: float = 2e-4,
         sd_part_scale: float = PART_SCALE_SD,
-        off_scale: float = 0.0,
+        off_scale: float = OFF_SCALE,
         off_scale_doubt: float = OFF_SCALE_DOUBT,
         thin: float = 1.0,
         radius: float = SUCCESS_RADIUS,
@@ -148,15 +148,19 @@ class WheelState:
         self._gg = np.zeros(n)
         self._logdet = np.zeros(self.grid.size)
         self._penalty = np.zeros(self.grid.size)
-        # what a part off its size takes back of the contradictions of a roll over what the wheel cannot pass
-        # (in _penalty, at the model's size): it may have rolled less of the model than was read
-        self._penalty_off = np.zeros(self.grid.size)
+        # the contradictions of a roll over what the wheel cannot pass (in _penalty, at the model's size): a part
+        # off its size may have rolled less of the model than was read (weigh_scale)
+        self._penalty_run = np.zeros(self.grid.size)
+        self._u_bound = np.full(self.grid.size, math.inf)  # _u_max as at the last reading used, as _penalty_run
         self.current = 0.0
         self.span = (0.0, 0.0)
         self._last: tuple[float, float] | None = None  # the last reading, used or not
         # the scale weighed out on every reading used, per (noise factor, temper): u's mean and sd, and the log
         # of the readings' factor off the model's size against at it, given each start (_scale_posterior)
         self._scale_cache: dict[tuple[float, float], tuple[FloatArray, FloatArray, FloatArray]] = {}
+        # each noise factor's tempered log-likelihood at the model's size with the reach's evidence, −inf where
+        # the wheel cannot touch (_base), kept until a reading is used or a jump counted
+        self._base_cache: dict[float, FloatArray] = {}
         self.steps = 0
         self._misfit: tuple[tuple[float, float], float] | None = None  # (stretch on the model, p-value)
         self._fit_at = 0  # readings used at the last fit test
@@ -310,6 +314,7 @@ class WheelState:
         if abs(L - last) < self.thin and not self._pivot(L, om, before):
             return
         self._scale_cache.clear()
+        self._base_cache.clear()
         used = np.array(self.L_used)
         c_new = self._cov(used, np.array([L]))[:, 0] if used.size else np.zeros(0)
         c_nn = float(self._cov(np.array([L]), np.array([L]))[0, 0])
@@ -337,11 +342,11 @@ class WheelState:
         self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
         self._lvbuf[k] = np.log(var)
         self._logdet += self._lvbuf[k]
-        clear = self._clear()
-        self._penalty += np.where(clear, 0.0, math.log(CONTRADICTION))
+        contradicted = np.where(self._clear(), 0.0, math.log(CONTRADICTION))
+        self._penalty += contradicted
+        self._penalty_run += contradicted
         if self._terms > 1:
-            relaxed = self._clear(1.0 - 3.0 * self.sd_part_scale)
-            self._penalty_off += np.where(relaxed & ~clear, -math.log(CONTRADICTION), 0.0)
+            self._u_bound = self._u_max()
         self._zbuf[:n, k] = z * np.sqrt(var / d2)  # whitened by the shared part alone
         self._cholbuf[k, :k] = ell
         self._cholbuf[k, k] = math.sqrt(d2)
@@ -382,6 +387,7 @@ class WheelState:
             raise QueryError(f"direction={direction!r}: give +1 (counter-clockwise) or -1")
         explained = self.explains_jump(direction, margin)
         self._penalty += np.where(explained, 0.0, math.log(BRIDGE_MISS))
+        self._base_cache.clear()
         return explained
 
     def explains_jump(self, direction: int, margin: float = 1.0) -> BoolArray:
@@ -392,14 +398,27 @@ class WheelState:
         return out
 
     # --------------------------------------------------------------- belief
-    def _clear(self, stretch: float = 1.0) -> BoolArray:
-        """Starts from which the arc rolled so far, both ways, runs over touchable points only; the model's arc
-        taken as ``stretch`` times the arc read (off its size, the scale prior's three standard deviations
-        less: a wheel rolled up to a place it cannot pass on a part 2% large reads 2% past it)."""
+    def _clear(self) -> BoolArray:
+        """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
         lo, hi = self.span
         tol = 2 * self.h
-        ok: BoolArray = (self._ahead + tol >= hi * stretch) & (self._behind + tol >= -lo * stretch)
+        ok: BoolArray = (self._ahead + tol >= hi) & (self._behind + tol >= -lo)
         return ok
+
+    def _u_max(self) -> FloatArray:
+        """Per start, the largest scale u for which the roll so far, L(1 + u) of the model either way, runs over
+        touchable points only (:meth:`_clear` at u = 0; a wheel rolled up to a place it cannot pass on a part
+        2% large reads 2% past it). +inf where nothing was rolled that way; below −1 where nothing is clear."""
+        lo, hi = self.span
+        tol = 2 * self.h
+        out = np.full(self.grid.size, math.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if hi > 0:
+                out = np.minimum(out, (self._ahead + tol) / hi - 1.0)
+            if lo < 0:
+                out = np.minimum(out, (self._behind + tol) / -lo - 1.0)
+        result: FloatArray = out
+        return result
 
     def _scale_posterior(
         self,
@@ -441,7 +460,7 @@ class WheelState:
             return self._scale_cache[key]
         zg = (self._zg if zg is None else zg) * (temper / factor**2)
         gg = (self._gg if gg is None else gg) * (temper / factor**2)
-        out = weigh_scale(zg, gg, self.sd_part_scale, self._penalty_off)
+        out = weigh_scale(zg, gg, self.sd_part_scale, self._u_bound, self._penalty_run)
         if own:
             self._scale_cache[key] = out
         return out
@@ -451,17 +470,43 @@ class WheelState:
 
     def _weighed(self, factor: float, odds: float | None = None) -> tuple[FloatArray, Spread]:
         """The posterior over the starts and each start's present contact (:meth:`_posterior`,
-        :meth:`present_spread`), the scale weighed out once for both."""
-        mean, sd, log_factor, p_off = self._scale_posterior(factor, odds=odds)
-        return self._weights(factor, log_factor), self._spread(mean, sd, p_off)
+        :meth:`present_spread`), the scale weighed out once for both: each start's weight at its model's size
+        and off it, whose sum is the posterior and whose share off it the probability it is off its size."""
+        if self._terms == 1:
+            zero = np.zeros(self.grid.size)
+            return self._weights(factor, zero), self._spread(zero, zero, zero)
+        odds = self.off_scale if odds is None else odds
+        mean, sd, evidence = self._scale_evidence(factor, None, None, TEMPER)
+        base = self._base(factor)
+        at_size = base + math.log1p(-odds)
+        off = base + evidence
+        off += math.log(odds)
+        top = max(float(at_size.max()), float(off.max()))
+        if not math.isfinite(top):
+            raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
+        w = relative_weights(at_size, top)
+        w_off = relative_weights(off, top)
+        w += w_off
+        p_off = np.divide(w_off, w, out=np.full(w.size, odds), where=w > 0)
+        w /= w.sum()
+        return w, self._spread(mean, sd, p_off)
+
+    def _base(self, factor: float) -> FloatArray:
+        """Each start's tempered log-likelihood at the model's size under the error model times ``factor``, with
+        the reach's evidence; −inf where the wheel cannot touch (kept until a reading is used or a jump
+        counted)."""
+        out = self._base_cache.get(factor)
+        if out is None:
+            ll = TEMPER * (-0.5 * self._quad / factor**2 - 0.5 * self._logdet) + self._penalty
+            out = self._base_cache[factor] = np.where(self.prior > 0, ll, -np.inf)
+        return out
 
     def _weights(self, factor: float, log_factor: FloatArray) -> FloatArray:
-        ll = TEMPER * (-0.5 * self._quad / factor**2 - 0.5 * self._logdet) + self._penalty + log_factor
-        ll = np.where(self.prior > 0, ll, -np.inf)
+        ll = self._base(factor) + log_factor
         top = ll.max()
         if not np.isfinite(top):
             raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
-        w = np.exp(ll - top)
+        w = relative_weights(ll, float(top))
         out: FloatArray = w / w.sum()
         return out
 

@@ -64,13 +64,15 @@ def test_the_readings_kept_are_bounded_and_a_reading_past_the_bound_is_refused_b
 
 @pytest.mark.parametrize("radius", [3.0, 10.0])
 def test_noise_free_rolls_from_concave_starts_end_sure_at_the_truth(radius):
+    """Within 80 mm of rolling, the part's size weighed (the default: at the model's size alone 60 mm does, the
+    last 15 mm being what a part that may be 1% off its size asks more of the kidney's near-circular arcs)."""
     part = load_part(KIDNEY)
     sigma = np.linspace(0, part.perimeter, 600, endpoint=False)
     starts = sigma[part.curvature_at_arc(sigma) < 0][::8]
     assert starts.size >= 5
     for s in starts:
         f = WheelFilter(part, WheelJaw(radius))
-        for L in np.arange(0.25, 60.0, 0.25):
+        for L in np.arange(0.25, 80.0, 0.25):
             f.update(L, float(theta(part, s + L) - theta(part, s)))
             b = f.belief() if f.steps % 4 == 0 else None
             if b is not None and b.mass >= 0.95:
@@ -94,28 +96,48 @@ def test_a_start_whose_roll_runs_over_what_the_wheel_cannot_touch_is_unlikely_no
     assert np.all(f._penalty[clear] == 0)
 
 
-def test_off_its_size_a_roll_read_up_to_three_scale_sds_past_a_place_it_cannot_pass_is_not_a_contradiction():
+def test_off_its_size_a_roll_read_past_a_place_it_cannot_pass_bounds_the_scale():
     """A part 2% large reads 2% more arc than its model rolls: a wheel rolled up to the peanut's waist on it
     reads past the waist. A start whose free run is 30 mm is clear at the model's size after 29.9 mm read and
-    not after 30.2; off its size (the 1% prior's three standard deviations) after 30.8 and not after 31. The
-    contradiction the model's size counts there is taken back for the part off its size alone."""
-    from localizer import PART_SCALE_SD
-
+    not after 30.2; off its size the roll is clear for u up to (30 + 2h)/read − 1, and the model's size's
+    contradictions there are counted for it only beyond."""
     outline, _ = peanut()
     dense = np.asarray(outline.point_at_arc(np.linspace(0, outline.perimeter, 400, endpoint=False)))
     part = part_from_points(dense, name="peanut")
     f = WheelFilter(part, WheelJaw(12.0), off_scale=OFF_SCALE)
     j = int(np.argmin(np.where(f._ahead > 0, np.abs(f._ahead - 30.0), np.inf)))
     run = float(f._ahead[j])
-    for stretch, clear_at, blocked_at in ((1.0, 29.9, 30.2), (1.0 - 3 * PART_SCALE_SD, 30.8, 31.0)):
-        f.span = (0.0, clear_at * run / 30.0)
-        assert f._clear(stretch)[j]
-        f.span = (0.0, blocked_at * run / 30.0)
-        assert not f._clear(stretch)[j]
+    for read, clear in ((29.9, True), (30.2, False)):
+        f.span = (0.0, read * run / 30.0)
+        assert f._clear()[j] == clear
+    f.span = (-5.0, 30.6 * run / 30.0)
+    assert math.isclose(f._u_max()[j], (run + 2 * f.h) / f.span[1] - 1.0, rel_tol=1e-12)
     f.reset()
     for L in [*np.arange(1.0, run - 0.5, 1.0), run + 0.6]:  # the last read 0.6 mm past the free run, used
         f.update(float(L), 0.0)
-    assert f._penalty[j] < 0 and f._penalty_off[j] == -f._penalty[j]
+    assert f._penalty[j] < 0 and f._penalty_run[j] == f._penalty[j]
+
+
+@pytest.mark.parametrize(("zg", "gg"), [(0.0, 0.0), (150.0, 4e4), (-300.0, 1e5)])
+@pytest.mark.parametrize("u_max", [-0.03, -0.01, 0.0, 0.02, math.inf])
+def test_the_scale_weighed_out_with_a_bound_from_the_free_run_agrees_with_sampling_its_prior(zg, gg, u_max):
+    """weigh_scale against brute force: u drawn from its prior N(0, σ²), each draw's factor on the likelihood
+    exp(zg·u − gg·u²/2) times 1 if the roll is clear (u ≤ u_max) else the model's size's contradictions
+    (e^P). The log of its mean over the draws, less P, is the evidence off the model's size against at it."""
+    from localizer import PART_SCALE_SD
+    from localizer.filters._wheel_scale import weigh_scale
+
+    rng = np.random.default_rng(5)
+    u = rng.normal(0.0, PART_SCALE_SD, 2_000_000)
+    penalty = math.log(1e-3) * 2
+    factor = np.exp(zg * u - 0.5 * gg * u**2) * np.where(u <= u_max, 1.0, math.exp(penalty))
+    expected = math.log(float(factor.mean())) - penalty
+    mean, sd, evidence = weigh_scale(
+        np.array([zg]), np.array([gg]), PART_SCALE_SD, np.array([u_max]), np.array([penalty])
+    )
+    assert evidence[0] == pytest.approx(expected, abs=0.01)
+    tilted = np.exp(zg * u - 0.5 * gg * u**2)
+    assert mean[0] == pytest.approx(float(np.sum(tilted * u) / tilted.sum()), abs=2e-4)
 
 
 def test_free_runs_count_the_arc_to_the_next_untouchable_point_both_ways():
@@ -211,19 +233,24 @@ def pivoting_readings(vertices, start, length, direction, step=0.25, pivot_step=
     return out
 
 
-@pytest.mark.parametrize(("corner", "direction"), [(1, 1), (2, 1), (1, -1), (0, -1)])
-def test_a_wheel_pivoting_on_a_drawings_convex_corners_is_found_from_the_vertices_alone(corner, direction):
-    """Rolls of 45 mm over one or two corners each way, one through the seam (corner 0 rolling clockwise); the
-    truth off the filter's grid. Every reading 0.2 mm from the last is used, so that the one that arrives at
-    a corner, part way through its pivot, is: without the corner rule it is 0.6 rad off at the truth.
-    The readings are the geometry's own, so the belief lies where they put it, within the corner window."""
+@pytest.mark.parametrize("off_scale", [0.0, OFF_SCALE])
+@pytest.mark.parametrize(("corner", "direction", "corners"), [(1, 1, 2), (2, 1, 1), (1, -1, 1), (0, -1, 2)])
+def test_a_wheel_pivoting_on_a_drawings_convex_corners_is_found_from_the_vertices_alone(
+    corner, direction, corners, off_scale
+):
+    """Rolls of 45.22 mm over one or two corners each way, one through the seam (corner 0 rolling clockwise);
+    the truth off the filter's grid. Every reading 0.2 mm from the last is used, so that the one that arrives
+    at a corner, part way through its pivot, is: without the corner rule it is 0.6 rad off at the truth.
+    The readings are the geometry's own, so the belief lies where they put it, within the corner window. At
+    the model's size it is sure; with the part's scale carried (the default) only where a second corner told
+    the size: after one, the face's 30 mm since it could be 1% longer or shorter (0.3 mm, the success radius)."""
     from localizer import Line, outline_from_pieces
 
     pieces = [Line(PENTAGON[i], PENTAGON[(i + 1) % 5]) for i in range(5)]
     outline = outline_from_pieces(pieces, name="pentagon")
     c = outline.corners[corner].arc
     start = float(outline.wrap_arc(c - direction * 15.22))  # the corner 0.22 mm past a reading at 15 mm
-    f = WheelFilter(outline, WheelJaw(5.0), thin=0.2)
+    f = WheelFilter(outline, WheelJaw(5.0), thin=0.2, off_scale=off_scale)
     readings = pivoting_readings(PENTAGON, start, 45.0, direction)
     for L, om in readings:
         f.update(L, om)
@@ -233,7 +260,8 @@ def test_a_wheel_pivoting_on_a_drawings_convex_corners_is_found_from_the_vertice
     truth = float(outline.wrap_arc(start + readings[-1][0]))
     # on a face only the corner places the contact: within the window a reading may be pivoting in
     assert abs(float(outline.arc_offset(b.map_arc, truth))) < f.corner_window(45.0)
-    assert b.consistent and b.mismatch is None and b.mass >= 0.95
+    assert b.consistent and b.mismatch is None
+    assert (b.mass >= 0.95) == (off_scale == 0.0 or corners == 2)
 
 
 def test_a_jump_next_to_a_shallow_concave_corner_does_not_count_against_the_start_it_came_from():
@@ -419,7 +447,10 @@ def test_without_the_scale_the_doubt_changes_nothing():
     same whatever they are."""
     model = _pentagon()
     start = float(model.wrap_arc(model.corners[1].arc - 15.22))
-    fs = [WheelFilter(model, WheelJaw(5.0), thin=0.2, off_scale_doubt=d) for d in (0.0, OFF_SCALE_DOUBT, 0.9)]
+    fs = [
+        WheelFilter(model, WheelJaw(5.0), thin=0.2, off_scale=0.0, off_scale_doubt=d)
+        for d in (0.0, OFF_SCALE_DOUBT, 0.9)
+    ]
     for L, om in pivoting_readings(PENTAGON, start, 40.0, 1):
         for g in fs:
             g.update(L, om)
@@ -436,3 +467,31 @@ def test_a_reading_that_fits_is_consistent_whatever_the_prior_odds_of_the_part_b
     f = WheelFilter(part, WheelJaw(5.0), off_scale=off)
     f.update(1.0, float(theta(part, 31.0) - theta(part, 30.0)))
     assert f.consistent() and f.consistent(1.0)
+
+
+@pytest.mark.parametrize("odds", [OFF_SCALE, OFF_SCALE_DOUBT])
+@pytest.mark.parametrize("factor", [1.0, 2.0])
+def test_the_posterior_weighed_over_both_sizes_at_once_is_the_odds_mixture_of_each_starts_two_likelihoods(
+    odds, factor
+):
+    """A belief weighs each start at its model's size and off it in one pass; against the mixture written out in
+    logs (each start's log-likelihood at its size plus log[(1 − p) + p·e^evidence], normalised over the starts
+    by :func:`numpy.logaddexp`), after a roll over a corner of the pentagon 2% large: the same posterior and
+    probability of being off its size, where a start weighs anything (1e-300 of the best)."""
+    from scipy.special import logsumexp
+
+    model = _pentagon()
+    start = float(model.wrap_arc(model.corners[1].arc - 15.22))
+    f = WheelFilter(model, WheelJaw(5.0), thin=0.2)
+    for L, om in pivoting_readings([(1.02 * x, 1.02 * y) for x, y in PENTAGON], start * 1.02, 40.0, 1):
+        f.update(L, om)
+    w, spread = f._weighed(factor, odds)
+    mean, sd, evidence = f._scale_evidence(factor, None, None, 0.5)
+    at_size = 0.5 * (-0.5 * f._quad / factor**2 - 0.5 * f._logdet) + f._penalty
+    ll = np.where(f.prior > 0, at_size + np.logaddexp(math.log1p(-odds), math.log(odds) + evidence), -np.inf)
+    expected = np.exp(ll - logsumexp(ll))
+    p_off = np.exp(math.log(odds) + evidence - np.logaddexp(math.log1p(-odds), math.log(odds) + evidence))
+    heavy = expected > 1e-300
+    np.testing.assert_allclose(w[heavy], expected[heavy], rtol=1e-9)
+    np.testing.assert_allclose(spread.p_off[heavy], p_off[heavy], rtol=1e-9, atol=1e-300)
+    assert w[~heavy].sum() < 1e-290
