@@ -148,7 +148,8 @@ def _filtered_roll(flt: WheelFilter, lengths: FloatArray, turns: FloatArray) -> 
 
 def test_wheel_filter_roll(benchmark: BenchmarkFixture) -> None:
     """A 5 mm wheel's filter over a 20 mm roll from inside the kidney's waist: 80 readings 0.25 mm apart
-    (one a millimetre used by the likelihood), a belief every 4, as :func:`driver.wheel.localize_with_wheel`."""
+    (one a millimetre used by the likelihood), a belief every 4, as :func:`driver.wheel.localize_with_wheel`;
+    the filter's defaults (the part's scale carried)."""
     part, flt, lengths, turns = _kidney_wheel_roll(0.25)
     b: Belief = benchmark.pedantic(_filtered_roll, args=(flt, lengths, turns), rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(float(part.arc_offset(b.map_arc, WHEEL_START + lengths[-1]))) < 0.3
@@ -162,13 +163,11 @@ def test_wheel_filter_roll(benchmark: BenchmarkFixture) -> None:
     per_second(benchmark, "readings_per_second", lengths.size)
 
 
-def test_wheel_filter_roll_off_size(benchmark: BenchmarkFixture) -> None:
-    """:func:`test_wheel_filter_roll` with the part's scale carried (``off_scale`` = localizer.OFF_SCALE): each
-    used reading whitens the residuals' derivatives in the scale too, and a belief weighs the two sizes."""
-    from localizer import OFF_SCALE
-
+def test_wheel_filter_roll_at_the_models_size(benchmark: BenchmarkFixture) -> None:
+    """:func:`test_wheel_filter_roll` with the part taken at its model's size (``off_scale`` 0; the default carries
+    its scale, localizer.OFF_SCALE): each used reading whitens the residuals alone, a belief weighs one size."""
     part, _, lengths, turns = _kidney_wheel_roll(0.25)
-    flt = WheelFilter(part, WheelJaw(5.0), off_scale=OFF_SCALE)
+    flt = WheelFilter(part, WheelJaw(5.0), off_scale=0.0)
     b: Belief = benchmark.pedantic(_filtered_roll, args=(flt, lengths, turns), rounds=5, iterations=1)  # type: ignore[no-untyped-call,unused-ignore]
     assert abs(float(part.arc_offset(b.map_arc, WHEEL_START + lengths[-1]))) < 0.3
     benchmark.extra_info.update({"starts": int(flt.grid.size), "readings": int(lengths.size)})

@@ -471,9 +471,7 @@ def test_a_reading_that_fits_is_consistent_whatever_the_prior_odds_of_the_part_b
 
 @pytest.mark.parametrize("odds", [OFF_SCALE, OFF_SCALE_DOUBT])
 @pytest.mark.parametrize("factor", [1.0, 2.0])
-def test_the_posterior_weighed_over_both_sizes_at_once_is_the_odds_mixture_of_each_starts_two_likelihoods(
-    odds, factor
-):
+def test_the_posterior_weighed_over_both_sizes_at_once_is_the_odds_mixture_of_each_starts_two_likelihoods(odds, factor):
     """A belief weighs each start at its model's size and off it in one pass; against the mixture written out in
     logs (each start's log-likelihood at its size plus log[(1 − p) + p·e^evidence], normalised over the starts
     by :func:`numpy.logaddexp`), after a roll over a corner of the pentagon 2% large: the same posterior and
