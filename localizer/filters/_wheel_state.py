@@ -411,14 +411,12 @@ class WheelState:
         2% large reads 2% past it). +inf where nothing was rolled that way; below −1 where nothing is clear."""
         lo, hi = self.span
         tol = 2 * self.h
-        out = np.full(self.grid.size, math.inf)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            if hi > 0:
-                out = np.minimum(out, (self._ahead + tol) / hi - 1.0)
-            if lo < 0:
-                out = np.minimum(out, (self._behind + tol) / -lo - 1.0)
-        result: FloatArray = out
-        return result
+        out: FloatArray = np.full(self.grid.size, math.inf)
+        if hi > 0:
+            out = np.minimum(out, (self._ahead + tol) / hi - 1.0)
+        if lo < 0:
+            out = np.minimum(out, (self._behind + tol) / -lo - 1.0)
+        return out
 
     def _scale_posterior(
         self,
