@@ -13,6 +13,7 @@ from typing import Any
 from localizer import (
     CONFIDENCE,
     DEFAULT_JAW,
+    OFF_SCALE,
     ROLL_STEP,
     SUCCESS_RADIUS,
     Finger,
@@ -25,6 +26,7 @@ from localizer import (
 )
 
 from ..jaw import MAX_ROTATION, PRESS, STEP_RANGE_DEG, PressSettings, ServoSettings
+from ..rig import RigError
 
 __all__ = [
     "finite",
@@ -44,6 +46,8 @@ __all__ = [
     "read_part",
     "positive",
     "probability",
+    "off_scale_argument",
+    "off_scale",
     "rig_arguments",
     "servo_arguments",
     "reactive_arguments",
@@ -101,6 +105,11 @@ def _number(text: str, ok: Callable[[float], bool], what: str) -> float:
 def probability(text: str) -> float:
     """A probability strictly between 0 and 1 (argparse type)."""
     return _number(text, lambda v: 0 < v < 1, "between 0 and 1")
+
+
+def odds(text: str) -> float:
+    """A probability from 0 up to, not including, 1 (argparse type)."""
+    return _number(text, lambda v: 0 <= v < 1, "from 0 up to, not including, 1")
 
 
 def finite(text: str) -> float:
@@ -228,6 +237,39 @@ def reactive_arguments(p: argparse.ArgumentParser) -> None:
         metavar="DEG",
         help=f"reactive: rotation budget, both directions counted (default {MAX_ROTATION_DEG:g}°)",
     )
+    off_scale_argument(p)
+
+
+def off_scale_argument(p: argparse.ArgumentParser, replay: bool = False) -> None:
+    """--off-scale: the wheel's prior probability that the part is off its model's size (its filter's
+    ``off_scale``). A replay's default is the one its record was made with."""
+    default = "the record's, else " if replay else ""
+    p.add_argument(
+        "--off-scale",
+        type=odds,
+        metavar="P",
+        help="wheel: the prior probability that the part is off its model's size (made to another revision, "
+        f"scaled on export), its scale then within about 1%%; sure only where the readings tell the size "
+        f"(default {default}{OFF_SCALE}; 0: the part is its model's size, sure sooner on faces and near-circular "
+        "stretches)",
+    )
+
+
+def off_scale(args: argparse.Namespace, finger: Finger, recorded: object = None) -> float:
+    """The wheel's ``off_scale`` from --off-scale, else ``recorded`` (a replayed record's), else the default;
+    refused for a straight jaw, which carries no scale."""
+    given = getattr(args, "off_scale", None)
+    if isinstance(finger, StraightJaw):
+        if given is not None:
+            raise UsageError(f"--off-scale {given:g} is the wheel's: the finger is {finger}, which carries no scale")
+        return 0.0
+    if given is not None:
+        return float(given)
+    if recorded is None:
+        return OFF_SCALE
+    if isinstance(recorded, bool) or not isinstance(recorded, (int, float)) or not 0 <= recorded < 1:
+        raise RigError(f"the record's off_scale {recorded!r} is not a probability in [0, 1): give --off-scale")
+    return float(recorded)
 
 
 def pressing(args: argparse.Namespace) -> PressSettings:

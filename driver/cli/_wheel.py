@@ -10,12 +10,12 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from localizer import Outline, Part, QueryError, WheelJaw, wheel_reach_for
+from localizer import Outline, Part, QueryError, WheelFilter, WheelJaw, wheel_reach_for
 
 from ..records import check_finger, check_same_part, part_record
 from ..rig import Rig, RigError
 from ..wheel import wheel_calibration_arc
-from ._options import UsageError, pressing
+from ._options import UsageError, off_scale, pressing
 from ._output import (
     CONNECTING,
     RELEASED,
@@ -118,6 +118,7 @@ def simulate_wheel(args: argparse.Namespace, part: Part | Outline, wheel: WheelJ
 
     change = world_change(args, part)
     rig = WheelRig(part, wheel, noise=noise, seed=args.seed, engine=args.engine, change=change)
+    odds = off_scale(args, wheel)
     run = localize_with_wheel(
         rig,
         part,
@@ -126,6 +127,7 @@ def simulate_wheel(args: argparse.Namespace, part: Part | Outline, wheel: WheelJ
         calibration=calibration,
         policy=wheel_policy(args),
         pressing=pressing(args),
+        filter=WheelFilter(part, wheel, off_scale=odds),
     )
     doc = wheel_doc(part, run, rig, calibration)
     doc.update(world_fields(change, rig))
@@ -137,6 +139,7 @@ def simulate_wheel(args: argparse.Namespace, part: Part | Outline, wheel: WheelJ
         noise=str(args.noise),
         seed=args.seed,
         start_arc=args.start,
+        off_scale=odds,
         result=doc,
     )
     trace.save(args.out)
@@ -208,6 +211,7 @@ def run_wheel(
             policy=wheel_policy(args),
             pressing=pressing(args),
             observer=progress,
+            filter=WheelFilter(part, wheel, off_scale=off_scale(args, wheel)),
         )
     args.interrupted = RELEASED
     doc = wheel_doc(part, run, rig, calibration)
@@ -227,7 +231,7 @@ def locate_wheel(args: argparse.Namespace, record: RunRecord) -> int:
     check_finger(path, trace.metadata["jaw"], args.jaw)
     part = load_part(args.part)
     check_same_part(trace.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
-    b = trace.relocalize(part)
+    b = trace.relocalize(part, off_scale=off_scale(args, trace.wheel, trace.metadata.get("off_scale")))
     true = trace.true_arc
     doc = {
         "part": part.name,

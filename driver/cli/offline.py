@@ -42,6 +42,8 @@ from ._options import (
     add_command,
     check_before_moving,
     jaw_argument,
+    off_scale,
+    off_scale_argument,
     part_arguments,
     positive,
     read_part,
@@ -132,6 +134,7 @@ def register(sub: Any) -> None:
         help="score the trace on --part although it was made on another part file (one known to be the same)",
     )
     jaw_argument(lct, default=None)
+    off_scale_argument(lct, replay=True)
     lct.add_argument("--rule", choices=RULES, default="likelihood", help="disambiguation rule (default likelihood)")
     lct.add_argument("--json", action="store_true", help="print the result as JSON")
     lct.add_argument("--plot", metavar="FILE.png", help="draw the part, the jaw poses, the true and estimated contacts")
@@ -208,6 +211,7 @@ def locate_command(args: argparse.Namespace) -> int:
     record = open_record(args.trace)
     if record.kind == "wheel":
         return locate_wheel(args, record)
+    off_scale(args, DEFAULT_JAW)  # refused: a straight jaw's record
     if record.kind == "reactive":
         meta, columns, readings = reactive_calls(record)
         truth = readings["true_arcs"] if readings is not None else np.array([], dtype=float)

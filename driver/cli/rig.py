@@ -20,6 +20,7 @@ from ._options import (
     add_command,
     check_before_moving,
     jaw_argument,
+    off_scale,
     part_arguments,
     pressing,
     reactive_arguments,
@@ -158,6 +159,7 @@ def run_command(args: argparse.Namespace) -> int:
     if isinstance(args.jaw, WheelJaw):
         log = RunLog(args.log, _wheel_header(args, part, cast("WheelCalibration | None", loaded))) if args.log else None
         return run_wheel(args, part, args.jaw, loaded, log, lambda event: None)
+    off_scale(args, args.jaw)  # refused for a straight jaw
     calibration = loaded if isinstance(loaded, Calibration) else None
     header = {
         "jaw": str(args.jaw),
@@ -220,6 +222,7 @@ def _wheel_header(
         "part": part_record(part, args.part),
         "arm": args.arm,
         "daq": args.daq,
+        "off_scale": off_scale(args, args.jaw),
     }
     if calibration is not None:
         header["calibration"] = calibration.as_dict()

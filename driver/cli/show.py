@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..rig import RigError
-from ._options import UsageError, add_command, jaw_argument, writable_file
+from ._options import UsageError, add_command, jaw_argument, off_scale, off_scale_argument, writable_file
 
 __all__ = ["register", "show_command"]
 
@@ -39,6 +39,7 @@ def register(sub: Any) -> None:
     )
     p.add_argument("--fps", type=int, default=10, metavar="N", help="frames per second of an animation (default 10)")
     jaw_argument(p, default=None)
+    off_scale_argument(p, replay=True)
     p.add_argument(
         "--same-part",
         action="store_true",
@@ -76,9 +77,11 @@ def show_command(args: argparse.Namespace) -> int:
     if wheel is not None:
         part = load_part(args.part)
         check_same_part(wheel.metadata.get("part"), part, args.part, f"trace {path}", same=args.same_part)
-        history = replay_wheel_beliefs(WheelFilter(part, wheel.wheel), wheel.columns)
+        odds = off_scale(args, wheel.wheel, wheel.metadata.get("off_scale"))
+        history = replay_wheel_beliefs(WheelFilter(part, wheel.wheel, off_scale=odds), wheel.columns)
         radius = wheel.wheel.radius
     else:
+        off_scale(args, DEFAULT_JAW)  # refused: a straight jaw's record
         if record.kind == "reactive":
             meta, columns, readings = reactive_calls(record)
         else:  # fixed rolls: their readings given to the reactive method's filter, as the studies' grid method

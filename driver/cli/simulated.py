@@ -23,6 +23,7 @@ from ._options import (
     check_before_moving,
     finite,
     jaw_argument,
+    off_scale,
     part_arguments,
     pressing,
     reactive_arguments,
@@ -151,6 +152,7 @@ def simulate_command(args: argparse.Namespace) -> int:
         args.engine = "kinematic" if isinstance(part, Outline) else "pymunk"
     if isinstance(args.jaw, WheelJaw):
         return simulate_wheel(args, part, args.jaw)
+    off_scale(args, args.jaw)  # refused for a straight jaw
     noise = load_noise(args.noise)
     if not args.roll and not args.reactive:
         raise UsageError("give the rolls (--roll DEG, repeated) or --reactive")

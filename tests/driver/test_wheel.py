@@ -556,3 +556,34 @@ def test_pressed_on_a_bumps_flank_the_wheel_measures_the_wrists_give_along_the_c
     assert run.stopped == "mismatch" and abs(err) < 0.3
     lo, hi = run.belief.mismatch
     assert lo < bump.arc + bump.length / 2 and hi > bump.arc - bump.length / 2
+
+
+def test_cli_the_wheels_prior_on_the_parts_size_is_given_recorded_and_replayed(tmp_path, capsys):
+    """--off-scale sets the wheel's filter's prior that the part is off its model's size; the trace records it,
+    'locate' replays with it unless given another, and a straight jaw, which carries no scale, refuses it."""
+    from driver.cli import main
+    from driver.records import WheelTrace
+
+    bracket, out = "parts/bracket.dxf", str(tmp_path / "w.npz")
+    args = ["--jaw", "wheel:5", "--reactive", "--start", "240", "--engine", "kinematic", "--noise", "paper"]
+    assert main(["simulate", bracket, *args, "--off-scale", "0", "--seed", "1", "--out", out, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    trace = WheelTrace.load(out)
+    assert trace.metadata["off_scale"] == 0.0
+    assert main(["locate", out, "--part", bracket, "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert abs(again["estimate_arc"] - doc["estimate_arc"]) < 1e-6 and again["mass"] == pytest.approx(doc["mass"])
+    assert main(["locate", out, "--part", bracket, "--off-scale", str(OFF_SCALE), "--json"]) == 0
+    other = json.loads(capsys.readouterr().out)
+    expected = trace.relocalize(load_part(bracket), off_scale=OFF_SCALE)
+    assert other["mass"] == pytest.approx(expected.mass) and other["mass"] != pytest.approx(doc["mass"])
+    with pytest.raises(SystemExit) as refused:
+        straight = ["--reactive", "--start", "240", "--off-scale", "0.1"]
+        main(["simulate", bracket, *straight, "--out", str(tmp_path / "s.npz")])
+    assert refused.value.code == 2 and "--off-scale 0.1 is the wheel's" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["simulate", bracket, *args, "--off-scale", "1", "--out", out])
+    trace.metadata["off_scale"] = 2.0
+    trace.save(tmp_path / "bad.npz")
+    assert main(["locate", str(tmp_path / "bad.npz"), "--part", bracket]) == 2
+    assert "off_scale 2.0 is not a probability" in capsys.readouterr().err
