@@ -16,7 +16,17 @@ from .._types import FloatArray
 from ..geometry import Outline, Part
 from ._belief import within
 
-__all__ = ["Spread", "OFF_SCALE", "OFF_SCALE_DOUBT", "weigh_scale", "weigh_odds"]
+__all__ = [
+    "Spread",
+    "OFF_SCALE",
+    "OFF_SCALE_DOUBT",
+    "NEGLIGIBLE",
+    "LOG_NEGLIGIBLE",
+    "weigh_scale",
+    "weigh_odds",
+    "relative_weights",
+    "log_add_exp",
+]
 
 #: The prior probability that a part is off its model's size by more than its machining (made to another
 #: revision's drawing, scaled on export): its scale is then N(1, ``sd_part_scale``²); else its model's

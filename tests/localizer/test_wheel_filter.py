@@ -493,3 +493,19 @@ def test_the_posterior_weighed_over_both_sizes_at_once_is_the_odds_mixture_of_ea
     np.testing.assert_allclose(w[heavy], expected[heavy], rtol=1e-9)
     np.testing.assert_allclose(spread.p_off[heavy], p_off[heavy], rtol=1e-9, atol=1e-300)
     assert w[~heavy].sum() < 1e-290
+
+
+def test_relative_weights_and_their_log_sum_agree_with_numpy_and_drop_only_what_no_sum_could_show():
+    """Against numpy's exp and logaddexp on log-weights from 0 down to −1e4 and −inf: the same where a weight
+    is above e^−700 of the top, exactly 0 below (numpy gives at most 1e-304 there)."""
+    from localizer.filters._wheel_scale import LOG_NEGLIGIBLE, log_add_exp, relative_weights
+
+    rng = np.random.default_rng(3)
+    log_w = np.concatenate([-rng.exponential(300.0, 5000), [0.0, -699.0, -701.0, -1e4, -np.inf]])
+    w = relative_weights(log_w, 0.0)
+    kept = log_w > LOG_NEGLIGIBLE
+    np.testing.assert_array_equal(w[kept], np.exp(log_w[kept]))
+    assert np.all(w[~kept] == 0.0) and np.all(np.exp(log_w[~kept]) < 1e-304)
+    other = -rng.exponential(300.0, log_w.size)
+    np.testing.assert_allclose(log_add_exp(log_w, other), np.logaddexp(log_w, other), rtol=1e-15, atol=1e-12)
+    np.testing.assert_allclose(log_add_exp(-0.05, log_w), np.logaddexp(-0.05, log_w), rtol=1e-15, atol=1e-15)
