@@ -70,6 +70,7 @@ def wheel_doc(part: Part | Outline, run: WheelRun, rig: Rig, calibration: WheelC
         "slip_mm": run.slip,
         "calibration": calibration.as_dict(),
         "modes": [{"arc": m.arc, "probability": m.mass} for m in b.modes[:5]],
+        "part_scale": run.part_scale._asdict(),
         **truth_fields(part, b, rig),
     }
 
@@ -80,6 +81,12 @@ def print_wheel(doc: dict[str, Any]) -> None:
         f"steps ({doc['stopped']}, {doc['jumps']} jumps undone, slip {doc['slip_mm']:+.3f} mm)"
     )
     print_belief(doc)
+    said = doc.get("part_scale")  # what the readings say of it where they fit the model: not after a mismatch
+    if said is not None and said["probability"] >= 0.5 and doc["stopped"] != "mismatch":
+        print(
+            f"the part seems {100 * (said['scale'] - 1):+.2f}% ± {100 * said['sd']:.2f}% off its model's size "
+            f"(probability {said['probability']:.2f}): made to another revision, or scaled on export?"
+        )
 
 
 def _emit(args: argparse.Namespace, doc: dict[str, Any], part: Part | Outline, run: WheelRun, out: str | None) -> int:

@@ -31,7 +31,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from localizer import DEFECT_WINDOW, Belief, Outline, Part, WheelFilter, WheelJaw, wheel_reach_for
+from localizer import DEFECT_WINDOW, Belief, Outline, Part, PartScale, WheelFilter, WheelJaw, wheel_reach_for
 
 from ..jaw import PRESS, PressSettings, holds_place
 from ..rig import Rig, RigError
@@ -85,6 +85,9 @@ class WheelRun:
     depth : float, mm
         The wrist's give at the target force (measured at the last press: the first, or the press again after
         meeting what the model does not have).
+    part_scale : PartScale
+        What the last segment's readings say of the part's size against its model's
+        (:meth:`localizer.WheelFilter.part_scale`).
     history : tuple of (rotation rad, map_arc mm, mass, true_arc mm)
     lengths, turns, true_arcs : tuple of float
         Every reading's L (mm) and Ω (rad) since its segment's start, and the true contact (NaN on a
@@ -104,6 +107,7 @@ class WheelRun:
     jumps: int
     slip: float
     depth: float
+    part_scale: PartScale = PartScale(0.0, 1.0, 0.0)
     history: tuple[tuple[float, float, float, float], ...] = field(repr=False, default=())
     lengths: tuple[float, ...] = field(repr=False, default=())
     turns: tuple[float, ...] = field(repr=False, default=())
@@ -383,6 +387,7 @@ def localize_with_wheel(
         jumps=jumps,
         slip=slip,
         depth=disc.depth,
+        part_scale=flt.part_scale(),
         history=tuple(history),
         lengths=tuple(lengths),
         turns=tuple(turns),

@@ -85,7 +85,7 @@ from .._defaults import FIT_ALPHA
 from ._belief import Belief, belief_flags, find_modes, flat_top, most_probable
 from ._contact_settings import TEMPER
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
-from ._wheel_scale import relative_weights
+from ._wheel_scale import PartScale, relative_weights
 from ._wheel_state import WHEEL_NOISE_SCALES, WHEEL_SD_SLOPE, WHEEL_SD_TURN, WHEEL_SLOPE_LENGTH, WheelState
 
 __all__ = [
@@ -208,6 +208,21 @@ class WheelFilter(WheelState):
             consistent=consistent,
             mismatch=mismatch,
         )
+
+    def part_scale(self) -> PartScale:
+        """What the readings used say of the part's size, over the starts (:class:`PartScale`): the posterior
+        probability that it is off its model's size, and its size then over its model's, b = 1/(1 + u) (mean
+        and standard deviation to first order in u's). Without the scale carried: (0, 1, 0)."""
+        if self._terms == 1 or not self.L_used:
+            return PartScale(0.0, 1.0, 0.0)
+        mean, sd, _, p_off = self._scale_posterior(self.noise_scales[0])
+        w = self.posterior() * p_off
+        probability = float(w.sum())
+        if not probability > 0:
+            return PartScale(0.0, 1.0, 0.0)
+        u = float(np.dot(w, mean)) / probability
+        var = max(float(np.dot(w, sd**2 + mean**2)) / probability - u * u, 0.0)
+        return PartScale(probability, 1.0 / (1.0 + u), math.sqrt(var) / (1.0 + u) ** 2)
 
     def stretch_mass(self, arc: float, radius: float | None = None) -> float:
         """The least probability within ``radius`` of the present contact at ``arc`` (mm) when the readings

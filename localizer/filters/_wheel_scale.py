@@ -18,6 +18,7 @@ from ._belief import within
 
 __all__ = [
     "Spread",
+    "PartScale",
     "OFF_SCALE",
     "OFF_SCALE_DOUBT",
     "NEGLIGIBLE",
@@ -83,6 +84,24 @@ class Spread(NamedTuple):
         """The present contact's posterior mean given each start, mm (unwrapped about the nominal one)."""
         out: FloatArray = self.nominal + self.p_off * (self.off - self.nominal)
         return out
+
+
+class PartScale(NamedTuple):
+    """What the wheel's readings say of the part's size against its model's (:meth:`WheelFilter.part_scale`).
+
+    Attributes
+    ----------
+    probability : float
+        The posterior probability that the part is off its model's size (0 where the scale is not carried).
+    scale : float
+        The part's size over its model's, if it is off it (posterior mean; 1.02: 2% larger).
+    sd : float
+        Its posterior standard deviation.
+    """
+
+    probability: float
+    scale: float
+    sd: float
 
 
 def weigh_scale(

@@ -568,6 +568,7 @@ def test_cli_the_wheels_prior_on_the_parts_size_is_given_recorded_and_replayed(t
     args = ["--jaw", "wheel:5", "--reactive", "--start", "240", "--engine", "kinematic", "--noise", "paper"]
     assert main(["simulate", bracket, *args, "--off-scale", "0", "--seed", "1", "--out", out, "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
+    assert doc["part_scale"] == {"probability": 0.0, "scale": 1.0, "sd": 0.0}  # the model's size, not weighed
     trace = WheelTrace.load(out)
     assert trace.metadata["off_scale"] == 0.0
     assert main(["locate", out, "--part", bracket, "--json"]) == 0
@@ -587,3 +588,20 @@ def test_cli_the_wheels_prior_on_the_parts_size_is_given_recorded_and_replayed(t
     trace.save(tmp_path / "bad.npz")
     assert main(["locate", str(tmp_path / "bad.npz"), "--part", bracket]) == 2
     assert "off_scale 2.0 is not a probability" in capsys.readouterr().err
+
+
+def test_the_wheels_ending_says_the_part_seems_off_its_size_where_the_readings_say_so(tmp_path, capsys):
+    """Printed where the part is more likely off its size than not, and the readings fit the model (after a
+    mismatch their scale is no measure of the part): a run's own JSON object, its part_scale and ending set."""
+    from driver.cli import main
+    from driver.cli._wheel import print_wheel
+
+    args = ["--jaw", "wheel:5", "--reactive", "--start", "240", "--engine", "kinematic", "--noise", "paper"]
+    assert main(["simulate", "parts/bracket.dxf", *args, "--out", str(tmp_path / "w.npz"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    line = "the part seems +1.95% ± 0.16% off its model's size (probability 0.97)"
+    for probability, stopped, said in ((0.97, "confident", True), (0.3, "confident", False), (0.97, "mismatch", False)):
+        doc.update(stopped=stopped, part_scale={"probability": probability, "scale": 1.0195, "sd": 0.0016})
+        print_wheel(doc)
+        out = capsys.readouterr().out
+        assert (line in out) == said and "wheel:5: rolled" in out

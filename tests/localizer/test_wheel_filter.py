@@ -381,14 +381,20 @@ def test_on_a_drawing_two_percent_off_its_size_the_wheel_is_never_sure_and_wrong
             told.update(L, om)
         b, i = f.belief(), int(np.argmax(f.posterior()))
         off = abs(float(model.arc_offset(b.map_arc, truth)))
+        said = f.part_scale()
         if length == 40.0:
             assert b.mass < 0.95 and (off < 0.05 or scale != 1.0)
+            # nothing told of the size: the prior's (off it with probability OFF_SCALE, then 1 ± 1%)
+            assert said.probability == pytest.approx(OFF_SCALE, abs=1e-3) and said.sd == pytest.approx(0.01, rel=0.01)
             continue
         assert off < 0.05 and b.mass >= 0.95
         if scale == 1.0:
-            assert f.present_spread().p_off[i] < 0.01
+            assert f.present_spread().p_off[i] < 0.01 and said.probability < 0.01
         else:
             assert not told.belief().consistent
+            # told by the two pivots: within two of its standard deviations (about 0.16%) of the part's size
+            assert said.probability > 0.99 and abs(said.scale - scale) < 2 * said.sd < 0.004
+    assert WheelFilter(model, WheelJaw(5.0), off_scale=0.0).part_scale() == (0.0, 1.0, 0.0)
 
 
 def test_a_pivot_within_thin_of_the_last_reading_used_is_read_with_the_scale_carried():
