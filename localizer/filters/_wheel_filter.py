@@ -85,7 +85,7 @@ from .._defaults import FIT_ALPHA
 from ._belief import Belief, belief_flags, find_modes, flat_top, most_probable
 from ._contact_settings import TEMPER
 from ._stretches import DEFECT_WINDOW, FIT_MIN_READINGS, FIT_RATIO, FIT_STARTS, FIT_WIDTH, stretch_windows
-from ._wheel_scale import PartScale, relative_weights
+from ._wheel_scale import PartScale
 from ._wheel_state import WHEEL_NOISE_SCALES, WHEEL_SD_SLOPE, WHEEL_SD_TURN, WHEEL_SLOPE_LENGTH, WheelState
 
 __all__ = [
@@ -215,8 +215,10 @@ class WheelFilter(WheelState):
         and standard deviation to first order in u's). Without the scale carried: (0, 1, 0)."""
         if self._terms == 1 or not self.L_used:
             return PartScale(0.0, 1.0, 0.0)
-        mean, sd, _, p_off = self._scale_posterior(self.noise_scales[0])
-        w = self.posterior() * p_off
+        f = self.noise_scales[0]
+        mean, sd, _ = self._scale_evidence(f, None, None, TEMPER)
+        posterior, spread = self._weighed(f)
+        w = posterior * spread.p_off
         probability = float(w.sum())
         if not probability > 0:
             return PartScale(0.0, 1.0, 0.0)
@@ -249,12 +251,11 @@ class WheelFilter(WheelState):
                 zg = self._zg - self._zg_each[inside].sum(axis=0)
                 gg = self._gg - self._gg_each[inside].sum(axis=0)
             for f in self.noise_scales:
-                base = TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty
-                for mean, sd, scale_ll, p_off in self._by_odds(f, zg, gg):
-                    ll = np.where(allowed, base + scale_ll, -np.inf)
-                    wts = relative_weights(ll, float(ll.max()))
-                    spread = self._spread(mean, sd, p_off)
-                    worst = min(worst, spread.mass(self.part, wts / wts.sum(), arc, radius))
+                base = np.where(allowed, TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty, -np.inf)
+                scale = self._scale_evidence(f, zg, gg, TEMPER) if self._terms > 1 else None
+                for odds in self.off_scales:
+                    wts, spread = self._mixed(base, scale, odds)
+                    worst = min(worst, spread.mass(self.part, wts, arc, radius))
             if worst < self.confidence:
                 break
         return worst

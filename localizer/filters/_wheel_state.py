@@ -364,15 +364,6 @@ class WheelState(WheelModel):
         log_factor, p_off = weigh_odds(evidence, self.off_scale if odds is None else odds)
         return mean, sd, log_factor, p_off
 
-    def _by_odds(
-        self, factor: float, zg: FloatArray | None = None, gg: FloatArray | None = None
-    ) -> list[tuple[FloatArray, FloatArray, FloatArray, FloatArray]]:
-        """:meth:`_scale_posterior` under each of :attr:`off_scales`, the scale weighed out once for all."""
-        if self._terms == 1:
-            return [self._scale_posterior(factor, zg, gg)]
-        mean, sd, evidence = self._scale_evidence(factor, zg, gg, TEMPER)
-        return [(mean, sd, *weigh_odds(evidence, odds)) for odds in self.off_scales]
-
     def _scale_evidence(
         self, factor: float, zg: FloatArray | None, gg: FloatArray | None, temper: float
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -389,19 +380,30 @@ class WheelState(WheelModel):
             self._scale_cache[key] = out
         return out
 
-    def _posterior(self, factor: float, odds: float | None = None) -> FloatArray:
-        return self._weights(factor, self._scale_posterior(factor, odds=odds)[2])
-
     def _weighed(self, factor: float, odds: float | None = None) -> tuple[FloatArray, Spread]:
-        """The posterior over the starts and each start's present contact (:meth:`_posterior`,
-        :meth:`present_spread`), the scale weighed out once for both: each start's weight at its model's size
-        and off it, whose sum is the posterior and whose share off it the probability it is off its size."""
-        if self._terms == 1:
+        """The posterior over the starts and each start's present contact (:meth:`posterior`,
+        :meth:`present_spread`) under the error model times ``factor`` and the prior probability ``odds``
+        (default :attr:`off_scale`) that the part is off its size, the scale weighed out once for both."""
+        scale = self._scale_evidence(factor, None, None, TEMPER) if self._terms > 1 else None
+        return self._mixed(self._base(factor), scale, self.off_scale if odds is None else odds)
+
+    def _mixed(
+        self, base: FloatArray, scale: tuple[FloatArray, FloatArray, FloatArray] | None, odds: float
+    ) -> tuple[FloatArray, Spread]:
+        """The posterior over the starts and each start's present contact, from each start's log-likelihood at
+        the model's size ``base`` (−inf where it cannot be) and, with the scale carried, u's posterior mean and
+        sd and the evidence off the model's size (:meth:`_scale_evidence`; None without): each start's weight
+        at its model's size and off it (by the prior ``odds``), whose sum is the posterior and whose share off
+        it the probability it is off its size."""
+        if scale is None:
             zero = np.zeros(self.grid.size)
-            return self._weights(factor, zero), self._spread(zero, zero, zero)
-        odds = self.off_scale if odds is None else odds
-        mean, sd, evidence = self._scale_evidence(factor, None, None, TEMPER)
-        base = self._base(factor)
+            top = float(base.max())
+            if not math.isfinite(top):
+                raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
+            w = relative_weights(base, top)
+            w /= w.sum()
+            return w, self._spread(zero, zero, zero)
+        mean, sd, evidence = scale
         at_size = base + math.log1p(-odds)
         off = base + evidence
         off += math.log(odds)
@@ -425,18 +427,9 @@ class WheelState(WheelModel):
             out = self._base_cache[factor] = np.where(self.prior > 0, ll, -np.inf)
         return out
 
-    def _weights(self, factor: float, log_factor: FloatArray) -> FloatArray:
-        ll = self._base(factor) + log_factor
-        top = ll.max()
-        if not np.isfinite(top):
-            raise QueryError("no start on the part fits the readings (all hypotheses ruled out)")
-        w = relative_weights(ll, float(top))
-        out: FloatArray = w / w.sum()
-        return out
-
     def posterior(self) -> FloatArray:
         """Posterior probability of each start on :attr:`grid` (sums to 1)."""
-        return self._posterior(self.noise_scales[0])
+        return self._weighed(self.noise_scales[0])[0]
 
     def present(self) -> FloatArray:
         """Each start's present contact, mm: its posterior mean given the start over the part's scale
@@ -448,8 +441,7 @@ class WheelState(WheelModel):
         """Each start's present contact at the model's size and off it (:class:`Spread`), under the error
         model times ``factor`` and the prior probability ``odds`` (default :attr:`off_scale`) that the part is
         off its size."""
-        mean, sd, _, p_off = self._scale_posterior(factor, odds=odds)
-        return self._spread(mean, sd, p_off)
+        return self._weighed(factor, odds)[1]
 
     def _spread(self, mean: FloatArray, sd: FloatArray, p_off: FloatArray) -> Spread:
         """Each start's present contact for the part's scale u given the start, off the model's size
