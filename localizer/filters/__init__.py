@@ -27,12 +27,11 @@ from ._wheel_filter import (
     WHEEL_SLOPE_LENGTH,
     WheelFilter,
 )
-from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, SCALE_DOUBT, PartScale, Spread
+from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, PartScale, Spread
 
 __all__ = [
     "OFF_SCALE",
     "OFF_SCALE_DOUBT",
-    "SCALE_DOUBT",
     "Spread",
     "PartScale",
     "Belief",

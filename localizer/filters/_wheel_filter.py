@@ -53,9 +53,8 @@ Trust, as the straight jaw's filter (docs/filter.md, "Trust"): the readings' lik
 power :data:`~localizer.TEMPER`, and a stated probability is the least over ``noise_scales`` (the
 covariance times each factor squared), so that readings noisier than the filter was told lower it
 instead of making it confidently wrong; with the scale carried, the least also over the prior
-probabilities ``off_scale`` and ``off_scale_doubt`` that the part is off its size, and under the latter
-with u's prior ``scale_doubt`` times wider, so that where the readings cannot tell the size, neither the
-prior's odds nor its width make the belief sure. And a belief is only stated
+probabilities ``off_scale`` and ``off_scale_doubt`` that the part is off its size, so that where the
+readings cannot tell the size, the prior's odds do not make the belief sure. And a belief is only stated
 when some start fits at all: when the best start's residuals are beyond the χ² test at
 :data:`~localizer.FIT_ALPHA` even under :data:`WHEEL_FIT_SCALE` times the error model, nothing fits (a
 wheel jammed between two walls reads exactly as rolling in a concave arc of its own radius,
@@ -129,9 +128,6 @@ class WheelFilter(WheelState):
     off_scale_doubt : float
         With the scale carried, the stated mass is the least also under this prior probability that the part
         is off its size (:data:`~localizer.OFF_SCALE_DOUBT`; not below ``off_scale``).
-    scale_doubt : float
-        ... and under that probability with u's prior standard deviation this many times ``sd_part_scale``
-        (:data:`~localizer.SCALE_DOUBT`; 1: not widened).
     thin : float, mm
         Arc between two readings the likelihood uses.
     radius : float, mm
@@ -173,9 +169,9 @@ class WheelFilter(WheelState):
         map_arc = float(present[i])
         mass = 1.0
         for f in self.noise_scales:
-            for odds, sd in self.size_priors:
-                first = f == self.noise_scales[0] and (odds, sd) == self.size_priors[0]
-                wf, sf = (w, spread) if first else self._weighed(f, odds, sd)
+            for odds in self.off_scales:
+                first = f == self.noise_scales[0] and odds == self.off_scale
+                wf, sf = (w, spread) if first else self._weighed(f, odds)
                 mass = min(mass, sf.mass(self.part, wf, map_arc, radius))
         consistent = self.consistent()
         if not consistent:
@@ -256,11 +252,9 @@ class WheelFilter(WheelState):
                 gg = self._gg - self._gg_each[inside].sum(axis=0)
             for f in self.noise_scales:
                 base = np.where(allowed, TEMPER * (-0.5 * quad / f**2 - 0.5 * logdet) + self._penalty, -np.inf)
-                by_sd = {}
-                for odds, sd in self.size_priors:
-                    if sd not in by_sd:
-                        by_sd[sd] = self._scale_evidence(f, zg, gg, TEMPER, sd) if self._terms > 1 else None
-                    wts, spread = self._mixed(base, by_sd[sd], odds)
+                scale = self._scale_evidence(f, zg, gg, TEMPER) if self._terms > 1 else None
+                for odds in self.off_scales:
+                    wts, spread = self._mixed(base, scale, odds)
                     worst = min(worst, spread.mass(self.part, wts, arc, radius))
             if worst < self.confidence:
                 break

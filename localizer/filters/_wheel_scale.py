@@ -21,7 +21,6 @@ __all__ = [
     "PartScale",
     "OFF_SCALE",
     "OFF_SCALE_DOUBT",
-    "SCALE_DOUBT",
     "NEGLIGIBLE",
     "LOG_NEGLIGIBLE",
     "weigh_scale",
@@ -42,12 +41,6 @@ OFF_SCALE = 0.05
 #: face, a near-circular stretch, a short roll) it is the prior's odds that would make the belief sure, and
 #: a part that is off its size is sure and wrong there (docs/robustness.md).
 OFF_SCALE_DOUBT = 0.5
-#: Under that doubt the stated probability holds also if the part, off its size, were off by this many times
-#: more than its prior says (u ~ N(0, (``SCALE_DOUBT``·``sd_part_scale``)²)): a part 2% off at the prior's two
-#: standard deviations, where the readings hardly tell its size from a shifted start, has u's posterior pulled
-#: toward its model's size by the prior, and the contact read from it off by the arc rolled times the rest
-#: (docs/robustness.md, "The prior's width doubted").
-SCALE_DOUBT = 2.0
 #: A start weighing less than this times the most probable one adds nothing a stated mass could show (11724
 #: starts on the kidney: 1.2e-8 at most, all told).
 NEGLIGIBLE = 1e-12

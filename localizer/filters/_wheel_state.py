@@ -17,7 +17,7 @@ from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, wheel_reach_f
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._wheel_model import WheelModel
-from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, SCALE_DOUBT, Spread, relative_weights, weigh_odds, weigh_scale
+from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, Spread, relative_weights, weigh_odds, weigh_scale
 
 __all__ = [
     "WheelState",
@@ -56,7 +56,6 @@ class WheelState(WheelModel):
         sd_part_scale: float = PART_SCALE_SD,
         off_scale: float = OFF_SCALE,
         off_scale_doubt: float = OFF_SCALE_DOUBT,
-        scale_doubt: float = SCALE_DOUBT,
         thin: float = 1.0,
         radius: float = SUCCESS_RADIUS,
         confidence: float = CONFIDENCE,
@@ -90,8 +89,6 @@ class WheelState(WheelModel):
         self.off_scale = float(off_scale)
         if not (math.isfinite(off_scale_doubt) and 0 <= off_scale_doubt < 1):
             raise QueryError(f"off_scale_doubt={off_scale_doubt!r} is a probability: give it in [0, 1)")
-        if not (math.isfinite(scale_doubt) and scale_doubt >= 1):
-            raise QueryError(f"scale_doubt={scale_doubt!r} widens the part's scale's prior: give a factor ≥ 1")
         self.radius, self.confidence, self.mode_floor = float(radius), float(confidence), float(mode_floor)
         self.noise_scales = tuple(float(f) for f in noise_scales)
         P = float(part.perimeter)
@@ -123,15 +120,11 @@ class WheelState(WheelModel):
         self._terms = (
             2 if self.sd_part_scale > 0 and self.off_scale > 0 else 1
         )  # residuals, and their derivatives in the scale
-        # the priors of the part's size the stated probability is the least under (the first is the belief's):
-        # the probability that it is off its size, and u's standard deviation then
-        self.size_priors: tuple[tuple[float, float], ...] = ((self.off_scale, self.sd_part_scale),)
-        if self._terms > 1:
-            doubt = max(float(off_scale_doubt), self.off_scale)
-            if doubt > self.off_scale:
-                self.size_priors += ((doubt, self.sd_part_scale),)
-            if scale_doubt > 1:
-                self.size_priors += ((doubt, self.sd_part_scale * float(scale_doubt)),)
+        # the prior probabilities of a part off its size the stated probability is the least under (the first
+        # is the belief's)
+        self.off_scales: tuple[float, ...] = (self.off_scale,)
+        if self._terms > 1 and off_scale_doubt > self.off_scale:
+            self.off_scales += (float(off_scale_doubt),)
         self._per_reading = 24.0 * self._terms * n
         b = self._per_reading
         self.max_readings = int((math.sqrt(b * b + 32.0 * MAX_ARRAY_BYTES) - b) / 16.0)
@@ -165,7 +158,7 @@ class WheelState(WheelModel):
         self._last: tuple[float, float] | None = None  # the last reading, used or not
         # the scale weighed out on every reading used, per (noise factor, temper): u's mean and sd, and the log
         # of the readings' factor off the model's size against at it, given each start (_scale_posterior)
-        self._scale_cache: dict[tuple[float, float, float], tuple[FloatArray, FloatArray, FloatArray]] = {}
+        self._scale_cache: dict[tuple[float, float], tuple[FloatArray, FloatArray, FloatArray]] = {}
         # each noise factor's tempered log-likelihood at the model's size with the reach's evidence, −inf where
         # the wheel cannot touch (_base), kept until a reading is used or a jump counted
         self._base_cache: dict[float, FloatArray] = {}
@@ -372,31 +365,26 @@ class WheelState(WheelModel):
         return mean, sd, log_factor, p_off
 
     def _scale_evidence(
-        self, factor: float, zg: FloatArray | None, gg: FloatArray | None, temper: float, sd: float | None = None
+        self, factor: float, zg: FloatArray | None, gg: FloatArray | None, temper: float
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """:func:`~localizer.filters._wheel_scale.weigh_scale` of the sums (default every reading used's, kept
-        until the next reading used), as :meth:`_scale_posterior` takes them: before any prior odds; u's prior
-        standard deviation ``sd`` (default :attr:`sd_part_scale`)."""
-        sd = self.sd_part_scale if sd is None else sd
-        key = (factor, temper, sd)
+        until the next reading used), as :meth:`_scale_posterior` takes them: before any prior odds."""
+        key = (factor, temper)
         own = zg is None and gg is None
         if own and key in self._scale_cache:
             return self._scale_cache[key]
         zg = (self._zg if zg is None else zg) * (temper / factor**2)
         gg = (self._gg if gg is None else gg) * (temper / factor**2)
-        out = weigh_scale(zg, gg, sd, self._u_bound, self._penalty_run)
+        out = weigh_scale(zg, gg, self.sd_part_scale, self._u_bound, self._penalty_run)
         if own:
             self._scale_cache[key] = out
         return out
 
-    def _weighed(
-        self, factor: float, odds: float | None = None, sd: float | None = None
-    ) -> tuple[FloatArray, Spread]:
+    def _weighed(self, factor: float, odds: float | None = None) -> tuple[FloatArray, Spread]:
         """The posterior over the starts and each start's present contact (:meth:`posterior`,
-        :meth:`present_spread`) under the error model times ``factor``, the prior probability ``odds`` (default
-        :attr:`off_scale`) that the part is off its size and u's prior standard deviation ``sd`` then (default
-        :attr:`sd_part_scale`), the scale weighed out once for both."""
-        scale = self._scale_evidence(factor, None, None, TEMPER, sd) if self._terms > 1 else None
+        :meth:`present_spread`) under the error model times ``factor`` and the prior probability ``odds``
+        (default :attr:`off_scale`) that the part is off its size, the scale weighed out once for both."""
+        scale = self._scale_evidence(factor, None, None, TEMPER) if self._terms > 1 else None
         return self._mixed(self._base(factor), scale, self.off_scale if odds is None else odds)
 
     def _mixed(
