@@ -21,7 +21,6 @@ from ._limits import (
     count_text,
     read_toml,
 )
-from ._loaded import LOADED_PARTS, forget_loaded
 from ._numerics import TWO_PI, curvature, gauss_legendre, mod_period, wrap_angle
 from ._outline import Corner, Outline, nearest_corner, outline_from_pieces
 from ._part import UNITS_TO_MM, Part, part_from_points, polygon_crossing
@@ -37,8 +36,6 @@ __all__ = [
     "FacetRule",
     "read_facets",
     "load_part",
-    "LOADED_PARTS",
-    "forget_loaded",
     "QUANTUM_MM",
     "fingerprint",
     "MAX_ARRAY_BYTES",

@@ -20,7 +20,6 @@ from .._errors import PartError
 from ._dxf import read_dxf
 from ._facets import FACETS, FacetRule, read_facets
 from ._limits import MAX_PART_BYTES, check_size
-from ._loaded import read_once
 from ._outline import Outline, outline_from_pieces
 from ._pieces import Line, Piece
 from ._svg import read_svg
@@ -57,10 +56,6 @@ def load_outline(
     """
     path = Path(path)
     check_size(path, MAX_PART_BYTES, "CAD file")
-    return read_once(path, ("outline", layer, element, facets), lambda: _read_outline(path, layer, element, facets))
-
-
-def _read_outline(path: Path, layer: str | None, element: str | None, facets: FacetRule | None) -> Outline:
     suffix = path.suffix.lower()
     if suffix == ".dxf":
         if element is not None:

@@ -11,7 +11,6 @@ from pathlib import Path
 from .._errors import PartError
 from ._cad import CAD_SUFFIXES, load_outline
 from ._limits import MAX_PART_BYTES, check_size
-from ._loaded import read_once
 from ._outline import Outline
 from ._part import Part, part_from_points
 
@@ -50,11 +49,6 @@ def load_part(path: str | os.PathLike[str], *, layer: str | None = None, element
     for name, value in (("layer", layer), ("element", element)):
         if value is not None:
             raise PartError(f"{src}: {name}={value!r} names a part of a CAD drawing; this is a point file")
-    return read_once(path, "points", lambda: _read_points(path))
-
-
-def _read_points(path: Path) -> Part:
-    src = str(path)
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:

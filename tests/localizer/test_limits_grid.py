@@ -283,7 +283,6 @@ GENERATED = [
 @pytest.mark.parametrize("path", SHIPPED + GENERATED, ids=lambda p: f"{p.parent.name}/{p.name}")
 def test_the_largest_parts_pass_every_check(path, passed_checks):
     part = load_part(path)
-    part.forget_tables()  # the same file read earlier in this process is the same part, its tables built
     spline = not part.corners and hasattr(part, "n_knots")
     builders = [
         lambda: ContactFilter(part),
