@@ -19,6 +19,8 @@ from bench.scoring import parse_curve
 from bench.study import StudyError, load_study
 from bench.summary import wilson
 
+from ..ctrl_c import CLI
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -463,7 +465,7 @@ def test_ctrl_c_keeps_the_finished_trials_and_does_not_wait_for_the_queue(tmp_pa
     within 45 s however loaded the machine, keeping what finished."""
     f = study_file(tmp_path, trials=1500)
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "driver.cli", "montecarlo", str(f), "--out", str(out), "--workers", "2"]
+    cmd = [*CLI, "montecarlo", str(f), "--out", str(out), "--workers", "2"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and len(read_trials(out / "trials.csv")) < 2:

@@ -7,7 +7,6 @@ import math
 import os
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -20,6 +19,8 @@ from driver.records import RunLog
 from driver.rig import ImplausibleReading, ProtocolError, RigError
 from localizer import load_part
 from sim2d import SimRig
+
+from ..ctrl_c import CLI
 
 ROOT = Path(__file__).resolve().parents[2]
 PART = load_part(ROOT / "parts" / "trefoil.json")
@@ -146,7 +147,7 @@ def test_a_device_refusal_is_not_a_connection_failure():
 
 def _run_cli(args, env=None):
     return subprocess.Popen(
-        [sys.executable, "-m", "driver.cli", *args],
+        [*CLI, *args],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
