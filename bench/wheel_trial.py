@@ -5,7 +5,8 @@ wheel's true radius (its nominal one within a ground wheel's tolerance, :data:`R
 start: uniformly over the whole boundary, redrawn until the wheel surely reaches it
 (:class:`localizer.WheelReach`; the redraws are counted). The wheel is calibrated on the part itself
 (:func:`driver.wheel.calibrate_wheel` on a rig of its own: the same wheel, another machined part and
-noise), then :func:`driver.wheel.localize_with_wheel` rolls from the start with the study's
+noise), then :func:`driver.wheel.localize_with_wheel` rolls from the start, both rigs in the study's world
+(``engine``: kinematic or pymunk), with the study's
 ``[reactive]`` confidence and rotation budget. :func:`bench.methods.score_trial` scores the run as the
 ``reactive`` method; the row has :data:`bench.columns.FINGER_COLUMNS` too.
 """
@@ -72,11 +73,11 @@ def roll_wheel(ctx: TrialContext) -> WheelRoll:
     try:
         if not math.isfinite(start):
             raise RuntimeError(f"no start the {wheel} reaches in {MAX_REDRAWS} draws on {part.name}")
-        cal_rig = WheelRig(part, wheel, noise=noise, seed=cal_seed, true_radius=true_radius)
+        cal_rig = WheelRig(part, wheel, noise=noise, seed=cal_seed, true_radius=true_radius, engine=s.engine)
         cal = calibrate_wheel(cal_rig, wheel, cal_rig.approach_pose(wheel_calibration_arc(part, wheel)), part=part)
         # the world (a [world] table) is the localizing rig's; the calibration is another session's
         change = ctx.world.draw(part, start, ctx.world_rng, ctx.part_index) if ctx.world is not None else None
-        rig = WheelRig(part, wheel, noise=noise, seed=rig_seed, true_radius=true_radius, change=change)
+        rig = WheelRig(part, wheel, noise=noise, seed=rig_seed, true_radius=true_radius, change=change, engine=s.engine)
         policy = WheelPolicy(confidence=s.reactive.confidence, max_rotation=math.radians(s.reactive.max_rotation_deg))
         run = localize_with_wheel(
             rig,

@@ -29,3 +29,28 @@ def test_rolling_on_past_a_dent_is_not_taken_for_the_rims_slip():
     assert row["reactive_stopped"] == "mismatch" and row["reactive_success"] == 1
     lo, hi = (float(v) for v in row["reactive_mismatch_arc"].rsplit("-", 1))
     assert lo - 2.0 <= float(row["world_defect_arc"]) <= hi + 2.0
+
+
+def test_the_studys_engine_is_the_wheels_world(monkeypatch):
+    """A study's ``engine`` reaches both of a wheel trial's rigs (the calibration's and the localizing one):
+    before, a wheel study said pymunk and rolled in the kinematic world."""
+    from dataclasses import replace
+
+    import sim2d
+
+    engines = []
+
+    class Recorded(sim2d.WheelRig):
+        def __init__(self, *args, **kwargs):
+            engines.append(kwargs.get("engine", "kinematic"))
+            if len(engines) == 2:
+                raise RuntimeError("both rigs made")  # the trial's failure: nothing needs to roll
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(sim2d, "WheelRig", Recorded)
+    study = load_study("bench/studies/wheel-heldout.toml")
+    for engine in ("pymunk", "kinematic"):
+        engines.clear()
+        row = run_trial(TrialSpec(replace(study, engine=engine), 0, 86))
+        assert "both rigs made" in row["reactive_failure"] or "both rigs made" in row["failure"]
+        assert engines == [engine, engine]
