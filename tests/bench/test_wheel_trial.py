@@ -1,4 +1,5 @@
-"""The wheel's Monte Carlo trial: its columns, and a recorded held-out failure that must not come back."""
+"""The wheel's Monte Carlo trial: its columns, the study's world reaching its rigs, and recorded held-out
+failures that must not come back."""
 
 import math
 
