@@ -273,7 +273,7 @@ class WheelFilter(WheelState):
             return None
         zz = self._zz[:, starts]  # (readings, starts)
         if self._terms > 1:  # each start's residuals with its scale fitted (the readings' own likelihood)
-            mean, _, _, p_off = self._scale_posterior(temper=1.0)
+            mean, p_off = self._scale_posterior(temper=1.0)
             u = (p_off * mean)[starts]
             zz = np.maximum(zz - 2.0 * u * self._zg_each[:, starts] + u**2 * self._gg_each[:, starts], 0.0)
         rolled = np.array(self.L_used)
@@ -325,7 +325,7 @@ class WheelFilter(WheelState):
             # the noise over the four readings before it turns round (18.5 against 31 at the model's size) and
             # not at twice
             f = min(scale, max(self.noise_scales))
-            u = self._scale_posterior(f, temper=1.0)[0]
+            u = self._scale_evidence(f, None, None, 1.0)[0]
             fit = (self._quad - self._zg * u) / f**2
             occam = np.log1p(self._gg * self.sd_part_scale**2 / f**2)
             off = fit + occam + 2.0 * max(0.0, math.log((1.0 - self.off_scale) / self.off_scale))

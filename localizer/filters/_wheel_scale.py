@@ -24,7 +24,6 @@ __all__ = [
     "NEGLIGIBLE",
     "LOG_NEGLIGIBLE",
     "weigh_scale",
-    "weigh_odds",
     "relative_weights",
     "log_add_exp",
 ]
@@ -148,13 +147,3 @@ def log_add_exp(a: FloatArray | float, b: FloatArray) -> FloatArray:
     on this machine."""
     out: FloatArray = np.maximum(a, b) + np.log1p(relative_weights(-np.abs(np.subtract(a, b)), 0.0))
     return out
-
-
-def weigh_odds(evidence: FloatArray, odds: float) -> tuple[FloatArray, FloatArray]:
-    """Per start, under the prior probability ``odds`` that the part is off its size: the log of the factor
-    the scale weighed out puts on the start's likelihood (both sizes), and the probability that the part is
-    off its size given the start."""
-    off = math.log(odds) + evidence
-    log_factor = log_add_exp(math.log1p(-odds), off)
-    p_off = relative_weights(off, log_factor)
-    return log_factor, p_off

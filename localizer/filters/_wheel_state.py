@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 from scipy.linalg import solve_triangular
+from scipy.special import expit
 
 from .._defaults import CONFIDENCE, PART_SCALE_SD, SUCCESS_RADIUS
 from .._errors import QueryError
@@ -17,7 +18,7 @@ from ..contact import ShiftedGrid, WheelJaw, free_runs, jump_runs, wheel_reach_f
 from ..geometry import MAX_ARRAY_BYTES, Outline, Part, bytes_text, check_grid
 from ._contact_settings import BRIDGE_MISS, CONTRADICTION, TEMPER
 from ._wheel_model import WheelModel
-from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, Spread, relative_weights, weigh_odds, weigh_scale
+from ._wheel_scale import OFF_SCALE, OFF_SCALE_DOUBT, Spread, relative_weights, weigh_scale
 
 __all__ = [
     "WheelState",
@@ -157,7 +158,7 @@ class WheelState(WheelModel):
         self.span = (0.0, 0.0)
         self._last: tuple[float, float] | None = None  # the last reading, used or not
         # the scale weighed out on every reading used, per (noise factor, temper): u's mean and sd, and the log
-        # of the readings' factor off the model's size against at it, given each start (_scale_posterior)
+        # of the readings' factor off the model's size against at it, given each start (_scale_evidence)
         self._scale_cache: dict[tuple[float, float], tuple[FloatArray, FloatArray, FloatArray]] = {}
         # each noise factor's tempered log-likelihood at the model's size with the reach's evidence, −inf where
         # the wheel cannot touch (_base), kept until a reading is used or a jump counted
@@ -268,11 +269,14 @@ class WheelState(WheelModel):
         self._zzbuf[k] = z**2  # each start's misfit of this reading, for the fit test and the stretches
         self._lvbuf[k] = np.log(var)
         self._logdet += self._lvbuf[k]
-        contradicted = np.where(self._clear(), 0.0, math.log(CONTRADICTION))
+        # clear at the model's size where the roll's bound on the scale admits u = 0 (the starts the wheel cannot
+        # touch, clear of any roll before there is one, weigh nothing whatever their penalty)
+        u_max = self._u_max()
+        contradicted = np.where(u_max >= 0.0, 0.0, math.log(CONTRADICTION))
         self._penalty += contradicted
         self._penalty_run += contradicted
         if self._terms > 1:
-            self._u_bound = self._u_max()
+            self._u_bound = u_max
         self._zbuf[:n, k] = z * np.sqrt(var / d2)  # whitened by the shared part alone
         self._cholbuf[k, :k] = ell
         self._cholbuf[k, k] = math.sqrt(d2)
@@ -324,17 +328,11 @@ class WheelState(WheelModel):
         return out
 
     # --------------------------------------------------------------- belief
-    def _clear(self) -> BoolArray:
-        """Starts from which the arc rolled so far, both ways, runs over touchable points only."""
-        lo, hi = self.span
-        tol = 2 * self.h
-        ok: BoolArray = (self._ahead + tol >= hi) & (self._behind + tol >= -lo)
-        return ok
-
     def _u_max(self) -> FloatArray:
         """Per start, the largest scale u for which the roll so far, L(1 + u) of the model either way, runs over
-        touchable points only (:meth:`_clear` at u = 0; a wheel rolled up to a place it cannot pass on a part
-        2% large reads 2% past it). +inf where nothing was rolled that way; below −1 where nothing is clear."""
+        touchable points only (u = 0 within it: the roll is clear at the model's size; a wheel rolled up to a
+        place it cannot pass on a part 2% large reads 2% past it). +inf where nothing was rolled that way; below
+        −1 where nothing is clear."""
         lo, hi = self.span
         tol = 2 * self.h
         out: FloatArray = np.full(self.grid.size, math.inf)
@@ -344,25 +342,17 @@ class WheelState(WheelModel):
             out = np.minimum(out, (self._behind + tol) / -lo - 1.0)
         return out
 
-    def _scale_posterior(
-        self,
-        factor: float = 1.0,
-        zg: FloatArray | None = None,
-        gg: FloatArray | None = None,
-        temper: float = TEMPER,
-        odds: float | None = None,
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """Per start: the part's scale u given the start and that the part is off its model's size (its mean
-        and standard deviation), the log of the factor weighing the scale out puts on the start's likelihood
-        (both sizes, by their prior ``odds``, default :attr:`off_scale`), and the probability that the part is
-        off its size; under the readings' likelihood raised to ``temper`` with the error model times
-        ``factor``, from the sums Σ z·g and Σ g² (default: every reading used's). Without the scale: zeros."""
+    def _scale_posterior(self, factor: float = 1.0, temper: float = TEMPER) -> tuple[FloatArray, FloatArray]:
+        """Per start: the mean of the part's scale u given the start and that the part is off its model's size,
+        and the probability, under the prior probability :attr:`off_scale`, that it is off its size; under the
+        readings' likelihood raised to ``temper`` with the error model times ``factor``. Without the scale:
+        zeros."""
         if self._terms == 1:
             zero = np.zeros(self.grid.size)
-            return zero, zero, zero, zero
-        mean, sd, evidence = self._scale_evidence(factor, zg, gg, temper)
-        log_factor, p_off = weigh_odds(evidence, self.off_scale if odds is None else odds)
-        return mean, sd, log_factor, p_off
+            return zero, zero
+        mean, _, evidence = self._scale_evidence(factor, None, None, temper)
+        p_off: FloatArray = expit(evidence + (math.log(self.off_scale) - math.log1p(-self.off_scale)))
+        return mean, p_off
 
     def _scale_evidence(
         self, factor: float, zg: FloatArray | None, gg: FloatArray | None, temper: float
