@@ -27,7 +27,7 @@ class ReactiveOptions:
     sd_scale: float | None = None
     sd_slope: float | str | None = None  # "auto": from the study's noise model
     min_spread: float = 0.05
-    seek: bool | None = None  # None: driver.jaw.ReactivePolicy's default; true: the information-seeking direction rule
+    seek: bool | None = None  # None: driver.jaw.ReactivePolicy's (seeking information); false: the baseline
     noise_scales: tuple[float, ...] | None = None  # None: localizer.NOISE_SCALES
     temper: float | None = None  # None: the filter's default
     shape_spacing: float | None = None  # None: the filter's default (mm between the slope basis' knots)

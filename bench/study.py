@@ -54,8 +54,8 @@ Several methods on the same trials (instead of ``method``)::
                                          #   lays the jaw on a corner only at its jump's ends (drawings)
     stretch_weight = 0.06                # optional: the weight of the stretch check in the stated
                                          #   mass (default localizer.STRETCH_WEIGHT; 1: the least)
-    seek = true                          # optional: the information-seeking direction rule (default:
-                                         #   driver.jaw.ReactivePolicy's)
+    seek = false                         # optional: false for the baseline direction rule (the two
+                                         #   leading modes' spread); default true, seeking information
     off_scale = 0.05                     # optional, the wheel: the prior probability that the part is
                                          #   off its model's size (default localizer.OFF_SCALE; 0: the
                                          #   part is its model's size)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 from localizer import FIT_ALPHA, SUCCESS_RADIUS, Belief, Localization, Outline, Part
 
 from ..rig import GroundTruth, Rig
-from ._options import pressing
+from ._options import pressing, seeks
 
 if TYPE_CHECKING:
     import numpy as np
@@ -74,7 +74,10 @@ def run_reactive(
     from driver.records import LoggedFilter
 
     policy = ReactivePolicy(
-        step=math.radians(args.step), confidence=args.confidence, max_rotation=math.radians(args.max_rotation)
+        step=math.radians(args.step),
+        confidence=args.confidence,
+        max_rotation=math.radians(args.max_rotation),
+        seek=seeks(args),
     )
     res = localize_reactively(
         rig,
@@ -90,6 +93,7 @@ def run_reactive(
     doc = {
         "part": part.name,
         "method": "reactive",
+        "policy": "seek" if policy.seek else "spread",
         **belief_fields(b),
         "stopped": res.stopped,
         "rotation_deg": math.degrees(res.rotation),

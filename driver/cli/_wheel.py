@@ -47,9 +47,13 @@ __all__ = [
 
 
 def wheel_policy(args: argparse.Namespace) -> WheelPolicy:
-    """The wheel's rolling from the reactive options (``--confidence``, ``--max-rotation``)."""
+    """The wheel's rolling from the reactive options (``--confidence``, ``--max-rotation``); ``--policy`` is refused."""
     from ..wheel import WheelPolicy
 
+    if getattr(args, "policy", None) is not None:
+        raise UsageError(
+            f"--policy {args.policy} is the straight jaw's direction rule: a wheel turns round only where it is blocked"
+        )
     return WheelPolicy(confidence=args.confidence, max_rotation=math.radians(args.max_rotation))
 
 

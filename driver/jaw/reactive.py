@@ -362,19 +362,19 @@ class _Roller(JawMoves):
             self.direction = -direction
             self.reversals += 1
             return None
-        # the direction rule: when rolling on cannot separate the two leading modes, turn round if
-        # the unexplored curvature the other way separates them better, and if that way is clear
-        # (else the rule above turns it straight back, and the jaw rocks)
+        # the direction rule, while two places hold the belief: turn round when the other way tells more of
+        # it apart per radian, the way back to its unexplored edge counted, and if that way is clear (else the
+        # rule above turns it straight back, and the jaw rocks)
         strong = [m for m in belief.modes if m.mass >= flt.mode_floor]
         if len(strong) < 2 or self.blocked[-direction]:
             return None
         if p.seek:
-            # ... or, seeking information: turn round when the other way tells more of the belief apart per
-            # radian, the way back to its unexplored edge counted
             ccw, cw = information_by_direction(flt, p.lookahead, tuple(self.explored))
             ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
             turn = behind > p.seek_margin * ahead
         else:
+            # the baseline: the two leading modes alone, by how much the unexplored curvature each way
+            # separates them (it rocks where the modes' places jump about within two look-alike stretches)
             ccw, cw = spread_by_direction(flt, p.lookahead, tuple(self.explored), [m.start_arc for m in strong[:2]])
             ahead, behind = (ccw, cw) if direction == 1 else (cw, ccw)
             turn = ahead < p.min_spread and behind > 3 * p.min_spread

@@ -13,12 +13,16 @@ simultaneously" as the way forward. :func:`driver.jaw.reactive.localize_reactive
    the first crossing; why not two: docs/filter.md, "How the settings were chosen"). When the
    rotation budget runs out between two checks, the
    readings since the last one are judged as a check would judge them;
-4. the direction rule: while the belief has two or more modes, compare how much
-   the next ``lookahead`` of *unexplored* rotation each way separates the two
-   leading ones (how much their radii of curvature differ over it,
-   integrated); when the way ahead cannot separate them (below ``min_spread``)
-   and the other way clearly can (above three times that), turn round (rolling
-   back over the explored range);
+4. the direction rule: while the belief has two or more modes, turn round when the other way is
+   expected to raise the probability of the right place more per radian of rolling, the way back to
+   its unexplored edge counted (:func:`information_by_direction`: each probable start's predicted
+   travel, a face crossed or a corner pivoted on included, weighed against the others'). The jaw
+   then rolls towards what tells the places apart: past a fillet's end onto the face whose length
+   differs between two look-alike fillets, rather than back and forth over the fillets themselves,
+   which read the same. The baseline (``seek=False``) compares how much the next ``lookahead`` of
+   *unexplored* rotation each way separates the two leading modes (their radii of curvature's
+   difference over it, integrated), and turns round when the way ahead cannot separate them (below
+   ``min_spread``) and the other way clearly can (above three times that);
 5. when most of the belief says the contact will leave its convex stretch
    within ``lookahead``, turn round before the jaw bridges the concavity; a
    step that jumps along the jaw all the same has bridged it: it is undone (the
@@ -306,8 +310,8 @@ class ReactivePolicy:
     backoff : float, mm
         How far the jaw is lifted off for a regrasp or after a bridge.
     min_spread : float, mm
-        The direction rule turns round when the window ahead separates the two leading
-        modes' predicted arcs by less than this and the other way's window by more than
+        The baseline direction rule (``seek=False``) turns round when the window ahead separates the
+        two leading modes' predicted arcs by less than this and the other way's window by more than
         three times this (0: never turn round by choice).
     confirm : int
         Checks in a row at which the belief must reach ``confidence`` before the rolling stops.
@@ -315,10 +319,10 @@ class ReactivePolicy:
         A reading whose contact moved more than this on the jaw in one step is read twice more and the
         middle of the three kept (a spike of the wrist's DAQ is one reading; a real jump reads the same).
     seek : bool
-        The direction rule seeks information: while the belief has two or more modes, turn round when the
-        other way is expected to raise the probability of the right place more per radian of rolling, the
-        way back to it included, by the factor ``seek_margin`` (:func:`information_by_direction`). False:
-        the two leading modes' spread rule (``min_spread``), the baseline.
+        The direction rule seeks information (the default): while the belief has two or more modes, turn
+        round when the other way is expected to raise the probability of the right place more per radian of
+        rolling, the way back to it included, by the factor ``seek_margin`` (:func:`information_by_direction`).
+        False: the baseline, the two leading modes' spread rule (``min_spread``).
     seek_margin : float
         How much more the other way must be expected to gain, per radian, before the jaw turns round
         (at least 1; above, so that two ways about as good do not rock the jaw).
@@ -337,7 +341,7 @@ class ReactivePolicy:
     min_spread: float = 0.05
     confirm: int = CONFIRM
     reread_jump: float = 1.0
-    seek: bool = False
+    seek: bool = True
     seek_margin: float = 1.5
 
     def __post_init__(self) -> None:

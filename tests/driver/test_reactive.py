@@ -131,7 +131,7 @@ def test_a_budget_that_runs_out_between_checks_judges_the_last_readings(trefoil,
     # the same rolling checked every 5 steps, and never until the budget ends a little after that stop:
     # the readings since the last check are judged as a check would, and a sure belief there is sure
     part, _ = trefoil
-    checked, _ = until_sure(False)  # ReactivePolicy(confidence=0.95): seek is off by default
+    checked, _ = until_sure(False)  # the baseline direction rule, which rolls this start one way
     never = ReactivePolicy(confidence=0.95, check_every=100_000, max_rotation=math.radians(60.0))
     unchecked, _ = from_300(trefoil, never)
     assert checked.stopped == "confident" and checked.rotation < math.radians(60.0) and checked.reversals == 0

@@ -252,6 +252,26 @@ def test_simulate_reactively_on_a_dxf_outline_with_its_plot(tmp_path, capsys):
     doc = json.loads(capsys.readouterr().out)
     assert rc == 0 and doc["stopped"] == "confident" and doc["error_mm"] < 0.3
     assert png.stat().st_size > 10_000 and out.exists()
+    # seeking information by default: from the fillet it rolls on to the face that tells it from its mirror twin.
+    # The baseline's direction rule turns round over the fillet, which reads the same as the twin's
+    assert doc["policy"] == "seek" and doc["reversals"] == 0
+    rc = main(
+        ["simulate", str(PARTS / "bracket.dxf"), "--start", "75", "--reactive", "--noise", "none"]
+        + ["--policy", "spread", "--out", str(out), "--json"]
+    )
+    spread = json.loads(capsys.readouterr().out)
+    assert rc == 0 and spread["policy"] == "spread" and spread["reversals"] > 0
+    assert spread["rotation_deg"] > doc["rotation_deg"]
+
+
+def test_the_direction_rule_is_the_straight_jaws(tmp_path, capsys):
+    with pytest.raises(SystemExit) as refused:
+        main(
+            ["simulate", str(PARTS / "kidney.csv"), "--jaw", "wheel:5", "--start", "66", "--reactive"]
+            + ["--policy", "spread", "--out", str(tmp_path / "w.npz")]
+        )
+    assert refused.value.code == 2 and "--policy spread is the straight jaw's" in capsys.readouterr().err
+    assert not (tmp_path / "w.npz").exists()
 
 
 def test_the_two_roll_rule_runs_on_outlines(capsys, tmp_path):

@@ -1,6 +1,7 @@
 """The kinematic world and the reactive rolling on an outline from CAD (issue 16): pivots on convex
 corners, flush contact on faces, and localization from starts on fillets, faces and corners."""
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -119,6 +120,18 @@ def test_noise_free_reactive_localization_from_fillets_faces_and_corners(bracket
     # the three starts on convex corners pivot there until the jaw jumps both ways: readings of one spot,
     # which a burr's crest would give as well, are not enough to be sure (issue 29)
     assert sure >= 5, sure
+
+
+@pytest.mark.parametrize("arc", [73.0, 78.0, 82.0])
+def test_from_a_fillet_the_jaw_rolls_to_what_tells_it_from_its_twin(bracket, calibration, arc):
+    # the bracket's lower right fillet and its mirror twin, the upper right one, read alike all along; what tells
+    # them apart lies past either end: the face rolling on counter-clockwise crosses in one step, 24 mm against
+    # the twin's 22. Seeking information the jaw rolls on to it, sure and right without turning round; the
+    # spread rule of the two leading modes turned round over the fillet 14 to 69 times, and from 78 mm spent
+    # its 240 degrees there
+    res, error = roll_from(bracket, calibration, (arc, 0.0, -40.0))
+    assert res.stopped == "confident" and error < 0.3, (res.stopped, res.belief.mass, error)
+    assert res.reversals == 0 and res.rotation < math.radians(90.0), (res.reversals, math.degrees(res.rotation))
 
 
 def test_noise_free_reactive_localization_in_the_pymunk_world(bracket, calibration):
