@@ -18,7 +18,7 @@ from ._contact_settings import (
     TEMPER,
 )
 from ._particle_filter import ParticleFilter
-from ._stretches import DEFECT_WINDOW, UNEXPLAINED, Misfit
+from ._stretches import DEFECT_WINDOW, NOISE_FIT_LIMIT, UNEXPLAINED, Misfit
 from ._wheel_filter import (
     WHEEL_FIT_SCALE,
     WHEEL_NOISE_SCALES,
@@ -52,6 +52,7 @@ __all__ = [
     "ParticleFilter",
     "DEFECT_WINDOW",
     "UNEXPLAINED",
+    "NOISE_FIT_LIMIT",
     "Misfit",
     "WHEEL_FIT_SCALE",
     "WHEEL_NOISE_SCALES",

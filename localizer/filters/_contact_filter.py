@@ -31,8 +31,10 @@ from ._contact_settings import (
 )
 from ._stretches import (
     FIT_EVERY,
+    FIT_MIN_READINGS,
     FIT_STARTS,
     MAX_QUARANTINE,
+    NOISE_FIT_LIMIT,
     UNEXPLAINED,
     Misfit,
 )
@@ -405,6 +407,10 @@ class ContactFilter(ContactFit):
         prior = self.feasible.astype(float) if self.steps == 0 else self.tracks.convex.astype(float)
         prior /= prior.sum()
         informative, ambiguous = belief_flags(w, prior, modes, self.mode_floor, self.confidence)
+        # readings that fit the most probable start only as noise many times the rig's say nothing of where the
+        # contact is: no probability is stated on them (the rolling goes on; the fit test may yet find the stretch)
+        if mass > 0 and self.steps >= FIT_MIN_READINGS and self.noise_scale() > NOISE_FIT_LIMIT:
+            mass = 0.0
         return Belief(
             map_arc=map_arc,
             mass=mass,

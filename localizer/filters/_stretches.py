@@ -21,6 +21,7 @@ __all__ = [
     "FIT_RATIO",
     "FIT_STARTS",
     "MAX_QUARANTINE",
+    "NOISE_FIT_LIMIT",
     "Misfit",
     "stretch_windows",
 ]
@@ -54,6 +55,14 @@ FIT_STARTS = 8
 #: How many stretches that do not fit a filter takes out of its likelihood (one burr and the edge of
 #: another, or both rims of a dent); it stops testing after that.
 MAX_QUARANTINE = 3
+#: The noise scale (the factor on the noise settings the readings say, :meth:`ContactFilter.noise_scale`)
+#: beyond which they say nothing of where the contact is: the belief states no probability. The fit test is
+#: a ratio of a stretch's misfit to the rest's and passes readings that misfit a start all along, which a
+#: wrong start can then explain by noise many times the rig's (a corner's pivot, after a burr under the
+#: start ruled the true one out). Twice the largest untold noise the filter is meant to meet (four times the
+#: noise model); the tuning family at ×5.6 reaches at most 6.9 (docs/robustness.md, "Readings that fit
+#: only as noise").
+NOISE_FIT_LIMIT = 8.0
 
 
 class Misfit(NamedTuple):

@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.special import logsumexp, softmax
 
-from localizer import ContactFilter, QueryError, load_part, part_from_points
+from localizer import NOISE_FIT_LIMIT, ContactFilter, QueryError, load_part, part_from_points
 from localizer.filters._filter_kernels import weigh_scales
 
 PARTS = Path(__file__).resolve().parents[2] / "parts"
@@ -279,3 +279,21 @@ def test_a_stretch_off_a_large_radius_is_judged_too():
     truth = int(round(300.0 / flt.tracks.h))
     found = flt.fit_test([truth])
     assert found is not None and found.rms_mm > 0.1
+
+
+def test_readings_that_fit_only_as_noise_many_times_the_rigs_state_no_probability(kidney):
+    # the fit test judges a stretch against the rest, so readings that misfit a start all along pass it: a
+    # wrong start may then explain them as noise many times the rig's (a corner's pivot, after a burr under the
+    # start ruled the true one out). Beyond NOISE_FIT_LIMIT times the noise it was told the belief states no
+    # probability; within it (noise four times what it was told, the filter's own remit) it does
+    turns = -STEP * np.arange(1, 301)
+    stated = {}
+    for factor in (4.0, 12.0):
+        flt = ContactFilter(kidney, spacing=0.05)
+        z, _ = exact(flt, 29.3, turns)
+        z = noisy(z, np.random.default_rng(3), factor * flt.sd_position)
+        for k in range(turns.size):
+            flt.update(float(z[k]), float(turns[k]))
+        stated[factor] = (flt.noise_scale(), flt.belief().mass)
+    assert stated[4.0][0] < NOISE_FIT_LIMIT < stated[12.0][0], stated
+    assert stated[4.0][1] > 0.0 and stated[12.0][1] == 0.0, stated
