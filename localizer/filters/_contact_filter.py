@@ -314,7 +314,8 @@ class ContactFilter(ContactFit):
 
     def belief(self, radius: float | None = None) -> Belief:
         """The belief over the present contact (see :class:`Belief`), its mass taken within ``radius`` mm
-        (default: the filter's ``radius``)."""
+        (default: the filter's ``radius``); the mass is 0 where the readings fit the most probable start only as
+        noise more than :data:`~localizer.NOISE_FIT_LIMIT` times what the filter was told."""
         radius = self.radius if radius is None else float(radius)
         part = self.part
         if not self._live.any():  # every start ruled out: nothing on the part fits the readings
