@@ -51,8 +51,6 @@ __all__ = [
     "rig_arguments",
     "servo_arguments",
     "reactive_arguments",
-    "seeks",
-    "POLICIES",
     "pressing",
     "jaw_spec",
     "jaw_argument",
@@ -241,21 +239,12 @@ def reactive_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--policy",
-        choices=POLICIES,
+        choices=("seek", "spread"),
         help="reactive, straight jaw: which way to roll while two places hold the belief: seek (turn towards the "
         "way expected to tell them apart soonest, a face or a corner included; the default) or spread (the "
         "baseline: by how much the unexplored curvature each way separates the two leading places)",
     )
     off_scale_argument(p)
-
-
-#: --policy's choices, the default first: the reactive direction rule (:class:`driver.jaw.ReactivePolicy`'s ``seek``).
-POLICIES = ("seek", "spread")
-
-
-def seeks(args: argparse.Namespace) -> bool:
-    """Whether the reactive run seeks information (--policy seek, the default) or rolls by the spread rule."""
-    return getattr(args, "policy", None) in (None, "seek")
 
 
 def off_scale_argument(p: argparse.ArgumentParser, replay: bool = False) -> None:

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 from localizer import FIT_ALPHA, SUCCESS_RADIUS, Belief, Localization, Outline, Part
 
 from ..rig import GroundTruth, Rig
-from ._options import pressing, seeks
+from ._options import pressing
 
 if TYPE_CHECKING:
     import numpy as np
@@ -73,11 +73,9 @@ def run_reactive(
     from driver.jaw import ReactivePolicy, localize_reactively
     from driver.records import LoggedFilter
 
+    rule = {} if getattr(args, "policy", None) is None else {"seek": args.policy == "seek"}  # else the policy's
     policy = ReactivePolicy(
-        step=math.radians(args.step),
-        confidence=args.confidence,
-        max_rotation=math.radians(args.max_rotation),
-        seek=seeks(args),
+        step=math.radians(args.step), confidence=args.confidence, max_rotation=math.radians(args.max_rotation), **rule
     )
     res = localize_reactively(
         rig,

@@ -342,15 +342,14 @@ class WheelState(WheelModel):
             out = np.minimum(out, (self._behind + tol) / -lo - 1.0)
         return out
 
-    def _scale_posterior(self, factor: float = 1.0, temper: float = TEMPER) -> tuple[FloatArray, FloatArray]:
+    def _scale_posterior(self, temper: float = TEMPER) -> tuple[FloatArray, FloatArray]:
         """Per start: the mean of the part's scale u given the start and that the part is off its model's size,
         and the probability, under the prior probability :attr:`off_scale`, that it is off its size; under the
-        readings' likelihood raised to ``temper`` with the error model times ``factor``. Without the scale:
-        zeros."""
+        readings' likelihood raised to ``temper`` with the error model as told. Without the scale: zeros."""
         if self._terms == 1:
             zero = np.zeros(self.grid.size)
             return zero, zero
-        mean, _, evidence = self._scale_evidence(factor, None, None, temper)
+        mean, _, evidence = self._scale_evidence(1.0, None, None, temper)
         p_off: FloatArray = expit(evidence + (math.log(self.off_scale) - math.log1p(-self.off_scale)))
         return mean, p_off
 
